@@ -1,0 +1,76 @@
+//! `stancelib frames`: ingest clips and write the frame, clip and contact tables.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+
+use super::super::args::FramesArgs;
+use super::super::Outcome;
+use crate::ingest::IngestOptions;
+use crate::library::{write::write_all, ClipRecord, Status};
+use crate::pipeline::batch::{discover, ingest_all};
+use crate::pipeline::spec::{load_body, resolve};
+
+/// Run `frames`.
+///
+/// # Errors
+/// Bad options or body file, missing inputs, an unwritable output folder.
+pub fn run(a: FramesArgs) -> anyhow::Result<Outcome> {
+    let cli = a.body.overrides()?;
+    let body = a.body.body.as_deref().map(load_body).transpose()?;
+    let opts = resolve(body.as_ref(), None, &cli);
+    let files = discover(&a.inputs)?;
+    execute(&files, &a.out, &opts, a.body.threads)
+}
+
+/// Ingest `files` with `threads` workers and write the tables to `out`.
+///
+/// # Errors
+/// A thread pool that cannot start, or an unwritable output folder.
+pub fn execute(
+    files: &[PathBuf],
+    out: &Path,
+    opts: &IngestOptions,
+    threads: usize,
+) -> anyhow::Result<Outcome> {
+    if files.is_empty() {
+        anyhow::bail!("no .bvh files found in the inputs");
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the worker threads")?;
+    let records = pool.install(|| ingest_all(files, opts));
+    write_all(out, &records, opts.joints)
+        .with_context(|| format!("writing tables to {}", out.display()))?;
+    Ok(report(&records, out))
+}
+
+/// Print the per-clip failures and a one-line summary; the outcome for the exit code.
+pub fn report(records: &[ClipRecord], out: &Path) -> Outcome {
+    let count = |s: Status| records.iter().filter(|r| r.status == s).count();
+    for r in records.iter().filter(|r| r.status == Status::Error) {
+        eprintln!("error: {}", r.message.as_deref().unwrap_or("unknown error"));
+    }
+    for r in records.iter().filter(|r| r.status == Status::Skipped) {
+        eprintln!(
+            "skipped: {}: {}",
+            r.path,
+            r.message.as_deref().unwrap_or("")
+        );
+    }
+    let failed = count(Status::Error);
+    println!(
+        "{} clips: {} ok, {} skipped, {} failed; tables in {}",
+        records.len(),
+        count(Status::Ok),
+        count(Status::Skipped),
+        failed,
+        out.display()
+    );
+    if failed > 0 {
+        Outcome::SomeFailed
+    } else {
+        Outcome::Clean
+    }
+}

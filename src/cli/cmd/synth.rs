@@ -1,0 +1,62 @@
+//! `stancelib synth`: write a generated clip and its ground truth (fixtures/README.md).
+
+use std::fmt::Write as _;
+
+use anyhow::Context;
+
+use super::super::args::SynthArgs;
+use super::super::Outcome;
+use crate::skeleton::units::parse_unit;
+use crate::synth::{generate, SynthMotion, SynthOptions, SynthUp};
+
+/// Write `<out>` (BVH) and `<out stem>.truth.csv` (frame, time_s, com_x/y/z in metres Z up,
+/// contact_left_foot, contact_right_foot, force per kg x/y/z).
+///
+/// # Errors
+/// Unknown motion, unit or axis; an unwritable output.
+pub fn run(a: SynthArgs) -> anyhow::Result<Outcome> {
+    let motion = match a.motion.to_ascii_lowercase().as_str() {
+        "run" => SynthMotion::Run,
+        "jump" => SynthMotion::Jump,
+        m => anyhow::bail!("--motion: '{m}' is not run or jump"),
+    };
+    let up = match a.up.to_ascii_uppercase().trim_start_matches('+') {
+        "Y" => SynthUp::Y,
+        "Z" => SynthUp::Z,
+        u => anyhow::bail!("--up: '{u}' is not Y or Z"),
+    };
+    let unit_m =
+        parse_unit(&a.unit).ok_or_else(|| anyhow::anyhow!("--unit: '{}' is not a unit", a.unit))?;
+    let opts = SynthOptions {
+        motion,
+        frame_rate_hz: a.rate,
+        duration_s: a.duration,
+        unit_m,
+        up,
+        seed: a.seed,
+    };
+    let clip = generate(&opts);
+    std::fs::write(&a.out, &clip.bvh).with_context(|| format!("writing {}", a.out.display()))?;
+    let mut csv = String::from("frame,time_s,com_x,com_y,com_z,contact_left_foot,contact_right_foot,force_x_per_kg,force_y_per_kg,force_z_per_kg\n");
+    let dt = 1.0 / opts.frame_rate_hz;
+    for (f, c) in clip.com.iter().enumerate() {
+        let g = clip.force_n_per_kg[f];
+        let _ = writeln!(
+            csv,
+            "{f},{:.9},{:.9},{:.9},{:.9},{},{},{:.9},{:.9},{:.9}",
+            f as f64 * dt,
+            c[0],
+            c[1],
+            c[2],
+            clip.contact_left[f],
+            clip.contact_right[f],
+            g[0],
+            g[1],
+            g[2]
+        );
+    }
+    let truth = a.out.with_extension("truth.csv");
+    std::fs::write(&truth, csv).with_context(|| format!("writing {}", truth.display()))?;
+    println!("wrote {} and {}", a.out.display(), truth.display());
+    Ok(Outcome::Clean)
+}

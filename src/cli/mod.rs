@@ -1,0 +1,27 @@
+//! Command-line interface: validated arguments → one command per subcommand.
+
+pub mod args;
+pub mod cmd;
+
+use args::{Cli, Command};
+
+/// How a command finished (fatal errors are `Err`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Every input was processed (ok or skipped).
+    Clean,
+    /// Finished, but some inputs failed (exit code 1).
+    SomeFailed,
+}
+
+/// Run a parsed command line.
+///
+/// # Errors
+/// Fatal errors (bad configuration, unreadable inputs, unwritable output): exit code 2.
+pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
+    match cli.command {
+        Command::Frames(a) => cmd::frames::run(a),
+        Command::Run(a) => cmd::run::run(a),
+        Command::Synth(a) => cmd::synth::run(a),
+    }
+}

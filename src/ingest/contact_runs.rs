@@ -1,0 +1,100 @@
+//! Contact runs with event times, surface heights and contact frames (spec com-from-bvh
+//! §7.3 event times, §7.5 contact frames, §8 `contacts.parquet`).
+//!
+//! # Model
+//! ```text
+//! run a..b:  t_TD = t[a] − dt/2 (null at the first kept frame), t_LO = t[b] + dt/2 (null at the last)
+//! origin    = mean of the effector's contact points over the run
+//! yaw       = atan2 of the mean horizontal ankle→toe (wrist→MET3) direction; facing from the
+//!             hips when that is vertical
+//! surface_z = static run: median height of its triggering point; else median ground_z
+//! ```
+
+use crate::contacts::{runs, EFFECTORS};
+use crate::math::stats::median;
+
+type V3 = [f64; 3];
+
+/// One maximal run of `contact_<e>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactRun {
+    /// `left_foot`, `right_foot`, `left_hand` or `right_hand`.
+    pub effector: &'static str,
+    /// First file row of the run.
+    pub first_frame: i64,
+    /// Last file row of the run.
+    pub last_frame: i64,
+    /// Touchdown time, s (null at a clip edge).
+    pub t_td_s: Option<f64>,
+    /// Liftoff time, s (null at a clip edge).
+    pub t_lo_s: Option<f64>,
+    /// Static contact on some frame of the run.
+    pub is_static: bool,
+    /// Contact height, m.
+    pub surface_z: f64,
+    /// Contact-frame origin, m.
+    pub origin: V3,
+    /// Contact-frame x direction about +z, rad.
+    pub yaw_rad: f64,
+    /// Surface normal (always +z from kinematics).
+    pub normal: V3,
+}
+
+/// Collect the runs of every effector (sorted by effector, then first frame).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn collect(
+    contact: &[Vec<bool>; 4],
+    stat: &[Vec<bool>; 4],
+    surf: &[Vec<Option<f64>>; 4],
+    points: &[Vec<Vec<V3>>; 4],
+    ground_z: &[f64],
+    facing: &[V3],
+    frame: &[i64],
+    time_s: &[f64],
+    dt: f64,
+    static_mode: bool,
+) -> Vec<ContactRun> {
+    let n = frame.len();
+    let mut out = Vec::new();
+    for e in 0..4 {
+        for (a, b) in runs(&contact[e]) {
+            let pts = &points[e];
+            let count = ((b - a + 1) * pts.len().max(1)) as f64;
+            let origin: V3 = std::array::from_fn(|i| {
+                pts.iter()
+                    .map(|p| (a..=b).map(|f| p[f][i]).sum::<f64>())
+                    .sum::<f64>()
+                    / count
+            });
+            let (mut dx, mut dy) = (0.0, 0.0);
+            if pts.len() == 2 {
+                for (p0, p1) in pts[0][a..=b].iter().zip(&pts[1][a..=b]) {
+                    dx += p1[0] - p0[0];
+                    dy += p1[1] - p0[1];
+                }
+            }
+            if (dx * dx + dy * dy).sqrt() < 1e-9 * (b - a + 1) as f64 {
+                dx = (a..=b).map(|f| facing[f][0]).sum();
+                dy = (a..=b).map(|f| facing[f][1]).sum();
+            }
+            let first_static = static_mode.then(|| (a..=b).find(|&f| stat[e][f])).flatten();
+            let surface_z = match first_static.and_then(|f| surf[e][f]) {
+                Some(z) => z,
+                None => median(&ground_z[a..=b]).unwrap_or(0.0),
+            };
+            out.push(ContactRun {
+                effector: EFFECTORS[e],
+                first_frame: frame[a],
+                last_frame: frame[b],
+                t_td_s: (a > 0).then(|| time_s[a] - dt / 2.0),
+                t_lo_s: (b + 1 < n).then(|| time_s[b] + dt / 2.0),
+                is_static: first_static.is_some(),
+                surface_z,
+                origin,
+                yaw_rad: dy.atan2(dx),
+                normal: [0.0, 0.0, 1.0],
+            });
+        }
+    }
+    out
+}

@@ -1,0 +1,377 @@
+//! The numerical body of `ingest`: FK over the kept frames, unit and up axis, toe tips,
+//! COM and its derivatives, floors, contacts and flights.
+
+use super::contact_runs::{self, ContactRun};
+use super::{ClipFrames, ClipSummary, IngestOptions};
+use crate::bvh::Bvh;
+use crate::contacts::detect::{clean, hysteresis, static_hysteresis, PointTrack};
+use crate::contacts::flight::{clip_summary, fit_run};
+use crate::contacts::options::STATIC_MIN_ON_S;
+use crate::contacts::{floor, raw_speed, runs};
+use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
+use crate::math::stats::median;
+use crate::skeleton::com::{com, BodyPoints, SidePoints};
+use crate::skeleton::landmarks::{leg_length, Landmarks, Limb, ToeTipRule};
+use crate::skeleton::names::Side;
+use crate::skeleton::units::{detect_unit, detect_up, NOMINAL_LEG_M};
+use crate::skeleton::{fk, Skeleton};
+
+/// Toe-tip fallback: distance ahead of the ankle per metre of leg (0.7·0.152·1.75/0.84).
+pub const TTIP_FALLBACK_AHEAD: f64 = 0.2217;
+/// Toe-tip fallback: distance below the ankle per metre of leg (0.07/0.84).
+pub const TTIP_FALLBACK_BELOW: f64 = 0.0833;
+/// A toe candidate is valid when its direction from the ankle has at least this cosine
+/// with the facing direction (rest pose, or median over the motion).
+pub const TTIP_MIN_FORWARD_COS: f64 = 0.5;
+
+type V3 = [f64; 3];
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn norm(a: V3) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Horizontal facing direction from the hips: normalize((HJC_L − HJC_R) × e_z).
+pub fn facing(hip_l: V3, hip_r: V3) -> V3 {
+    let d = sub(hip_l, hip_r);
+    let f = [d[1], -d[0], 0.0];
+    let n = norm(f);
+    if n > 0.0 {
+        f.map(|v| v / n)
+    } else {
+        [1.0, 0.0, 0.0]
+    }
+}
+
+/// FK over the kept frames into one flat array (frames × points), file units and axes.
+fn fk_frames(skel: &Skeleton, bvh: &Bvh, skip: usize) -> Vec<V3> {
+    let np = skel.n_points();
+    let n = bvh.motion.n_frames() - skip;
+    let mut out = vec![[0.0; 3]; n * np];
+    let mut ws = fk::FkWorkspace::new(skel);
+    for (f, chunk) in out.chunks_exact_mut(np).enumerate() {
+        fk::forward(skel, &mut ws, bvh.motion.row(skip + f), chunk);
+    }
+    out
+}
+
+fn choose_toe(
+    skel: &Skeleton,
+    lm: &Landmarks,
+    s: Side,
+    rest: &[V3],
+    frames: &[&[V3]],
+    fwd: &[V3],
+    min_end: f64,
+) -> (ToeTipRule, Option<usize>) {
+    let ankle = lm.limb(s).ankle;
+    let rest_fwd = facing(rest[lm.left.hip], rest[lm.right.hip]);
+    for (rule, p) in lm.toe_candidates(skel, s, min_end) {
+        let w = sub(rest[p], rest[ankle]);
+        let rest_ok = norm(w) > 0.0 && dot(w, rest_fwd) >= TTIP_MIN_FORWARD_COS * norm(w);
+        let cosines: Vec<f64> = frames
+            .iter()
+            .zip(fwd)
+            .map(|(fp, fw)| {
+                let w = sub(fp[p], fp[ankle]);
+                let n = norm(w);
+                if n > 0.0 {
+                    dot(w, *fw) / n
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        if rest_ok || median(&cosines).is_some_and(|m| m >= TTIP_MIN_FORWARD_COS) {
+            return (rule, Some(p));
+        }
+    }
+    (ToeTipRule::Fallback, None)
+}
+
+fn side_points(limb: &Limb, fp: &[V3], ttip: V3) -> SidePoints {
+    SidePoints {
+        hjc: fp[limb.hip],
+        kjc: fp[limb.knee],
+        ajc: fp[limb.ankle],
+        ttip,
+        arm: limb
+            .arm
+            .as_ref()
+            .map(|a| [fp[a.shoulder], fp[a.elbow], fp[a.wrist], a.met3.at(fp)]),
+    }
+}
+
+/// Run the numerical stages; fills the per-clip fields of `summary`.
+pub(super) fn run(
+    skel: &Skeleton,
+    lm: &Landmarks,
+    rest_file: &[V3],
+    bvh: &Bvh,
+    skip: usize,
+    opts: &IngestOptions,
+    summary: &mut ClipSummary,
+) -> (ClipFrames, Vec<ContactRun>) {
+    let dt = bvh.motion.frame_time_s;
+    let legs = [
+        [lm.left.hip, lm.left.knee, lm.left.ankle],
+        [lm.right.hip, lm.right.knee, lm.right.ankle],
+    ];
+    let leg_file = leg_length(rest_file, legs);
+    let (scale, unit_name) = match opts.unit_m {
+        Some(u) => (u, "override".to_string()),
+        None => {
+            let (u, w) = detect_unit(leg_file);
+            summary.warnings.extend(w);
+            (u.scale, u.name)
+        }
+    };
+    let mut pts = fk_frames(skel, bvh, skip);
+    let np = skel.n_points();
+    let n = pts.len() / np;
+    let up = match opts.up_axis {
+        Some(a) => a,
+        None => {
+            let head_above = |fp: &[V3]| {
+                let mid: V3 =
+                    std::array::from_fn(|i| 0.5 * (fp[lm.left.ankle][i] + fp[lm.right.ankle][i]));
+                sub(fp[lm.head], mid)
+            };
+            let mut mean = [0.0; 3];
+            for fp in pts.chunks_exact(np) {
+                let v = head_above(fp);
+                (0..3).for_each(|i| mean[i] += v[i] / n as f64);
+            }
+            let (a, w) = detect_up(mean, head_above(rest_file));
+            summary.warnings.extend(w);
+            a
+        }
+    };
+    let to_int = |p: V3| up.to_internal(p).map(|v| v * scale);
+    pts.iter_mut().for_each(|p| *p = to_int(*p));
+    let rest: Vec<V3> = rest_file.iter().map(|p| to_int(*p)).collect();
+    let leg_m = leg_file * scale;
+    summary.unit_scale = Some(scale);
+    summary.unit = Some(unit_name);
+    summary.up_axis = Some(up.as_str().to_string());
+    summary.leg_length_m = Some(leg_m);
+    let frames: Vec<&[V3]> = pts.chunks_exact(np).collect();
+
+    let fwd: Vec<V3> = frames
+        .iter()
+        .map(|fp| facing(fp[lm.left.hip], fp[lm.right.hip]))
+        .collect();
+    let min_end = crate::skeleton::landmarks::DEGENERATE_END_SITE_FRACTION * leg_file;
+    let mut toe: [Vec<V3>; 2] = Default::default();
+    for (k, s) in [Side::L, Side::R].into_iter().enumerate() {
+        let (rule, p) = choose_toe(skel, lm, s, &rest, &frames, &fwd, min_end);
+        summary.toe_tip_rule[k] = Some(rule.as_str().to_string());
+        let ankle = lm.limb(s).ankle;
+        toe[k] = (0..n)
+            .map(|f| {
+                let fp = frames[f];
+                match p {
+                    Some(p) => fp[p],
+                    None => std::array::from_fn(|i| {
+                        fp[ankle][i] + TTIP_FALLBACK_AHEAD * leg_m * fwd[f][i]
+                            - if i == 2 {
+                                TTIP_FALLBACK_BELOW * leg_m
+                            } else {
+                                0.0
+                            }
+                    }),
+                }
+            })
+            .collect();
+    }
+    if let Some(s) = summary.skeleton.as_mut() {
+        s.push_str(&format!(
+            ";TTIP_L={};TTIP_R={}",
+            summary.toe_tip_rule[0].as_deref().unwrap_or("?"),
+            summary.toe_tip_rule[1].as_deref().unwrap_or("?")
+        ));
+    }
+    for (tag, limb) in [("left", &lm.left), ("right", &lm.right)] {
+        if limb.arm.is_none() {
+            summary
+                .warnings
+                .push(format!("no {tag} arm: arm mass added to the trunk"));
+        }
+    }
+    let com_pos: Vec<V3> = (0..n)
+        .map(|f| {
+            let fp = frames[f];
+            let b = BodyPoints {
+                vert: lm.vert.at(fp),
+                cerv: fp[lm.cerv],
+                left: side_points(&lm.left, fp, toe[0][f]),
+                right: side_points(&lm.right, fp, toe[1][f]),
+            };
+            com(&b, opts.sex)
+        })
+        .collect();
+    summary.handedness_ok = Some(handedness(&frames, lm, &toe));
+    if summary.handedness_ok == Some(false) {
+        summary.warnings.push(
+            "handedness check failed: left/right labels swapped or the file is mirrored".into(),
+        );
+    }
+
+    let sg = SavGol::new(window_for_rate(1.0 / dt), DEFAULT_ORDER).expect("window ≥ 5 is valid");
+    let deriv = |d: usize| -> Vec<V3> {
+        let cols: [Vec<f64>; 3] = std::array::from_fn(|i| {
+            sg.apply(&com_pos.iter().map(|c| c[i]).collect::<Vec<_>>(), d, dt)
+        });
+        (0..n)
+            .map(|f| [cols[0][f], cols[1][f], cols[2][f]])
+            .collect()
+    };
+    let com_v = deriv(1);
+    let com_a = deriv(2);
+    let frame: Vec<i64> = (0..n).map(|f| (skip + f) as i64).collect();
+    let time_s: Vec<f64> = frame.iter().map(|&f| f as f64 * dt).collect();
+
+    // Contacts (§7).
+    let c = &opts.contacts;
+    let half = floor::half_window(dt, c.floor_window_s);
+    let zs = |v: &[V3]| v.iter().map(|p| p[2]).collect::<Vec<f64>>();
+    let ground_z = floor::ground(&zs(&toe[0]), &zs(&toe[1]), half);
+    let sc = leg_m / NOMINAL_LEG_M;
+    let track_of = |p: &[V3], h: Vec<f64>| PointTrack {
+        h,
+        v: raw_speed(p, dt),
+    };
+    let ankle_pos = |s: Side| -> Vec<V3> { (0..n).map(|f| frames[f][lm.limb(s).ankle]).collect() };
+    let mut effector_pos: [Option<Vec<V3>>; 4] = Default::default();
+    let mut tracks: [Vec<PointTrack>; 4] = Default::default();
+    let mut points: [Vec<Vec<V3>>; 4] = Default::default();
+    for (k, s) in [Side::L, Side::R].into_iter().enumerate() {
+        let a = ankle_pos(s);
+        tracks[k] = vec![
+            track_of(
+                &a,
+                floor::foot_heights(&zs(&a), &ground_z, half, floor::CLEARANCE_ANKLE, sc),
+            ),
+            track_of(
+                &toe[k],
+                floor::foot_heights(&zs(&toe[k]), &ground_z, half, floor::CLEARANCE_TTIP, sc),
+            ),
+        ];
+        points[k] = vec![a.clone(), toe[k].clone()];
+        effector_pos[k] = Some(a);
+        if let Some(arm) = &lm.limb(s).arm {
+            let wr: Vec<V3> = (0..n).map(|f| frames[f][arm.wrist]).collect();
+            let m3: Vec<V3> = (0..n).map(|f| arm.met3.at(frames[f])).collect();
+            if c.hands {
+                tracks[2 + k] = vec![
+                    track_of(
+                        &wr,
+                        floor::hand_heights(&zs(&wr), &ground_z, floor::CLEARANCE_WRIST, sc),
+                    ),
+                    track_of(
+                        &m3,
+                        floor::hand_heights(&zs(&m3), &ground_z, floor::CLEARANCE_MET3, sc),
+                    ),
+                ];
+                points[2 + k] = vec![wr.clone(), m3];
+            }
+            effector_pos[2 + k] = Some(wr);
+        }
+    }
+    let rate = 1.0 / dt;
+    let mut contact: [Vec<bool>; 4] = Default::default();
+    let mut stat: [Vec<bool>; 4] = Default::default();
+    let mut surf: [Vec<Option<f64>>; 4] = Default::default();
+    for e in 0..4 {
+        if tracks[e].is_empty() {
+            contact[e] = vec![false; n];
+            stat[e] = vec![false; n];
+            surf[e] = vec![None; n];
+            continue;
+        }
+        let th = if e < 2 { &c.foot } else { &c.hand };
+        let mut flags = hysteresis(&tracks[e], th);
+        clean(&mut flags, rate, c.min_gap_s, c.min_on_s);
+        if c.static_mode {
+            let (mut sflags, trig) = static_hysteresis(&tracks[e]);
+            clean(&mut sflags, rate, c.min_gap_s, STATIC_MIN_ON_S);
+            surf[e] = vec![None; n];
+            for (a, b) in runs(&sflags) {
+                let p = trig[a].unwrap_or(0);
+                let z: Vec<f64> = (a..=b).map(|f| points[e][p][f][2]).collect();
+                let m = median(&z);
+                surf[e][a..=b].iter_mut().for_each(|s| *s = m);
+            }
+            flags.iter_mut().zip(&sflags).for_each(|(f, s)| *f |= *s);
+            clean(&mut flags, rate, c.min_gap_s, c.min_on_s);
+            stat[e] = sflags;
+        }
+        contact[e] = flags;
+    }
+
+    // Flights (§7.7).
+    let any: Vec<bool> = (0..n).map(|f| contact.iter().any(|c| c[f])).collect();
+    let vz: Vec<f64> = com_v.iter().map(|v| v[2]).collect();
+    let no_contact: Vec<bool> = any.iter().map(|a| !a).collect();
+    summary.flights = runs(&no_contact)
+        .into_iter()
+        .filter(|&(a, b)| a > 0 && b + 1 < n)
+        .map(|(a, b)| fit_run(&com_pos, &time_s, &vz, a, b, dt, skip as i64))
+        .collect();
+    let (s_eff, az) = clip_summary(&summary.flights);
+    summary.s_eff = s_eff;
+    summary.flight_az_median = az;
+
+    let runs_out = contact_runs::collect(
+        &contact,
+        &stat,
+        &surf,
+        &points,
+        &ground_z,
+        &fwd,
+        &frame,
+        &time_s,
+        dt,
+        c.static_mode,
+    );
+    let joints = opts
+        .joints
+        .then(|| ((0..np).map(|p| skel.point_name(p)).collect(), pts.clone()));
+    let frames = ClipFrames {
+        frame,
+        time_s,
+        com: com_pos,
+        com_v,
+        com_a,
+        ground_z,
+        contact,
+        static_contact: c.static_mode.then_some(stat),
+        surface_z: c.static_mode.then_some(surf),
+        effector_pos,
+        toe,
+        joints,
+    };
+    (frames, runs_out)
+}
+
+/// `(hip_L − hip_R) · (e_z × forward) > 0`, forward = mean horizontal ankle→toe direction.
+fn handedness(frames: &[&[V3]], lm: &Landmarks, toe: &[Vec<V3>; 2]) -> bool {
+    let mut fw = [0.0; 3];
+    let mut hip = [0.0; 3];
+    for (f, fp) in frames.iter().enumerate() {
+        for (k, limb) in [&lm.left, &lm.right].into_iter().enumerate() {
+            let d = sub(toe[k][f], fp[limb.ankle]);
+            fw[0] += d[0];
+            fw[1] += d[1];
+        }
+        let h = sub(fp[lm.left.hip], fp[lm.right.hip]);
+        (0..3).for_each(|i| hip[i] += h[i]);
+    }
+    let side = [-fw[1], fw[0], 0.0]; // e_z × forward
+    dot(hip, side) > 0.0
+}

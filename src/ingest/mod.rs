@@ -1,0 +1,197 @@
+//! One clip from parsed BVH to per-frame COM, contacts and per-clip diagnostics.
+//!
+//! # Model
+//! ```text
+//! Bvh → Skeleton → landmarks → lead-in → FK (file frame) → unit, up axis → points (m, Z up)
+//!     → toe tips → COM (de Leva) → SG velocity/acceleration → local floor → contacts
+//!     → flights (§7.7) → contact runs (§8)
+//! ```
+//! Pure: no I/O. The batch layer (`library`, `cli`) reads files and writes tables.
+//!
+//! # References
+//! spec com-from-bvh §1–§8.
+
+mod contact_runs;
+mod kinematics;
+
+use std::collections::BTreeMap;
+
+use crate::bvh::Bvh;
+use crate::contacts::flight::Flight;
+use crate::contacts::ContactOptions;
+use crate::error::Result;
+use crate::skeleton::com::Sex;
+use crate::skeleton::landmarks::{self, Mapping};
+use crate::skeleton::units::UpAxis;
+use crate::skeleton::{fk, leadin, Skeleton};
+
+pub use contact_runs::ContactRun;
+
+/// Default body mass, kg (spec com-from-bvh §5).
+pub const DEFAULT_MASS_KG: f64 = 70.0;
+
+/// Options of the ingest stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IngestOptions {
+    /// Body mass, kg (scales forces downstream; does not move the COM).
+    pub mass_kg: f64,
+    /// de Leva column.
+    pub sex: Sex,
+    /// Unit override, metres per file unit.
+    pub unit_m: Option<f64>,
+    /// Up-axis override.
+    pub up_axis: Option<UpAxis>,
+    /// Landmark overrides (`AJC_L` → joint name, …).
+    pub landmarks: BTreeMap<String, String>,
+    /// Contact thresholds.
+    pub contacts: ContactOptions,
+    /// Keep every joint's world position (for `joints.parquet`).
+    pub joints: bool,
+}
+
+impl Default for IngestOptions {
+    fn default() -> Self {
+        IngestOptions {
+            mass_kg: DEFAULT_MASS_KG,
+            sex: Sex::Male,
+            unit_m: None,
+            up_axis: None,
+            landmarks: BTreeMap::new(),
+            contacts: ContactOptions::default(),
+            joints: false,
+        }
+    }
+}
+
+/// Per-frame outputs of a clip (kept frames only), metres, Z up.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ClipFrames {
+    /// File row index per kept frame.
+    pub frame: Vec<i64>,
+    /// `frame · dt`, s.
+    pub time_s: Vec<f64>,
+    /// Whole-body COM, m.
+    pub com: Vec<[f64; 3]>,
+    /// SG COM velocity, m/s.
+    pub com_v: Vec<[f64; 3]>,
+    /// SG COM acceleration, m/s².
+    pub com_a: Vec<[f64; 3]>,
+    /// Local floor height, m.
+    pub ground_z: Vec<f64>,
+    /// Contact flags per effector (`contacts::EFFECTORS` order).
+    pub contact: [Vec<bool>; 4],
+    /// Static flags per effector (static mode only).
+    pub static_contact: Option<[Vec<bool>; 4]>,
+    /// Static surface height per effector and frame (static mode only).
+    pub surface_z: Option<[Vec<Option<f64>>; 4]>,
+    /// Ankle (feet) or wrist (hands) centre per effector; `None` without that limb.
+    pub effector_pos: [Option<Vec<[f64; 3]>>; 4],
+    /// Left and right toe tips.
+    pub toe: [Vec<[f64; 3]>; 2],
+    /// All joint and End Site positions (`--joints`): names and frames × points.
+    pub joints: Option<(Vec<String>, Vec<[f64; 3]>)>,
+}
+
+/// Per-clip results (the `clips.parquet` fields that come from the motion).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ClipSummary {
+    /// `Frames:` header value.
+    pub frames_header: Option<i64>,
+    /// Complete data rows.
+    pub frames_data: i64,
+    /// Kept frames.
+    pub frames_kept: i64,
+    /// Dropped lead-in rows.
+    pub leadin_dropped: Vec<i64>,
+    /// Frame time, s.
+    pub frame_time_s: f64,
+    /// Metres per file unit.
+    pub unit_scale: Option<f64>,
+    /// Unit name, `estimated` or `override`.
+    pub unit: Option<String>,
+    /// Up axis used.
+    pub up_axis: Option<String>,
+    /// Handedness check passed.
+    pub handedness_ok: Option<bool>,
+    /// Leg length, m.
+    pub leg_length_m: Option<f64>,
+    /// `landmark=joint` pairs.
+    pub skeleton: Option<String>,
+    /// Toe-tip rules, left and right.
+    pub toe_tip_rule: [Option<String>; 2],
+    /// Flights (no-contact runs not at a clip edge).
+    pub flights: Vec<Flight>,
+    /// Median `a_z` over airborne intervals, m/s².
+    pub flight_az_median: Option<f64>,
+    /// Clip effective time scale.
+    pub s_eff: Option<f64>,
+    /// Advisory messages.
+    pub warnings: Vec<String>,
+}
+
+/// What ingesting a clip gives.
+// Returned once per clip and destructured at once: boxing the large variant buys nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum ClipOutcome {
+    /// A body with enough frames.
+    Body {
+        /// Per-clip fields.
+        summary: ClipSummary,
+        /// Per-frame table.
+        frames: ClipFrames,
+        /// Contact runs.
+        contacts: Vec<ContactRun>,
+    },
+    /// Not a body, or too short: not a failure.
+    Skipped {
+        /// Per-clip fields known so far.
+        summary: ClipSummary,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// Ingest one parsed clip.
+///
+/// # Errors
+/// A partial landmark mapping (spec com-from-bvh §1.1), or a `[landmarks]` override that
+/// names no joint.
+pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
+    let m = &bvh.motion;
+    let mut summary = ClipSummary {
+        frames_header: m.frames_header.map(|v| v.min(i64::MAX as u64) as i64),
+        frames_data: m.n_frames() as i64,
+        frame_time_s: m.frame_time_s,
+        warnings: bvh.warnings.clone(),
+        ..Default::default()
+    };
+    let skel = Skeleton::from_bvh(bvh);
+    let rest = fk::rest_pose(&skel);
+    let lm = match landmarks::map(&skel, &rest, &opts.landmarks)? {
+        Mapping::NotABody => {
+            let reason =
+                "no body landmark found (no sided ankle, knee or hip, no head)".to_string();
+            return Ok(ClipOutcome::Skipped { summary, reason });
+        }
+        Mapping::Found(lm) => lm,
+    };
+    let skip = leadin::leadin_frames(&skel, m);
+    summary.leadin_dropped = (0..skip as i64).collect();
+    summary.frames_kept = (m.n_frames() - skip) as i64;
+    summary.skeleton = Some(lm.describe(&skel));
+    let w = crate::math::savgol::window_for_rate(1.0 / m.frame_time_s);
+    if m.n_frames() - skip < w {
+        let reason = format!(
+            "too short: {} kept frames, fewer than the SG window of {w}",
+            m.n_frames() - skip
+        );
+        return Ok(ClipOutcome::Skipped { summary, reason });
+    }
+    let (frames, contacts) = kinematics::run(&skel, &lm, &rest, bvh, skip, opts, &mut summary);
+    Ok(ClipOutcome::Body {
+        summary,
+        frames,
+        contacts,
+    })
+}

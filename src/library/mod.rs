@@ -1,0 +1,57 @@
+//! The columnar outputs: one record per input clip, turned into `frames.parquet`,
+//! `clips.parquet`, `contacts.parquet` and (optionally) `joints.parquet`, written
+//! atomically (temporary name, then rename).
+//!
+//! # References
+//! spec com-from-bvh §8 (column tables); STYLE.md §5.6 (deterministic files).
+
+pub mod read;
+pub mod schema;
+pub mod write;
+
+use crate::ingest::{ClipFrames, ClipSummary, ContactRun};
+
+/// Status of one input file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Ingested.
+    Ok,
+    /// Not a body, or too short (not a failure).
+    Skipped,
+    /// Could not be read or mapped (a failure).
+    Error,
+}
+
+impl Status {
+    /// Value of the `status` column.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Skipped => "skipped",
+            Status::Error => "error",
+        }
+    }
+}
+
+/// Everything known about one input file after ingest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClipRecord {
+    /// The path as given.
+    pub path: String,
+    /// Clip name (spec com-from-bvh §1.1).
+    pub clip: String,
+    /// SHA-256 of the file's bytes, hex (empty when unreadable).
+    pub content_sha256: String,
+    /// Outcome.
+    pub status: Status,
+    /// Skip reason or error message.
+    pub message: Option<String>,
+    /// Body mass used, kg.
+    pub mass_kg: f64,
+    /// Per-clip fields (defaults when the file did not parse).
+    pub summary: ClipSummary,
+    /// Per-frame table (status `ok` only).
+    pub frames: Option<ClipFrames>,
+    /// Contact runs (status `ok` only).
+    pub contacts: Vec<ContactRun>,
+}

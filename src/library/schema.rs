@@ -1,0 +1,81 @@
+//! Column names of the output tables, in one place (spec com-from-bvh §8).
+//!
+//! `frames.parquet` (sorted by `clip`, `frame`): `clip`, `frame`, `time_s`, `com_{x,y,z}`,
+//! `com_v{x,y,z}`, `com_a{x,y,z}`, `ground_z`, `contact_<e>`, `static_<e>`,
+//! `surface_z_<e>`, `<e>_{x,y,z}`, `{left,right}_toe_{x,y,z}`.
+//! `clips.parquet` (sorted by `clip`): see [`CLIPS_COLUMNS`].
+//! `contacts.parquet` (sorted by `clip`, `effector`, `first_frame`): see [`CONTACTS_COLUMNS`].
+//! `joints.parquet` (sorted by `clip`, `frame`, then file joint order): `clip`, `frame`,
+//! `joint`, `x`, `y`, `z`.
+
+/// Version of the table layout; bumped on any column change.
+pub const SCHEMA_VERSION: &str = "1";
+/// Per-frame table.
+pub const FRAMES_FILE: &str = "frames.parquet";
+/// Per-clip table.
+pub const CLIPS_FILE: &str = "clips.parquet";
+/// Contact-run table.
+pub const CONTACTS_FILE: &str = "contacts.parquet";
+/// Joint-position table (`--joints`).
+pub const JOINTS_FILE: &str = "joints.parquet";
+
+/// Columns of `clips.parquet`, in order.
+pub const CLIPS_COLUMNS: [&str; 23] = [
+    "path",
+    "clip",
+    "content_sha256",
+    "status",
+    "message",
+    "frames_header",
+    "frames_data",
+    "frames_kept",
+    "leadin_dropped",
+    "frame_time_s",
+    "unit_scale",
+    "unit",
+    "up_axis",
+    "handedness_ok",
+    "leg_length_m",
+    "mass_kg",
+    "skeleton",
+    "toe_tip_rule_left",
+    "toe_tip_rule_right",
+    "flights",
+    "flight_az_median",
+    "s_eff",
+    "warnings",
+];
+
+/// Fields of the `flights` struct in `clips.parquet`.
+pub const FLIGHT_FIELDS: [&str; 11] = [
+    "first_frame",
+    "last_frame",
+    "duration_s",
+    "a_z",
+    "a_x",
+    "a_y",
+    "rms_m",
+    "s_eff",
+    "a_z_mean",
+    "ballistic",
+    "tested",
+];
+
+/// Columns of `contacts.parquet`, in order.
+pub const CONTACTS_COLUMNS: [&str; 15] = [
+    "clip",
+    "effector",
+    "first_frame",
+    "last_frame",
+    "t_td_s",
+    "t_lo_s",
+    "static",
+    "surface_z",
+    "origin_x",
+    "origin_y",
+    "origin_z",
+    "yaw_rad",
+    "normal_x",
+    "normal_y",
+    "normal_z",
+];

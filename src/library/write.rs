@@ -1,0 +1,386 @@
+//! Building the output tables from clip records and writing them atomically.
+//!
+//! Rows are sorted by stable keys (`clip`, then frame or effector) before writing, with
+//! fixed writer settings (zstd, statistics on, one row group per 64 Ki rows), so the files
+//! do not depend on thread count or input order.
+
+use std::path::Path;
+
+use polars::prelude::*;
+
+use super::schema::*;
+use super::ClipRecord;
+use crate::contacts::EFFECTORS;
+use crate::error::{Error, Result};
+
+/// Rows per Parquet row group.
+pub const ROW_GROUP_ROWS: usize = 65_536;
+
+fn col<T, P>(name: &str, v: T) -> Column
+where
+    Series: NamedFrom<T, P>,
+    P: ?Sized,
+{
+    Column::new(name.into(), v)
+}
+
+fn polars_err(path: &Path, e: PolarsError) -> Error {
+    Error::io(path, "cannot build table", e)
+}
+
+/// `frames.parquet` from the `ok` records (already sorted by clip).
+pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
+    let fr: Vec<(&str, &crate::ingest::ClipFrames)> = records
+        .iter()
+        .filter_map(|r| r.frames.as_ref().map(|f| (r.clip.as_str(), f)))
+        .collect();
+    let n: usize = fr.iter().map(|(_, f)| f.frame.len()).sum();
+    let mut clip = Vec::with_capacity(n);
+    for (c, f) in &fr {
+        clip.extend(std::iter::repeat_n(*c, f.frame.len()));
+    }
+    let cat_i64 = |g: &dyn Fn(&crate::ingest::ClipFrames) -> &Vec<i64>| -> Vec<i64> {
+        fr.iter().flat_map(|(_, f)| g(f).iter().copied()).collect()
+    };
+    let cat_f64 = |g: &dyn Fn(&crate::ingest::ClipFrames) -> Vec<f64>| -> Vec<f64> {
+        fr.iter().flat_map(|(_, f)| g(f)).collect()
+    };
+    let mut cols = vec![
+        col("clip", clip),
+        col("frame", cat_i64(&|f| &f.frame)),
+        col("time_s", cat_f64(&|f| f.time_s.clone())),
+    ];
+    for (prefix, get) in [("com_", 0usize), ("com_v", 1), ("com_a", 2)] {
+        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+            let v = cat_f64(&|f| {
+                let src = match get {
+                    0 => &f.com,
+                    1 => &f.com_v,
+                    _ => &f.com_a,
+                };
+                src.iter().map(|p| p[a]).collect()
+            });
+            cols.push(col(&format!("{prefix}{axis}"), v));
+        }
+    }
+    cols.push(col("ground_z", cat_f64(&|f| f.ground_z.clone())));
+    for (e, name) in EFFECTORS.iter().enumerate() {
+        let v: Vec<bool> = fr
+            .iter()
+            .flat_map(|(_, f)| f.contact[e].iter().copied())
+            .collect();
+        cols.push(col(&format!("contact_{name}"), v));
+    }
+    for (e, name) in EFFECTORS.iter().enumerate() {
+        let v: Vec<Option<bool>> = fr
+            .iter()
+            .flat_map(|(_, f)| match &f.static_contact {
+                Some(s) => s[e].iter().map(|b| Some(*b)).collect::<Vec<_>>(),
+                None => vec![None; f.frame.len()],
+            })
+            .collect();
+        cols.push(col(&format!("static_{name}"), v));
+        let z: Vec<Option<f64>> = fr
+            .iter()
+            .flat_map(|(_, f)| match &f.surface_z {
+                Some(s) => s[e].clone(),
+                None => vec![None; f.frame.len()],
+            })
+            .collect();
+        cols.push(col(&format!("surface_z_{name}"), z));
+    }
+    for (e, name) in EFFECTORS.iter().enumerate() {
+        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+            let v: Vec<Option<f64>> = fr
+                .iter()
+                .flat_map(|(_, f)| match &f.effector_pos[e] {
+                    Some(p) => p.iter().map(|q| Some(q[a])).collect::<Vec<_>>(),
+                    None => vec![None; f.frame.len()],
+                })
+                .collect();
+            cols.push(col(&format!("{name}_{axis}"), v));
+        }
+    }
+    for (k, side) in ["left", "right"].iter().enumerate() {
+        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+            cols.push(col(
+                &format!("{side}_toe_{axis}"),
+                cat_f64(&|f| f.toe[k].iter().map(|p| p[a]).collect()),
+            ));
+        }
+    }
+    DataFrame::new(cols)
+}
+
+fn flights_dtype() -> DataType {
+    let f = |n: &str, t: DataType| Field::new(n.into(), t);
+    let fields = vec![
+        f("first_frame", DataType::Int64),
+        f("last_frame", DataType::Int64),
+        f("duration_s", DataType::Float64),
+        f("a_z", DataType::Float64),
+        f("a_x", DataType::Float64),
+        f("a_y", DataType::Float64),
+        f("rms_m", DataType::Float64),
+        f("s_eff", DataType::Float64),
+        f("a_z_mean", DataType::Float64),
+        f("ballistic", DataType::Boolean),
+        f("tested", DataType::Boolean),
+    ];
+    DataType::List(Box::new(DataType::Struct(fields)))
+}
+
+fn flights_series(r: &ClipRecord) -> PolarsResult<Option<Series>> {
+    if r.frames.is_none() {
+        return Ok(None);
+    }
+    let fl = &r.summary.flights;
+    macro_rules! s {
+        ($name:expr, $get:expr) => {
+            Series::new($name.into(), fl.iter().map($get).collect::<Vec<_>>())
+        };
+    }
+    let fields = [
+        s!("first_frame", |f| f.first_frame),
+        s!("last_frame", |f| f.last_frame),
+        s!("duration_s", |f| f.duration_s),
+        s!("a_z", |f| f.a_z),
+        s!("a_x", |f| f.a_x),
+        s!("a_y", |f| f.a_y),
+        s!("rms_m", |f| f.rms_m),
+        s!("s_eff", |f| f.s_eff),
+        s!("a_z_mean", |f| f.a_z_mean),
+        s!("ballistic", |f| f.ballistic),
+        s!("tested", |f| f.tested),
+    ];
+    Ok(Some(
+        StructChunked::from_series("flights".into(), fl.len(), fields.iter())?.into_series(),
+    ))
+}
+
+/// `clips.parquet` from every record (already sorted by clip).
+pub fn clips_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
+    let s = |g: &dyn Fn(&ClipRecord) -> Option<String>| -> Vec<Option<String>> {
+        records.iter().map(g).collect()
+    };
+    let f = |g: &dyn Fn(&ClipRecord) -> Option<f64>| -> Vec<Option<f64>> {
+        records.iter().map(g).collect()
+    };
+    let i = |g: &dyn Fn(&ClipRecord) -> Option<i64>| -> Vec<Option<i64>> {
+        records.iter().map(g).collect()
+    };
+    let parsed = |r: &ClipRecord| r.summary.frame_time_s > 0.0;
+    let leadin: ListChunked = records
+        .iter()
+        .map(|r| Some(Series::new("".into(), r.summary.leadin_dropped.clone())))
+        .collect();
+    let warnings: ListChunked = records
+        .iter()
+        .map(|r| Some(Series::new("".into(), r.summary.warnings.clone())))
+        .collect();
+    let flights: ListChunked = records
+        .iter()
+        .map(flights_series)
+        .collect::<PolarsResult<Vec<_>>>()?
+        .into_iter()
+        .collect();
+    let cols = vec![
+        col("path", s(&|r| Some(r.path.clone()))),
+        col("clip", s(&|r| Some(r.clip.clone()))),
+        col("content_sha256", s(&|r| Some(r.content_sha256.clone()))),
+        col("status", s(&|r| Some(r.status.as_str().to_string()))),
+        col("message", s(&|r| r.message.clone())),
+        col("frames_header", i(&|r| r.summary.frames_header)),
+        col(
+            "frames_data",
+            i(&|r| parsed(r).then_some(r.summary.frames_data)),
+        ),
+        col(
+            "frames_kept",
+            i(&|r| parsed(r).then_some(r.summary.frames_kept)),
+        ),
+        leadin
+            .into_series()
+            .cast(&DataType::List(Box::new(DataType::Int64)))?
+            .with_name("leadin_dropped".into())
+            .into(),
+        col(
+            "frame_time_s",
+            f(&|r| parsed(r).then_some(r.summary.frame_time_s)),
+        ),
+        col("unit_scale", f(&|r| r.summary.unit_scale)),
+        col("unit", s(&|r| r.summary.unit.clone())),
+        col("up_axis", s(&|r| r.summary.up_axis.clone())),
+        col(
+            "handedness_ok",
+            records
+                .iter()
+                .map(|r| r.summary.handedness_ok)
+                .collect::<Vec<_>>(),
+        ),
+        col("leg_length_m", f(&|r| r.summary.leg_length_m)),
+        col(
+            "mass_kg",
+            records.iter().map(|r| r.mass_kg).collect::<Vec<_>>(),
+        ),
+        col("skeleton", s(&|r| r.summary.skeleton.clone())),
+        col(
+            "toe_tip_rule_left",
+            s(&|r| r.summary.toe_tip_rule[0].clone()),
+        ),
+        col(
+            "toe_tip_rule_right",
+            s(&|r| r.summary.toe_tip_rule[1].clone()),
+        ),
+        flights
+            .into_series()
+            .cast(&flights_dtype())?
+            .with_name("flights".into())
+            .into(),
+        col("flight_az_median", f(&|r| r.summary.flight_az_median)),
+        col("s_eff", f(&|r| r.summary.s_eff)),
+        warnings
+            .into_series()
+            .cast(&DataType::List(Box::new(DataType::String)))?
+            .with_name("warnings".into())
+            .into(),
+    ];
+    DataFrame::new(cols)
+}
+
+/// `contacts.parquet` (sorted by clip, effector, first frame).
+pub fn contacts_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
+    let mut rows: Vec<(&str, &crate::ingest::ContactRun)> = records
+        .iter()
+        .flat_map(|r| r.contacts.iter().map(move |c| (r.clip.as_str(), c)))
+        .collect();
+    rows.sort_by(|a, b| {
+        (a.0, a.1.effector, a.1.first_frame).cmp(&(b.0, b.1.effector, b.1.first_frame))
+    });
+    let f = |g: &dyn Fn(&crate::ingest::ContactRun) -> f64| -> Vec<f64> {
+        rows.iter().map(|(_, c)| g(c)).collect()
+    };
+    DataFrame::new(vec![
+        col("clip", rows.iter().map(|r| r.0).collect::<Vec<_>>()),
+        col(
+            "effector",
+            rows.iter().map(|r| r.1.effector).collect::<Vec<_>>(),
+        ),
+        col(
+            "first_frame",
+            rows.iter().map(|r| r.1.first_frame).collect::<Vec<_>>(),
+        ),
+        col(
+            "last_frame",
+            rows.iter().map(|r| r.1.last_frame).collect::<Vec<_>>(),
+        ),
+        col(
+            "t_td_s",
+            rows.iter().map(|r| r.1.t_td_s).collect::<Vec<_>>(),
+        ),
+        col(
+            "t_lo_s",
+            rows.iter().map(|r| r.1.t_lo_s).collect::<Vec<_>>(),
+        ),
+        col(
+            "static",
+            rows.iter().map(|r| r.1.is_static).collect::<Vec<_>>(),
+        ),
+        col("surface_z", f(&|c| c.surface_z)),
+        col("origin_x", f(&|c| c.origin[0])),
+        col("origin_y", f(&|c| c.origin[1])),
+        col("origin_z", f(&|c| c.origin[2])),
+        col("yaw_rad", f(&|c| c.yaw_rad)),
+        col("normal_x", f(&|c| c.normal[0])),
+        col("normal_y", f(&|c| c.normal[1])),
+        col("normal_z", f(&|c| c.normal[2])),
+    ])
+}
+
+/// `joints.parquet` from the records that kept joint positions.
+pub fn joints_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
+    let (mut clip, mut frame, mut joint) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+    for r in records {
+        let Some(fr) = &r.frames else { continue };
+        let Some((names, pts)) = &fr.joints else {
+            continue;
+        };
+        for (k, f) in fr.frame.iter().enumerate() {
+            for (j, name) in names.iter().enumerate() {
+                let p = pts[k * names.len() + j];
+                clip.push(r.clip.as_str());
+                frame.push(*f);
+                joint.push(name.as_str());
+                x.push(p[0]);
+                y.push(p[1]);
+                z.push(p[2]);
+            }
+        }
+    }
+    DataFrame::new(vec![
+        col("clip", clip),
+        col("frame", frame),
+        col("joint", joint),
+        col("x", x),
+        col("y", y),
+        col("z", z),
+    ])
+}
+
+/// Write a table to `dir/name` atomically: a temporary file in `dir`, then a rename, so a
+/// reader never sees a half-written file and an earlier file survives a failed write.
+///
+/// # Errors
+/// The directory is not writable or the table cannot be encoded.
+pub fn write_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<()> {
+    let path = dir.join(name);
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, "cannot create", e))?;
+        ParquetWriter::new(file)
+            .with_compression(ParquetCompression::Zstd(None))
+            .with_statistics(StatisticsOptions::full())
+            .with_row_group_size(Some(ROW_GROUP_ROWS))
+            .set_parallel(false)
+            .finish(df)
+            .map_err(|e| Error::io(&tmp, "cannot write parquet", e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, "cannot rename into place", e))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Build and write every table of a `frames` run into `dir`.
+///
+/// # Errors
+/// As [`write_atomic`]; a table that cannot be built names its file.
+pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create output folder", e))?;
+    let mut tables = vec![
+        (
+            FRAMES_FILE,
+            frames_table(records).map_err(|e| polars_err(&dir.join(FRAMES_FILE), e))?,
+        ),
+        (
+            CLIPS_FILE,
+            clips_table(records).map_err(|e| polars_err(&dir.join(CLIPS_FILE), e))?,
+        ),
+        (
+            CONTACTS_FILE,
+            contacts_table(records).map_err(|e| polars_err(&dir.join(CONTACTS_FILE), e))?,
+        ),
+    ];
+    if joints {
+        tables.push((
+            JOINTS_FILE,
+            joints_table(records).map_err(|e| polars_err(&dir.join(JOINTS_FILE), e))?,
+        ));
+    }
+    for (name, df) in tables.iter_mut() {
+        write_atomic(dir, name, df)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,17 @@
+//! `stancelib`: thin entry point. Parse arguments, run, map the outcome to an exit code
+//! (0 ok, 1 finished with per-clip failures, 2 fatal).
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    let args = stancelib::cli::args::Cli::parse();
+    match stancelib::cli::run(args) {
+        Ok(stancelib::cli::Outcome::Clean) => ExitCode::SUCCESS,
+        Ok(stancelib::cli::Outcome::SomeFailed) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("stancelib: error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,6 @@
+//! Pure numerical helpers shared by the stages: Savitzky–Golay differentiation,
+//! order statistics and small polynomial least-squares fits.
+
+pub mod polyfit;
+pub mod savgol;
+pub mod stats;

@@ -1,0 +1,90 @@
+//! Order statistics: median and percentiles with linear interpolation, and a running
+//! percentile over a sliding time window.
+//!
+//! # Model
+//! ```text
+//! percentile(v, p) = v₍ₖ₎ + (r − k)(v₍ₖ₊₁₎ − v₍ₖ₎),   r = p/100 · (n − 1),  k = ⌊r⌋
+//! ```
+//! (numpy's default "linear" method).
+
+/// Percentile `p` (0–100) of `v` by linear interpolation between order statistics.
+/// `None` for an empty slice.
+pub fn percentile(v: &[f64], p: f64) -> Option<f64> {
+    let mut s: Vec<f64> = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    percentile_sorted(&s, p)
+}
+
+/// Percentile of an already sorted slice.
+pub fn percentile_sorted(s: &[f64], p: f64) -> Option<f64> {
+    if s.is_empty() {
+        return None;
+    }
+    let r = (p / 100.0).clamp(0.0, 1.0) * (s.len() - 1) as f64;
+    let k = r.floor() as usize;
+    let frac = r - k as f64;
+    Some(if k + 1 < s.len() {
+        s[k] + frac * (s[k + 1] - s[k])
+    } else {
+        s[k]
+    })
+}
+
+/// Median of `v` (`None` when empty).
+pub fn median(v: &[f64]) -> Option<f64> {
+    percentile(v, 50.0)
+}
+
+/// Percentile `p` of `v` over the window `i − half ..= i + half` (clipped at the ends), for
+/// every `i`. Sliding sorted window: O(n · half).
+pub fn running_percentile(v: &[f64], half: usize, p: f64) -> Vec<f64> {
+    let n = v.len();
+    let mut out = Vec::with_capacity(n);
+    let mut win: Vec<f64> = Vec::with_capacity(2 * half + 1);
+    let (mut lo, mut hi) = (0usize, 0usize); // window holds v[lo..hi]
+    for i in 0..n {
+        let want_hi = (i + half + 1).min(n);
+        let want_lo = i.saturating_sub(half);
+        while hi < want_hi {
+            let x = v[hi];
+            let pos = win.partition_point(|y| y.total_cmp(&x).is_lt());
+            win.insert(pos, x);
+            hi += 1;
+        }
+        while lo < want_lo {
+            let x = v[lo];
+            let pos = win.partition_point(|y| y.total_cmp(&x).is_lt());
+            win.remove(pos);
+            lo += 1;
+        }
+        out.push(percentile_sorted(&win, p).unwrap_or(f64::NAN));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentile_matches_numpy_linear() {
+        let v = [3.0, 1.0, 4.0, 1.0, 5.0, 9.0, 2.0, 6.0];
+        assert_eq!(percentile(&v, 0.0), Some(1.0));
+        assert_eq!(percentile(&v, 100.0), Some(9.0));
+        // numpy.percentile([3,1,4,1,5,9,2,6], 5) = 1.0 ; 50 -> 3.5 ; 90 -> 6.9
+        assert!((percentile(&v, 50.0).unwrap() - 3.5).abs() < 1e-12);
+        assert!((percentile(&v, 90.0).unwrap() - 6.9).abs() < 1e-12);
+        assert_eq!(median(&[]), None);
+    }
+
+    #[test]
+    fn running_percentile_equals_brute_force() {
+        let v: Vec<f64> = (0..200).map(|i| ((i * 7919) % 101) as f64 * 0.37).collect();
+        let r = running_percentile(&v, 13, 5.0);
+        for (i, ri) in r.iter().enumerate() {
+            let lo = i.saturating_sub(13);
+            let hi = (i + 14).min(v.len());
+            assert_eq!(*ri, percentile(&v[lo..hi], 5.0).unwrap());
+        }
+    }
+}

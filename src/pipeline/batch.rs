@@ -1,0 +1,150 @@
+//! One batch of clips: discover inputs, ingest each file in parallel (rayon), collect one
+//! [`ClipRecord`] per file, sorted by clip name. A failure on one file is recorded in its
+//! row and never stops the others.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use sha2::{Digest, Sha256};
+
+use super::names::clip_names;
+use crate::error::{Error, Result};
+use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions};
+use crate::library::{ClipRecord, Status};
+
+/// Expand files and folders (recursively, `*.bvh` case-insensitive) into a sorted,
+/// de-duplicated list of files.
+///
+/// # Errors
+/// An input that does not exist.
+pub fn discover(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for p in inputs {
+        if p.is_dir() {
+            walk(p, &mut out)?;
+        } else if p.is_file() {
+            out.push(p.clone());
+        } else {
+            return Err(Error::config(
+                Some(p.clone()),
+                None,
+                "no such file or folder",
+            ));
+        }
+    }
+    out.sort();
+    out.dedup();
+    Ok(out)
+}
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
+    let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, "cannot list folder", e))?;
+    for entry in rd {
+        let p = entry
+            .map_err(|e| Error::io(dir, "cannot list folder", e))?
+            .path();
+        if p.is_dir() {
+            walk(&p, out)?;
+        } else if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) {
+            out.push(p);
+        }
+    }
+    Ok(())
+}
+
+/// A reader that hashes what passes through it (one pass over a large file).
+struct HashingReader<R> {
+    inner: R,
+    hasher: Sha256,
+}
+
+impl<R: Read> Read for HashingReader<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.hasher.update(&buf[..n]);
+        Ok(n)
+    }
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Ingest one file into its record. Never fails: errors become an `error` record.
+pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecord {
+    let mut rec = ClipRecord {
+        path: path.display().to_string(),
+        clip,
+        content_sha256: String::new(),
+        status: Status::Error,
+        message: None,
+        mass_kg: opts.mass_kg,
+        summary: ClipSummary::default(),
+        frames: None,
+        contacts: Vec::new(),
+    };
+    let file = match std::fs::File::open(path) {
+        Ok(f) => f,
+        Err(e) => {
+            rec.message = Some(format!("{}: cannot open: {e}", path.display()));
+            return rec;
+        }
+    };
+    let mut rdr = HashingReader {
+        inner: file,
+        hasher: Sha256::new(),
+    };
+    let parsed = crate::bvh::parse_reader(&mut rdr).map_err(|e| e.with_path(path));
+    // Hash the rest of a file whose parse stopped early, so the hash is of the whole file.
+    let _ = std::io::copy(&mut rdr, &mut std::io::sink());
+    rec.content_sha256 = hex(&rdr.hasher.finalize());
+    let outcome = parsed.and_then(|b| {
+        ingest(&b, opts).map_err(|e| Error::skeleton(format!("{}: {e}", path.display())))
+    });
+    match outcome {
+        Err(e) => rec.message = Some(e.to_string()),
+        Ok(ClipOutcome::Skipped { summary, reason }) => {
+            rec.status = Status::Skipped;
+            rec.message = Some(reason);
+            rec.summary = summary;
+        }
+        Ok(ClipOutcome::Body {
+            summary,
+            frames,
+            contacts,
+        }) => {
+            rec.status = Status::Ok;
+            rec.summary = summary;
+            rec.frames = Some(frames);
+            rec.contacts = contacts;
+        }
+    }
+    rec
+}
+
+/// Ingest every file in parallel; records sorted by clip name. A progress bar is drawn on
+/// a terminal (stderr) and hidden otherwise.
+pub fn ingest_all(files: &[PathBuf], opts: &IngestOptions) -> Vec<ClipRecord> {
+    let names = clip_names(files);
+    let bar = ProgressBar::new(files.len() as u64);
+    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} clips {msg}") {
+        bar.set_style(style);
+    }
+    let mut recs: Vec<ClipRecord> = files
+        .par_iter()
+        .zip(names)
+        .map(|(p, n)| {
+            let r = ingest_file(p, n, opts);
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    recs.sort_by(|a, b| a.clip.cmp(&b.clip));
+    recs
+}

@@ -1,0 +1,399 @@
+//! The body file (`--body`) and pipeline files (`pipelines/*.toml`): parsed, validated,
+//! and resolved into [`IngestOptions`] with the precedence CLI > pipeline > body > default.
+//!
+//! Unknown keys are errors; every error is reported as `path:line: message`.
+//!
+//! # References
+//! spec README "Configuration files".
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::contacts::ContactOptions;
+use crate::error::{Error, Result};
+use crate::ingest::{IngestOptions, DEFAULT_MASS_KG};
+use crate::skeleton::com::Sex;
+use crate::skeleton::units::{parse_unit, UpAxis};
+
+/// A unit given as metres per file unit or by name.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum UnitValue {
+    /// Metres per file unit.
+    Number(f64),
+    /// `m`, `cm`, `mm`, `in`, `cmu`, …
+    Name(String),
+}
+
+/// The body file.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BodyFile {
+    /// Character id.
+    pub id: Option<String>,
+    /// Body mass, kg.
+    pub mass_kg: Option<f64>,
+    /// `male`, `female` or `average`.
+    pub sex: Option<String>,
+    /// Unit override.
+    pub unit: Option<UnitValue>,
+    /// Up-axis override.
+    pub up_axis: Option<String>,
+    /// Landmark → joint name.
+    pub landmarks: Option<BTreeMap<String, String>>,
+}
+
+/// `[contacts]` of a pipeline file.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct ContactsTable {
+    #[serde(rename = "static")]
+    pub static_mode: Option<bool>,
+    pub hands: Option<bool>,
+    pub foot_h_on: Option<f64>,
+    pub foot_h_off: Option<f64>,
+    pub foot_v_on: Option<f64>,
+    pub foot_v_off: Option<f64>,
+    pub hand_h_on: Option<f64>,
+    pub hand_h_off: Option<f64>,
+    pub hand_v_on: Option<f64>,
+    pub hand_v_off: Option<f64>,
+    pub min_on_s: Option<f64>,
+    pub min_gap_s: Option<f64>,
+    pub floor_window_s: Option<f64>,
+}
+
+/// `[fit]` of a pipeline file (stance-model stage; accepted and validated here).
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct FitTable {
+    pub stage_b: Option<bool>,
+    pub stage_b_time_refinement: Option<bool>,
+    pub max_harmonics: Option<u32>,
+    pub energy: Option<f64>,
+    pub samples: Option<u32>,
+}
+
+/// `[constraints]` of a pipeline file (query stage; accepted and validated here).
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct ConstraintsTable {
+    pub mu: Option<f64>,
+    pub limits: Option<String>,
+}
+
+/// A pipeline file.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PipelineFile {
+    /// Globs of BVH files or folders, relative to the pipeline file.
+    pub inputs: Vec<String>,
+    /// Output folder, relative to the pipeline file.
+    pub out: String,
+    /// Body file, relative to the pipeline file.
+    pub body: Option<String>,
+    /// Body mass, kg.
+    pub mass_kg: Option<f64>,
+    /// Unit override for every input.
+    pub unit: Option<UnitValue>,
+    /// Up-axis override for every input.
+    pub up_axis: Option<String>,
+    /// Rayon threads (0 = all cores).
+    pub threads: Option<usize>,
+    /// Contact options.
+    pub contacts: Option<ContactsTable>,
+    /// Force-model options.
+    pub fit: Option<FitTable>,
+    /// Constraint options.
+    pub constraints: Option<ConstraintsTable>,
+}
+
+/// 1-based line of a byte offset.
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// Line where `key = …` is written, for value errors.
+fn key_line(text: &str, key: &str) -> Option<usize> {
+    text.lines()
+        .position(|l| {
+            let t = l.trim_start();
+            t.strip_prefix(key)
+                .is_some_and(|r| r.trim_start().starts_with('='))
+        })
+        .map(|i| i + 1)
+}
+
+fn parse_toml<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
+    toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| line_of(text, s.start));
+        Error::config(Some(path.to_path_buf()), line, e.message().to_string())
+    })
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| Error::io(path, "cannot read", e))
+}
+
+/// Parse a body file.
+///
+/// # Errors
+/// Unreadable file, TOML errors, unknown keys, invalid values (`path:line: message`).
+pub fn parse_body(path: &Path, text: &str) -> Result<BodyFile> {
+    let b: BodyFile = parse_toml(path, text)?;
+    let bad =
+        |key: &str, msg: String| Error::config(Some(path.to_path_buf()), key_line(text, key), msg);
+    if let Some(m) = b.mass_kg {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(bad(
+                "mass_kg",
+                format!("mass_kg must be positive, found {m}"),
+            ));
+        }
+    }
+    if let Some(s) = &b.sex {
+        Sex::parse(s).ok_or_else(|| {
+            bad(
+                "sex",
+                format!("sex must be male, female or average, found '{s}'"),
+            )
+        })?;
+    }
+    if let Some(u) = &b.unit {
+        unit_value(u).ok_or_else(|| bad("unit", format!("invalid unit {u:?}")))?;
+    }
+    if let Some(a) = &b.up_axis {
+        UpAxis::parse(a).ok_or_else(|| {
+            bad(
+                "up_axis",
+                format!("up_axis must be one of +X -X +Y -Y +Z -Z, found '{a}'"),
+            )
+        })?;
+    }
+    Ok(b)
+}
+
+/// Metres per file unit of a unit value.
+pub fn unit_value(u: &UnitValue) -> Option<f64> {
+    match u {
+        UnitValue::Number(v) => (v.is_finite() && *v > 0.0).then_some(*v),
+        UnitValue::Name(s) => parse_unit(s),
+    }
+}
+
+/// Read and parse a body file.
+///
+/// # Errors
+/// As [`parse_body`].
+pub fn load_body(path: &Path) -> Result<BodyFile> {
+    parse_body(path, &read(path)?)
+}
+
+/// Parse a pipeline file.
+///
+/// # Errors
+/// TOML errors, unknown keys, invalid values (`path:line: message`).
+pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
+    let p: PipelineFile = parse_toml(path, text)?;
+    let bad =
+        |key: &str, msg: String| Error::config(Some(path.to_path_buf()), key_line(text, key), msg);
+    if p.inputs.is_empty() {
+        return Err(bad("inputs", "inputs must list at least one glob".into()));
+    }
+    if let Some(u) = &p.unit {
+        unit_value(u).ok_or_else(|| bad("unit", format!("invalid unit {u:?}")))?;
+    }
+    if let Some(a) = &p.up_axis {
+        UpAxis::parse(a).ok_or_else(|| {
+            bad(
+                "up_axis",
+                format!("up_axis must be one of +X -X +Y -Y +Z -Z, found '{a}'"),
+            )
+        })?;
+    }
+    if let Some(m) = p.mass_kg {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(bad(
+                "mass_kg",
+                format!("mass_kg must be positive, found {m}"),
+            ));
+        }
+    }
+    if let Some(l) = p.constraints.as_ref().and_then(|c| c.limits.as_ref()) {
+        if !["per_query", "absolute", "relative"].contains(&l.as_str()) {
+            return Err(bad(
+                "limits",
+                format!("limits must be per_query, absolute or relative, found '{l}'"),
+            ));
+        }
+    }
+    Ok(p)
+}
+
+/// Read and parse a pipeline file.
+///
+/// # Errors
+/// As [`parse_pipeline`].
+pub fn load_pipeline(path: &Path) -> Result<PipelineFile> {
+    parse_pipeline(path, &read(path)?)
+}
+
+/// Values given on the command line (each wins over the files).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Overrides {
+    /// `--mass`.
+    pub mass_kg: Option<f64>,
+    /// `--unit`, metres per unit.
+    pub unit_m: Option<f64>,
+    /// `--up-axis`.
+    pub up_axis: Option<UpAxis>,
+    /// `--static-contacts`.
+    pub static_contacts: bool,
+    /// `--no-hands`.
+    pub no_hands: bool,
+    /// `--joints`.
+    pub joints: bool,
+}
+
+/// Resolve options: CLI > pipeline > body > default.
+pub fn resolve(
+    body: Option<&BodyFile>,
+    pipe: Option<&PipelineFile>,
+    cli: &Overrides,
+) -> IngestOptions {
+    let mut o = IngestOptions::default();
+    if let Some(b) = body {
+        o.mass_kg = b.mass_kg.unwrap_or(DEFAULT_MASS_KG);
+        o.sex = b.sex.as_deref().and_then(Sex::parse).unwrap_or_default();
+        o.unit_m = b.unit.as_ref().and_then(unit_value);
+        o.up_axis = b.up_axis.as_deref().and_then(UpAxis::parse);
+        o.landmarks = b.landmarks.clone().unwrap_or_default();
+    }
+    if let Some(p) = pipe {
+        o.mass_kg = p.mass_kg.unwrap_or(o.mass_kg);
+        o.unit_m = p.unit.as_ref().and_then(unit_value).or(o.unit_m);
+        o.up_axis = p.up_axis.as_deref().and_then(UpAxis::parse).or(o.up_axis);
+        if let Some(c) = &p.contacts {
+            apply_contacts(&mut o.contacts, c);
+        }
+    }
+    o.mass_kg = cli.mass_kg.unwrap_or(o.mass_kg);
+    o.unit_m = cli.unit_m.or(o.unit_m);
+    o.up_axis = cli.up_axis.or(o.up_axis);
+    o.contacts.static_mode |= cli.static_contacts;
+    o.contacts.hands &= !cli.no_hands;
+    o.joints = cli.joints;
+    o
+}
+
+fn apply_contacts(o: &mut ContactOptions, c: &ContactsTable) {
+    let set = |dst: &mut f64, v: Option<f64>| {
+        if let Some(v) = v {
+            *dst = v
+        }
+    };
+    o.static_mode = c.static_mode.unwrap_or(o.static_mode);
+    o.hands = c.hands.unwrap_or(o.hands);
+    set(&mut o.foot.h_on, c.foot_h_on);
+    set(&mut o.foot.h_off, c.foot_h_off);
+    set(&mut o.foot.v_on, c.foot_v_on);
+    set(&mut o.foot.v_off, c.foot_v_off);
+    set(&mut o.hand.h_on, c.hand_h_on);
+    set(&mut o.hand.h_off, c.hand_h_off);
+    set(&mut o.hand.v_on, c.hand_v_on);
+    set(&mut o.hand.v_off, c.hand_v_off);
+    set(&mut o.min_on_s, c.min_on_s);
+    set(&mut o.min_gap_s, c.min_gap_s);
+    set(&mut o.floor_window_s, c.floor_window_s);
+}
+
+/// Expand a pipeline's input globs (relative to the pipeline file's folder).
+///
+/// # Errors
+/// An invalid glob pattern, or a glob that matches nothing.
+pub fn expand_inputs(pipeline_path: &Path, p: &PipelineFile) -> Result<Vec<PathBuf>> {
+    let base = pipeline_path.parent().unwrap_or(Path::new("."));
+    let mut out = Vec::new();
+    for g in &p.inputs {
+        let pat = base.join(g);
+        let pat_s = pat.to_string_lossy();
+        let matches = glob::glob(&pat_s).map_err(|e| {
+            Error::config(
+                Some(pipeline_path.to_path_buf()),
+                None,
+                format!("inputs: bad glob '{g}': {e}"),
+            )
+        })?;
+        let found: Vec<PathBuf> = matches.filter_map(|m| m.ok()).collect();
+        if found.is_empty() {
+            return Err(Error::config(
+                Some(pipeline_path.to_path_buf()),
+                None,
+                format!("inputs: '{g}' matches nothing"),
+            ));
+        }
+        out.extend(found);
+    }
+    Ok(out)
+}
+
+/// The pipeline's output and body paths, resolved against its folder.
+pub fn relative_to(pipeline_path: &Path, p: &str) -> PathBuf {
+    pipeline_path.parent().unwrap_or(Path::new(".")).join(p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_keys_and_bad_values_name_the_line() {
+        let p = Path::new("x.toml");
+        let e = parse_pipeline(p, "inputs = [\"a\"]\nout = \"o\"\nbogus = 1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("x.toml:3:"), "{e}");
+        let e = parse_pipeline(p, "inputs = [\"a\"]\nout = \"o\"\nup_axis = \"up\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("x.toml:3:") && e.contains("up_axis"), "{e}");
+        let e = parse_body(p, "mass_kg = 70\nunit = \"furlong\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("x.toml:2:"), "{e}");
+    }
+
+    #[test]
+    fn precedence_is_cli_pipeline_body_default() {
+        let body = parse_body(
+            Path::new("b"),
+            "mass_kg = 80\nunit = \"cm\"\nsex = \"female\"\n",
+        )
+        .unwrap();
+        let pipe = parse_pipeline(
+            Path::new("p"),
+            "inputs = [\"a\"]\nout = \"o\"\nmass_kg = 75\n[contacts]\nfoot_h_on = 0.03\n",
+        )
+        .unwrap();
+        let o = resolve(Some(&body), Some(&pipe), &Overrides::default());
+        assert_eq!(
+            (o.mass_kg, o.unit_m, o.sex, o.contacts.foot.h_on),
+            (75.0, Some(0.01), Sex::Female, 0.03)
+        );
+        let o = resolve(
+            Some(&body),
+            Some(&pipe),
+            &Overrides {
+                mass_kg: Some(60.0),
+                ..Default::default()
+            },
+        );
+        assert_eq!(o.mass_kg, 60.0);
+        assert_eq!(resolve(None, None, &Overrides::default()).mass_kg, 70.0);
+    }
+}
