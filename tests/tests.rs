@@ -1,4 +1,18 @@
 //! The one integration-test binary. Table of contents:
 //!
+//! - `bad_input`: malformed files name file and line; a 300 MB stream loads.
+//! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
+//! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
 //! - `util`: shared helpers (paths to `../shared`, skip messages, temp dirs, running the binary).
+//! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
+//! - `props`: property tests: mutated and extreme inputs never panic the reader or the ingest.
+//! - `real_data`: every shared BVH loads; flight physics, walk/run contact patterns, invariance.
+//! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
+mod bad_input;
+mod cli;
+mod fixtures;
+mod forceplate;
+mod multicontact;
+mod props;
+mod real_data;
 mod util;

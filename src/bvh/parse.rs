@@ -6,6 +6,11 @@ use std::path::Path;
 use super::{Bvh, Channel, Hierarchy, JointDef, Motion};
 use crate::error::{Error, Result};
 
+/// Smallest accepted frame time, s (100 kHz): anything shorter is a corrupt header.
+pub const MIN_FRAME_TIME_S: f64 = 1e-5;
+/// Largest accepted frame time, s (0.1 Hz).
+pub const MAX_FRAME_TIME_S: f64 = 10.0;
+
 /// Parse a BVH file from disk. Errors name the file and the line.
 ///
 /// # Errors
@@ -408,6 +413,12 @@ fn read_motion_header<R: BufRead>(
                     format!("Frame Time must be positive, found {v}"),
                 ));
             }
+            if !(MIN_FRAME_TIME_S..=MAX_FRAME_TIME_S).contains(&dt) {
+                return Err(Error::bvh(
+                    lines.line,
+                    format!("Frame Time {v} s is outside 1e-5 to 10 s per frame"),
+                ));
+            }
             return Ok((frames, dt));
         } else if let Some(v) = lower.strip_prefix("frames") {
             let v = v.trim_start().strip_prefix(':').unwrap_or(v).trim();
@@ -573,6 +584,12 @@ mod tests {
         assert!(err_line(&SIMPLE.replace(".01", "-0.01"))
             .1
             .contains("positive"));
+        assert!(err_line(&SIMPLE.replace(".01", "1e-300"))
+            .1
+            .contains("outside"));
+        assert!(err_line(&SIMPLE.replace(".01", "3600"))
+            .1
+            .contains("outside"));
         assert!(err_line(&SIMPLE.replace("End site", "End"))
             .1
             .contains("Site"));

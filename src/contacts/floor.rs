@@ -28,7 +28,7 @@ pub const CLEARANCE_MET3: f64 = 0.02;
 
 /// Half-window in frames: the largest `h` with `h·dt ≤ T_floor`.
 pub fn half_window(dt: f64, t_floor: f64) -> usize {
-    ((t_floor / dt) + 1e-9).floor().max(0.0) as usize
+    ((t_floor / dt) + 1e-9).floor().clamp(0.0, 1e12) as usize
 }
 
 /// Ground height `z_g` per frame from the two toe tips' heights.

@@ -8,6 +8,7 @@ use crate::contacts::detect::{clean, hysteresis, static_hysteresis, PointTrack};
 use crate::contacts::flight::{clip_summary, fit_run};
 use crate::contacts::options::STATIC_MIN_ON_S;
 use crate::contacts::{floor, raw_speed, runs};
+use crate::error::{Error, Result};
 use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
 use crate::math::stats::median;
 use crate::skeleton::com::{com, BodyPoints, SidePoints};
@@ -116,7 +117,7 @@ pub(super) fn run(
     skip: usize,
     opts: &IngestOptions,
     summary: &mut ClipSummary,
-) -> (ClipFrames, Vec<ContactRun>) {
+) -> Result<(ClipFrames, Vec<ContactRun>)> {
     let dt = bvh.motion.frame_time_s;
     let legs = [
         [lm.left.hip, lm.left.knee, lm.left.ankle],
@@ -154,6 +155,13 @@ pub(super) fn run(
     };
     let to_int = |p: V3| up.to_internal(p).map(|v| v * scale);
     pts.iter_mut().for_each(|p| *p = to_int(*p));
+    if let Some(k) = pts.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+        let (f, p) = (skip + k / np, k % np);
+        return Err(Error::skeleton(format!(
+            "non-finite position of '{}' at frame {f} (offsets or angles too large for f64)",
+            skel.point_name(p)
+        )));
+    }
     let rest: Vec<V3> = rest_file.iter().map(|p| to_int(*p)).collect();
     let leg_m = leg_file * scale;
     summary.unit_scale = Some(scale);
@@ -356,7 +364,7 @@ pub(super) fn run(
         toe,
         joints,
     };
-    (frames, runs_out)
+    Ok((frames, runs_out))
 }
 
 /// `(hip_L − hip_R) · (e_z × forward) > 0`, forward = mean horizontal ankle→toe direction.

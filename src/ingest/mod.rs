@@ -155,8 +155,8 @@ pub enum ClipOutcome {
 /// Ingest one parsed clip.
 ///
 /// # Errors
-/// A partial landmark mapping (spec com-from-bvh §1.1), or a `[landmarks]` override that
-/// names no joint.
+/// A partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that
+/// names no joint, or offsets and angles so large that positions overflow f64.
 pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
     let m = &bvh.motion;
     let mut summary = ClipSummary {
@@ -188,7 +188,7 @@ pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
         );
         return Ok(ClipOutcome::Skipped { summary, reason });
     }
-    let (frames, contacts) = kinematics::run(&skel, &lm, &rest, bvh, skip, opts, &mut summary);
+    let (frames, contacts) = kinematics::run(&skel, &lm, &rest, bvh, skip, opts, &mut summary)?;
     Ok(ClipOutcome::Body {
         summary,
         frames,

@@ -33,7 +33,8 @@ pub const DEFAULT_ORDER: usize = 3;
 
 /// The SG window for a frame rate: `W = max(5, 2·round(0.05·F) + 1)` frames.
 pub fn window_for_rate(frame_rate_hz: f64) -> usize {
-    let h = (0.05 * frame_rate_hz).round().max(0.0) as usize; // f64::round is half away from zero
+    // f64::round is half away from zero; the clamp keeps absurd rates from overflowing.
+    let h = (0.05 * frame_rate_hz).round().clamp(0.0, 1e9) as usize;
     (2 * h + 1).max(5)
 }
 

@@ -1,0 +1,270 @@
+//! The binary end to end: tables and their layout, exit codes, per-file failures that do
+//! not stop a batch, deterministic and atomic outputs, clip-name collisions, pipelines.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use stancelib::library::read::read_parquet;
+use stancelib::library::schema::{CLIPS_COLUMNS, CONTACTS_COLUMNS};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn stancelib(args: &[&str]) -> (i32, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_stancelib"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+fn fixture(name: &str) -> String {
+    root().join("fixtures/bvh").join(name).display().to_string()
+}
+
+/// The five generated clips (not the `bad/` folder below them).
+fn good_fixtures() -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(root().join("fixtures/bvh"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
+        .map(|p| p.display().to_string())
+        .collect();
+    v.sort();
+    v
+}
+
+/// `frames <good fixtures> <extra…>`.
+fn frames_on_fixtures(extra: &[&str]) -> (i32, String, String) {
+    let files = good_fixtures();
+    let mut args: Vec<&str> = vec!["frames"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend(extra);
+    stancelib(&args)
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn names(df: &polars::prelude::DataFrame) -> Vec<String> {
+    df.get_column_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+}
+
+#[test]
+fn frames_writes_the_documented_tables() {
+    let out = tmp();
+    let o = out.path().display().to_string();
+    let (code, stdout, stderr) = frames_on_fixtures(&["--out", &o, "--joints"]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let frames = read_parquet(&out.path().join("frames.parquet")).unwrap();
+    let clips = read_parquet(&out.path().join("clips.parquet")).unwrap();
+    let contacts = read_parquet(&out.path().join("contacts.parquet")).unwrap();
+    let joints = read_parquet(&out.path().join("joints.parquet")).unwrap();
+    assert_eq!(names(&clips), CLIPS_COLUMNS.to_vec());
+    assert_eq!(names(&contacts), CONTACTS_COLUMNS.to_vec());
+    assert_eq!(
+        names(&joints),
+        vec!["clip", "frame", "joint", "x", "y", "z"]
+    );
+    let fcols = names(&frames);
+    for c in [
+        "clip",
+        "frame",
+        "time_s",
+        "com_x",
+        "com_vz",
+        "com_az",
+        "ground_z",
+        "contact_left_foot",
+        "contact_right_hand",
+        "static_left_foot",
+        "surface_z_left_foot",
+        "left_foot_x",
+        "right_hand_z",
+        "left_toe_x",
+        "right_toe_z",
+    ] {
+        assert!(fcols.iter().any(|f| f == c), "frames.parquet lacks {c}");
+    }
+    // One row per kept frame of the 5 fixtures, sorted by clip then frame.
+    let kept: i64 = clips
+        .column("frames_kept")
+        .unwrap()
+        .i64()
+        .unwrap()
+        .into_iter()
+        .flatten()
+        .sum();
+    assert_eq!(frames.height() as i64, kept);
+    let clip: Vec<String> = frames
+        .column("clip")
+        .unwrap()
+        .str()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.unwrap().to_string())
+        .collect();
+    let frame: Vec<i64> = frames
+        .column("frame")
+        .unwrap()
+        .i64()
+        .unwrap()
+        .into_iter()
+        .map(|v| v.unwrap())
+        .collect();
+    let keys: Vec<(String, i64)> = clip.into_iter().zip(frame).collect();
+    assert!(
+        keys.windows(2).all(|w| w[0] < w[1]),
+        "frames not sorted by (clip, frame)"
+    );
+    // The generator's skeleton: 21 joints (6 + 20·3 = 66 channels) and 5 End Sites.
+    assert_eq!(joints.height() as i64, kept * 26);
+    assert!(stdout.contains("5 clips: 5 ok"));
+}
+
+#[test]
+fn a_batch_with_bad_files_processes_the_rest_and_exits_1() {
+    let out = tmp();
+    let o = out.path().display().to_string();
+    let bad = root().join("fixtures/bvh/bad").display().to_string();
+    let (code, _, stderr) =
+        stancelib(&["frames", &fixture("run_30hz_in_yup.bvh"), &bad, "--out", &o]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("truncated_last_row.bvh: line 21: truncated"),
+        "{stderr}"
+    );
+    let clips = read_parquet(&out.path().join("clips.parquet")).unwrap();
+    let status: Vec<String> = clips
+        .column("status")
+        .unwrap()
+        .str()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.unwrap().to_string())
+        .collect();
+    assert_eq!(status.iter().filter(|s| *s == "ok").count(), 1);
+    assert_eq!(status.iter().filter(|s| *s == "error").count(), 15);
+    let frames = read_parquet(&out.path().join("frames.parquet")).unwrap();
+    assert!(frames.height() > 0);
+    // Nothing half-written is left behind.
+    let leftovers: Vec<_> = std::fs::read_dir(out.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty());
+}
+
+#[test]
+fn fatal_errors_exit_2_and_keep_earlier_outputs() {
+    let out = tmp();
+    let o = out.path().display().to_string();
+    assert_eq!(
+        stancelib(&["frames", &fixture("run_30hz_in_yup.bvh"), "--out", &o]).0,
+        0
+    );
+    let before = std::fs::read(out.path().join("frames.parquet")).unwrap();
+    let (code, _, err) = stancelib(&["frames", "/no/such/file.bvh", "--out", &o]);
+    assert_eq!(code, 2);
+    assert!(err.contains("/no/such/file.bvh"), "{err}");
+    assert_eq!(frames_on_fixtures(&["--out", &o, "--unit", "furlong"]).0, 2);
+    assert_eq!(frames_on_fixtures(&["--out", &o, "--up-axis", "up"]).0, 2);
+    assert_eq!(
+        std::fs::read(out.path().join("frames.parquet")).unwrap(),
+        before,
+        "a failed run changed an earlier output"
+    );
+}
+
+#[test]
+fn outputs_do_not_depend_on_thread_count() {
+    let (a, b) = (tmp(), tmp());
+    for (d, t) in [(&a, "1"), (&b, "2")] {
+        let o = d.path().display().to_string();
+        assert_eq!(frames_on_fixtures(&["--out", &o, "--threads", t]).0, 0);
+    }
+    for f in ["frames.parquet", "clips.parquet", "contacts.parquet"] {
+        assert_eq!(
+            std::fs::read(a.path().join(f)).unwrap(),
+            std::fs::read(b.path().join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+}
+
+#[test]
+fn colliding_stems_get_parent_prefixes() {
+    let inp = tmp();
+    for d in ["a", "b"] {
+        std::fs::create_dir_all(inp.path().join(d)).unwrap();
+        std::fs::copy(
+            fixture("run_30hz_in_yup.bvh"),
+            inp.path().join(d).join("clip.bvh"),
+        )
+        .unwrap();
+    }
+    let out = tmp();
+    let (code, ..) = stancelib(&[
+        "frames",
+        &inp.path().display().to_string(),
+        "--out",
+        &out.path().display().to_string(),
+    ]);
+    assert_eq!(code, 0);
+    let clips = read_parquet(&out.path().join("clips.parquet")).unwrap();
+    let c: Vec<String> = clips
+        .column("clip")
+        .unwrap()
+        .str()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.unwrap().to_string())
+        .collect();
+    assert_eq!(c, vec!["a/clip", "b/clip"]);
+}
+
+#[test]
+fn every_pipeline_file_parses() {
+    let dir = root().join("pipelines");
+    let files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    assert!(files.len() >= 2);
+    for f in files {
+        let p = stancelib::pipeline::spec::load_pipeline(&f).unwrap_or_else(|e| panic!("{e}"));
+        if let Some(b) = &p.body {
+            stancelib::pipeline::spec::load_body(&stancelib::pipeline::spec::relative_to(&f, b))
+                .unwrap();
+        }
+    }
+}
+
+#[test]
+fn the_demo_pipeline_runs() {
+    // Copy the demo job next to a temporary output folder: same inputs, other `out`.
+    let dir = tmp();
+    let text = std::fs::read_to_string(root().join("pipelines/demo.toml")).unwrap();
+    let text = text
+        .replace(
+            "\"../fixtures/",
+            &format!("\"{}/fixtures/", root().display()),
+        )
+        .replace("\"../out/demo\"", "\"out\"");
+    let p = dir.path().join("demo.toml");
+    std::fs::write(&p, text).unwrap();
+    let (code, stdout, stderr) = stancelib(&["run", &p.display().to_string()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    assert!(dir.path().join("out/frames.parquet").is_file());
+}
