@@ -1,7 +1,7 @@
 # stancelib: the two commands a newcomer needs are `make demo` and `make test`.
 CARGO ?= cargo
 
-.PHONY: demo test lint bench nightly build doc golden fixtures
+.PHONY: demo test lint bench nightly build doc fixtures
 
 ## Run the main job on the bundled fixtures (pipelines/demo.toml); tables go to out/demo/.
 demo:
@@ -31,10 +31,11 @@ build:
 doc:
 	$(CARGO) doc --no-deps
 
-## Re-generate the golden files of the tests (review the diff before committing).
-golden:
-	UPDATE_GOLDEN=1 $(CARGO) test --test integration
-
 ## Re-generate fixtures/bvh from the project's own generator (see fixtures/README.md).
+SYNTH = $(CARGO) run --release -- synth --seed 1
 fixtures:
-	$(CARGO) test --test integration fixtures_are_generated -- --ignored
+	$(SYNTH) --motion run --rate 120 --duration 1.5 --unit m --up Y --out fixtures/bvh/run_120hz_m_yup.bvh
+	$(SYNTH) --motion run --rate 60 --duration 1.5 --unit cm --up Z --out fixtures/bvh/run_60hz_cm_zup.bvh
+	$(SYNTH) --motion run --rate 30 --duration 2.0 --unit in --up Y --out fixtures/bvh/run_30hz_in_yup.bvh
+	$(SYNTH) --motion jump --rate 120 --duration 2.2 --unit cmu --up Y --out fixtures/bvh/jump_120hz_cmu_yup.bvh
+	$(SYNTH) --motion jump --rate 100 --duration 2.2 --unit m --up Z --out fixtures/bvh/jump_100hz_m_zup.bvh
