@@ -52,6 +52,17 @@ fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
 
+/// A string column as owned strings.
+fn strings(df: &polars::prelude::DataFrame, col: &str) -> Vec<String> {
+    df.column(col)
+        .unwrap()
+        .str()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.unwrap().to_string())
+        .collect()
+}
+
 fn names(df: &polars::prelude::DataFrame) -> Vec<String> {
     df.get_column_names()
         .iter()
@@ -105,14 +116,7 @@ fn frames_writes_the_documented_tables() {
         .flatten()
         .sum();
     assert_eq!(frames.height() as i64, kept);
-    let clip: Vec<String> = frames
-        .column("clip")
-        .unwrap()
-        .str()
-        .unwrap()
-        .into_iter()
-        .map(|s| s.unwrap().to_string())
-        .collect();
+    let clip = strings(&frames, "clip");
     let frame: Vec<i64> = frames
         .column("frame")
         .unwrap()
@@ -144,14 +148,7 @@ fn a_batch_with_bad_files_processes_the_rest_and_exits_1() {
         "{stderr}"
     );
     let clips = read_parquet(&out.path().join("clips.parquet")).unwrap();
-    let status: Vec<String> = clips
-        .column("status")
-        .unwrap()
-        .str()
-        .unwrap()
-        .into_iter()
-        .map(|s| s.unwrap().to_string())
-        .collect();
+    let status = strings(&clips, "status");
     assert_eq!(status.iter().filter(|s| *s == "ok").count(), 1);
     assert_eq!(status.iter().filter(|s| *s == "error").count(), 15);
     let frames = read_parquet(&out.path().join("frames.parquet")).unwrap();
@@ -222,14 +219,7 @@ fn colliding_stems_get_parent_prefixes() {
     ]);
     assert_eq!(code, 0);
     let clips = read_parquet(&out.path().join("clips.parquet")).unwrap();
-    let c: Vec<String> = clips
-        .column("clip")
-        .unwrap()
-        .str()
-        .unwrap()
-        .into_iter()
-        .map(|s| s.unwrap().to_string())
-        .collect();
+    let c = strings(&clips, "clip");
     assert_eq!(c, vec!["a/clip", "b/clip"]);
 }
 

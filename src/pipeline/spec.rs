@@ -146,9 +146,31 @@ fn read(path: &Path) -> Result<String> {
 /// Unreadable file, TOML errors, unknown keys, invalid values (`path:line: message`).
 pub fn parse_body(path: &Path, text: &str) -> Result<BodyFile> {
     let b: BodyFile = parse_toml(path, text)?;
+    check_common(path, text, b.mass_kg, b.unit.as_ref(), b.up_axis.as_deref())?;
+    if let Some(s) = &b.sex {
+        if Sex::parse(s).is_none() {
+            let msg = format!("sex must be male, female or average, found '{s}'");
+            return Err(Error::config(
+                Some(path.to_path_buf()),
+                key_line(text, "sex"),
+                msg,
+            ));
+        }
+    }
+    Ok(b)
+}
+
+/// Validate the keys the body and pipeline files share (`mass_kg`, `unit`, `up_axis`).
+fn check_common(
+    path: &Path,
+    text: &str,
+    mass_kg: Option<f64>,
+    unit: Option<&UnitValue>,
+    up_axis: Option<&str>,
+) -> Result<()> {
     let bad =
         |key: &str, msg: String| Error::config(Some(path.to_path_buf()), key_line(text, key), msg);
-    if let Some(m) = b.mass_kg {
+    if let Some(m) = mass_kg {
         if !(m.is_finite() && m > 0.0) {
             return Err(bad(
                 "mass_kg",
@@ -156,26 +178,23 @@ pub fn parse_body(path: &Path, text: &str) -> Result<BodyFile> {
             ));
         }
     }
-    if let Some(s) = &b.sex {
-        Sex::parse(s).ok_or_else(|| {
-            bad(
-                "sex",
-                format!("sex must be male, female or average, found '{s}'"),
-            )
-        })?;
+    if let Some(u) = unit {
+        if unit_value(u).is_none() {
+            return Err(bad(
+                "unit",
+                format!("invalid unit {u:?}: m, cm, mm, in, cmu or metres per unit"),
+            ));
+        }
     }
-    if let Some(u) = &b.unit {
-        unit_value(u).ok_or_else(|| bad("unit", format!("invalid unit {u:?}")))?;
-    }
-    if let Some(a) = &b.up_axis {
-        UpAxis::parse(a).ok_or_else(|| {
-            bad(
+    if let Some(a) = up_axis {
+        if UpAxis::parse(a).is_none() {
+            return Err(bad(
                 "up_axis",
                 format!("up_axis must be one of +X -X +Y -Y +Z -Z, found '{a}'"),
-            )
-        })?;
+            ));
+        }
     }
-    Ok(b)
+    Ok(())
 }
 
 /// Metres per file unit of a unit value.
@@ -205,25 +224,7 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
     if p.inputs.is_empty() {
         return Err(bad("inputs", "inputs must list at least one glob".into()));
     }
-    if let Some(u) = &p.unit {
-        unit_value(u).ok_or_else(|| bad("unit", format!("invalid unit {u:?}")))?;
-    }
-    if let Some(a) = &p.up_axis {
-        UpAxis::parse(a).ok_or_else(|| {
-            bad(
-                "up_axis",
-                format!("up_axis must be one of +X -X +Y -Y +Z -Z, found '{a}'"),
-            )
-        })?;
-    }
-    if let Some(m) = p.mass_kg {
-        if !(m.is_finite() && m > 0.0) {
-            return Err(bad(
-                "mass_kg",
-                format!("mass_kg must be positive, found {m}"),
-            ));
-        }
-    }
+    check_common(path, text, p.mass_kg, p.unit.as_ref(), p.up_axis.as_deref())?;
     if let Some(l) = p.constraints.as_ref().and_then(|c| c.limits.as_ref()) {
         if !["per_query", "absolute", "relative"].contains(&l.as_str()) {
             return Err(bad(
