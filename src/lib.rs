@@ -23,13 +23,16 @@
 
 pub mod bvh;
 pub mod cli;
+pub mod constraints;
 pub mod contacts;
 pub mod error;
+pub mod force_model;
 pub mod ingest;
 pub mod library;
 pub mod math;
 pub mod pipeline;
 pub mod skeleton;
+pub mod stances;
 pub mod synth;
 
 pub use error::{Error, ErrorKind, Result};

@@ -58,7 +58,7 @@ fn strings(df: &polars::prelude::DataFrame, col: &str) -> Vec<String> {
         .unwrap()
         .str()
         .unwrap()
-        .into_iter()
+        .iter()
         .map(|s| s.unwrap().to_string())
         .collect()
 }
@@ -112,7 +112,7 @@ fn frames_writes_the_documented_tables() {
         .unwrap()
         .i64()
         .unwrap()
-        .into_iter()
+        .iter()
         .flatten()
         .sum();
     assert_eq!(frames.height() as i64, kept);
@@ -122,7 +122,7 @@ fn frames_writes_the_documented_tables() {
         .unwrap()
         .i64()
         .unwrap()
-        .into_iter()
+        .iter()
         .map(|v| v.unwrap())
         .collect();
     let keys: Vec<(String, i64)> = clip.into_iter().zip(frame).collect();

@@ -3,6 +3,7 @@
 //! - `bad_input`: malformed files name file and line; a 300 MB stream loads.
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
+//! - `stances`: stances of real clips: flights on both sides, impulse–momentum, walks, running forces.
 //! - `util`: shared helpers (paths to `../shared`, skip messages, temp dirs, running the binary).
 //! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
 //! - `props`: property tests: mutated and extreme inputs never panic the reader or the ingest.
@@ -15,4 +16,5 @@ mod forceplate;
 mod multicontact;
 mod props;
 mod real_data;
+mod stances;
 mod util;

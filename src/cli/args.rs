@@ -23,6 +23,8 @@ pub enum Command {
     Frames(FramesArgs),
     /// Run a declarative pipeline file (pipelines/*.toml).
     Run(RunArgs),
+    /// Build a stance library (stances, force models, constraint coefficients).
+    Build(BuildArgs),
     /// Write a generated clip with known ground truth (fixtures).
     Synth(SynthArgs),
 }
@@ -98,6 +100,20 @@ pub struct FramesArgs {
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Body and contact options.
+    #[command(flatten)]
+    pub body: BodyArgs,
+}
+
+/// `stancelib build`.
+#[derive(Debug, Args)]
+pub struct BuildArgs {
+    /// BVH files or folders (searched recursively for *.bvh).
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Library folder (replaced atomically).
     #[arg(long)]
     pub out: PathBuf,
     /// Body and contact options.

@@ -22,6 +22,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Frames(a) => cmd::frames::run(a),
         Command::Run(a) => cmd::run::run(a),
+        Command::Build(a) => cmd::build::run(a),
         Command::Synth(a) => cmd::synth::run(a),
     }
 }

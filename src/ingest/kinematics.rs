@@ -168,6 +168,10 @@ pub(super) fn run(
     summary.unit = Some(unit_name);
     summary.up_axis = Some(up.as_str().to_string());
     summary.leg_length_m = Some(leg_m);
+    summary.character_id = Some(match &opts.character_id {
+        Some(id) => id.clone(),
+        None => character_id(skel, leg_m),
+    });
     let frames: Vec<&[V3]> = pts.chunks_exact(np).collect();
 
     let fwd: Vec<V3> = frames
@@ -362,9 +366,26 @@ pub(super) fn run(
         surface_z: c.static_mode.then_some(surf),
         effector_pos,
         toe,
+        facing: fwd,
         joints,
     };
     Ok((frames, runs_out))
+}
+
+/// `sk-` + the first 12 hex digits of SHA-256 over one `<name>\t<parent index>\n` line per
+/// joint (file order, End Sites excluded, root parent −1) and `leg_mm=<round(1000·L_leg)>\n`
+/// (spec stance-model §11).
+pub fn character_id(skel: &Skeleton, leg_m: f64) -> String {
+    use sha2::{Digest, Sha256};
+    let mut text = String::new();
+    for (name, parent) in skel.names.iter().zip(&skel.parents) {
+        let p = parent.map_or(-1, |p| p as i64);
+        text.push_str(&format!("{name}\t{p}\n"));
+    }
+    text.push_str(&format!("leg_mm={}\n", (1000.0 * leg_m).round() as i64));
+    let digest = Sha256::digest(text.as_bytes());
+    let hex: String = digest.iter().take(6).map(|b| format!("{b:02x}")).collect();
+    format!("sk-{hex}")
 }
 
 /// `(hip_L − hip_R) · (e_z × forward) > 0`, forward = mean horizontal ankle→toe direction.

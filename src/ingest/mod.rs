@@ -47,6 +47,8 @@ pub struct IngestOptions {
     pub contacts: ContactOptions,
     /// Keep every joint's world position (for `joints.parquet`).
     pub joints: bool,
+    /// Character id from the body file (`id`); derived from the skeleton when `None`.
+    pub character_id: Option<String>,
 }
 
 impl Default for IngestOptions {
@@ -59,6 +61,7 @@ impl Default for IngestOptions {
             landmarks: BTreeMap::new(),
             contacts: ContactOptions::default(),
             joints: false,
+            character_id: None,
         }
     }
 }
@@ -88,6 +91,8 @@ pub struct ClipFrames {
     pub effector_pos: [Option<Vec<[f64; 3]>>; 4],
     /// Left and right toe tips.
     pub toe: [Vec<[f64; 3]>; 2],
+    /// Horizontal facing direction from the hips per frame (unit; stance-model §2).
+    pub facing: Vec<[f64; 3]>,
     /// All joint and End Site positions (`--joints`): names and frames × points.
     pub joints: Option<(Vec<String>, Vec<[f64; 3]>)>,
 }
@@ -127,6 +132,8 @@ pub struct ClipSummary {
     pub s_eff: Option<f64>,
     /// Advisory messages.
     pub warnings: Vec<String>,
+    /// Character id (stance-model §11): the body file's `id`, else `sk-` + 12 hex digits.
+    pub character_id: Option<String>,
 }
 
 /// What ingesting a clip gives.

@@ -7,6 +7,7 @@
 
 pub mod read;
 pub mod schema;
+pub mod stances;
 pub mod write;
 
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};

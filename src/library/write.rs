@@ -109,7 +109,7 @@ pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
             ));
         }
     }
-    DataFrame::new(cols)
+    DataFrame::new_infer_height(cols)
 }
 
 fn flights_dtype() -> DataType {
@@ -245,7 +245,7 @@ pub fn clips_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
             .with_name("warnings".into())
             .into(),
     ];
-    DataFrame::new(cols)
+    DataFrame::new_infer_height(cols)
 }
 
 /// `contacts.parquet` (sorted by clip, effector, first frame).
@@ -260,7 +260,7 @@ pub fn contacts_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
     let f = |g: &dyn Fn(&crate::ingest::ContactRun) -> f64| -> Vec<f64> {
         rows.iter().map(|(_, c)| g(c)).collect()
     };
-    DataFrame::new(vec![
+    DataFrame::new_infer_height(vec![
         col("clip", rows.iter().map(|r| r.0).collect::<Vec<_>>()),
         col(
             "effector",
@@ -318,7 +318,7 @@ pub fn joints_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
             }
         }
     }
-    DataFrame::new(vec![
+    DataFrame::new_infer_height(vec![
         col("clip", clip),
         col("frame", frame),
         col("joint", joint),
@@ -333,7 +333,12 @@ pub fn joints_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
 ///
 /// # Errors
 /// The directory is not writable or the table cannot be encoded.
-pub fn write_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<()> {
+pub fn write_atomic(
+    dir: &Path,
+    name: &str,
+    df: &mut DataFrame,
+    kv: &[(String, String)],
+) -> Result<()> {
     let path = dir.join(name);
     let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
     let result = (|| {
@@ -343,6 +348,9 @@ pub fn write_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<()> {
             .with_statistics(StatisticsOptions::full())
             .with_row_group_size(Some(ROW_GROUP_ROWS))
             .set_parallel(false)
+            .with_key_value_metadata(
+                (!kv.is_empty()).then(|| KeyValueMetadata::from_static(kv.to_vec())),
+            )
             .finish(df)
             .map_err(|e| Error::io(&tmp, "cannot write parquet", e))?;
         std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, "cannot rename into place", e))
@@ -379,8 +387,18 @@ pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()>
             joints_table(records).map_err(|e| polars_err(&dir.join(JOINTS_FILE), e))?,
         ));
     }
+    let kv = vec![
+        (
+            "stancelib.schema_version".to_string(),
+            SCHEMA_VERSION.to_string(),
+        ),
+        (
+            "stancelib.tool_version".to_string(),
+            env!("CARGO_PKG_VERSION").to_string(),
+        ),
+    ];
     for (name, df) in tables.iter_mut() {
-        write_atomic(dir, name, df)?;
+        write_atomic(dir, name, df, &kv)?;
     }
     Ok(())
 }

@@ -3,4 +3,5 @@
 
 pub mod polyfit;
 pub mod savgol;
+pub mod spline;
 pub mod stats;

@@ -2,5 +2,6 @@
 //! parallel with a progress bar, and the declarative pipeline and body files.
 
 pub mod batch;
+pub mod build;
 pub mod names;
 pub mod spec;

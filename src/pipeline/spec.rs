@@ -274,6 +274,7 @@ pub fn resolve(
         o.unit_m = b.unit.as_ref().and_then(unit_value);
         o.up_axis = b.up_axis.as_deref().and_then(UpAxis::parse);
         o.landmarks = b.landmarks.clone().unwrap_or_default();
+        o.character_id = b.id.clone();
     }
     if let Some(p) = pipe {
         o.mass_kg = p.mass_kg.unwrap_or(o.mass_kg);

@@ -1,4 +1,5 @@
-//! `stancelib run <pipeline.toml>`: a declarative job (inputs, body, options, output).
+//! `stancelib run <pipeline.toml>`: a declarative library build (inputs, body, options,
+//! output folder).
 
 use super::super::args::RunArgs;
 use super::super::Outcome;
@@ -24,5 +25,9 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
     } else {
         pipe.threads.unwrap_or(0)
     };
-    super::frames::execute(&files, &relative_to(&a.pipeline, &pipe.out), &opts, threads)
+    let opts = crate::pipeline::build::BuildOptions {
+        ingest: opts,
+        ..Default::default()
+    };
+    super::build::execute(&files, &relative_to(&a.pipeline, &pipe.out), &opts, threads)
 }

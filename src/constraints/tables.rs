@@ -1,0 +1,157 @@
+//! Sampled tables of one force model on its evaluation grid (spec stance-model §7.2).
+//!
+//! # Model
+//!
+//! Per stance axis `a ∈ {h, p, v}`, on the grid `τ_k = k/(N_s − 1)` of §4.3:
+//!
+//! ```text
+//! f_a(τ) = d_a + Σ_i c_i cos(Ω_i τ + φ_i),        Ω_i = 2π j_i,  j_i ≥ 1      (N)
+//! d_a    = c0_a + Σ_{i: j_i = 0} c_i cos φ_i                                   (N)
+//! S_a(τ) = κ F2_a(τ)                                                          (m)
+//!        = κ [q0 + q1 τ + q2 τ² − Σ_i (c_i/Ω_i²) cos(Ω_i τ + φ_i)]
+//! κ = Δt²/m (s²/kg),  q0 = Σ c_i cos φ_i/Ω_i²,  q1 = −Σ c_i sin φ_i/Ω_i,  q2 = d_a/2
+//! ```
+//!
+//! `f_a` and `S_a` share the one cosine per harmonic and grid point. On the uniform grid
+//! the angle is `Ω_i τ_k + φ_i = 2π (j_i k mod (N_s − 1))/(N_s − 1) + φ_i`, so
+//!
+//! ```text
+//! cos(Ω_i τ_k + φ_i) = cos φ_i · C[m] − sin φ_i · S[m],   m = j_i k mod (N_s − 1)
+//! C[m] = cos(2π m/(N_s − 1)),  S[m] = sin(2π m/(N_s − 1))
+//! ```
+//!
+//! with the unit-circle table `C`, `S` built once per grid size and kept across stances: no
+//! trigonometric call per grid point or per stance beyond `sin_cos φ_i` (error ≈ 1 ulp).
+//!
+//! # Frames and units
+//!
+//! Stance frame (h, p, v); forces in N, `S_a` in m, `τ` dimensionless.
+
+use crate::force_model::ForceModel;
+use std::f64::consts::TAU;
+
+/// `f_a(τ_k)` and `S_a(τ_k)` of one stance on its grid; reusable across stances.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SampledTables {
+    /// The grid `τ_k = k/(N_s − 1)` (equal to `ForceModel::grid`), dimensionless.
+    pub tau: Vec<f64>,
+    /// `f_a(τ_k)` per axis (h, p, v), N.
+    pub f: [Vec<f64>; 3],
+    /// `S_a(τ_k) = (Δt²/m) F2_a(τ_k)` per axis (h, p, v), m.
+    pub s: [Vec<f64>; 3],
+    /// `(cos, sin)` of `2π m/(N_s − 1)`, `m = 0 … N_s − 2`, for the last grid size.
+    unit_circle: Vec<(f64, f64)>,
+}
+
+impl SampledTables {
+    /// Tables of `model` on its own grid.
+    pub fn new(model: &ForceModel) -> Self {
+        let mut tables = Self::default();
+        tables.rebuild(model);
+        tables
+    }
+
+    /// Refills the tables for `model`, keeping the allocations (and the unit-circle table
+    /// when the grid size is unchanged).
+    pub fn rebuild(&mut self, model: &ForceModel) {
+        let n = model.grid_len();
+        let period = n.saturating_sub(1);
+        let last = period as f64;
+        self.tau.clear();
+        self.tau.extend((0..n).map(|k| k as f64 / last));
+        if self.unit_circle.len() != period {
+            self.unit_circle.clear();
+            self.unit_circle.extend(
+                (0..period)
+                    .map(|m| (TAU * m as f64 / last).sin_cos())
+                    .map(|(s, c)| (c, s)),
+            );
+        }
+        let kappa = model.dt_s * model.dt_s / model.mass_kg;
+        for axis in 0..3 {
+            let (f, s) = (&mut self.f[axis], &mut self.s[axis]);
+            f.clear();
+            s.clear();
+            let d = dc_term(model, axis);
+            let (mut q0, mut q1) = (0.0, 0.0);
+            for (j, c, phi) in harmonic_terms(model, axis) {
+                let omega = TAU * f64::from(j);
+                let (sin_phi, cos_phi) = phi.sin_cos();
+                q0 += c * cos_phi / (omega * omega);
+                q1 -= c * sin_phi / omega;
+            }
+            let q2 = 0.5 * d;
+            for &t in &self.tau {
+                f.push(d);
+                s.push(kappa * (q0 + t * (q1 + t * q2)));
+            }
+            for (j, c, phi) in harmonic_terms(model, axis) {
+                let omega = TAU * f64::from(j);
+                let c_s = -kappa * c / (omega * omega);
+                let (sin_phi, cos_phi) = phi.sin_cos();
+                if period == 0 {
+                    for (fk, sk) in f.iter_mut().zip(s.iter_mut()) {
+                        *fk += c * cos_phi;
+                        *sk += c_s * cos_phi;
+                    }
+                    continue;
+                }
+                let step = usize::try_from(j).map_or(0, |j| j % period);
+                let mut m = 0usize;
+                for (fk, sk) in f.iter_mut().zip(s.iter_mut()) {
+                    let (cos_m, sin_m) = self.unit_circle.get(m).copied().unwrap_or((1.0, 0.0));
+                    let cos_angle = cos_phi * cos_m - sin_phi * sin_m;
+                    *fk += c * cos_angle;
+                    *sk += c_s * cos_angle;
+                    m += step;
+                    if m >= period {
+                        m -= period;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Number of grid points `N_s`.
+    pub fn len(&self) -> usize {
+        self.tau.len()
+    }
+
+    /// True when the grid is empty.
+    pub fn is_empty(&self) -> bool {
+        self.tau.is_empty()
+    }
+}
+
+/// DC force of axis `axis`, N: `c0 + Σ_{j = 0} c cos φ` (a `j = 0` term is a constant).
+pub(crate) fn dc_term(model: &ForceModel, axis: usize) -> f64 {
+    let Some(ax) = model.axes.get(axis) else {
+        return 0.0;
+    };
+    ax.c0
+        + ax.harmonics
+            .iter()
+            .zip(ax.amps.iter().zip(&ax.phases))
+            .filter(|(&j, _)| j == 0)
+            .map(|(_, (&c, &phi))| c * phi.cos())
+            .sum::<f64>()
+}
+
+/// The `(j, c, φ)` terms of axis `axis` with `j ≥ 1` (lists of unequal length are cut to the
+/// shortest).
+pub(crate) fn harmonic_terms(
+    model: &ForceModel,
+    axis: usize,
+) -> impl Iterator<Item = (u32, f64, f64)> + '_ {
+    model
+        .axes
+        .get(axis)
+        .into_iter()
+        .flat_map(|ax| {
+            ax.harmonics
+                .iter()
+                .zip(ax.amps.iter().zip(&ax.phases))
+                .map(|(&j, (&c, &phi))| (j, c, phi))
+        })
+        .filter(|&(j, _, _)| j > 0)
+}

@@ -1,0 +1,206 @@
+//! Closed-form integrals and moments of one cosine term, for any `Ω ≥ 0`.
+//!
+//! # Model
+//! ```text
+//! term(τ) = cos(Ωτ + φ)                       τ normalized stance time, Ω rad per unit τ
+//! F1(τ) = ∫₀^τ cos(Ωu+φ) du                  = (sin(Ωτ+φ) − sin φ)/Ω
+//! F2(τ) = ∫₀^τ∫₀ˢ cos(Ωu+φ) du ds             = (cos φ − cos(Ωτ+φ))/Ω² − τ sin φ/Ω
+//! I1 = F1(1),  D = F2(1),  M1 = ∫₀¹ τ cos(Ωτ+φ) dτ = I1 − D
+//!    = sin(Ω+φ)/Ω + (cos(Ω+φ) − cos φ)/Ω²
+//! For Ω = 2πj (j ≥ 1 integer): I1 = 0, M1 = sin φ/Ω, D = −sin φ/Ω.
+//! ```
+//! Written as `cos φ·cos Ωu − sin φ·sin Ωu`, with `x = Ωτ`:
+//! ```text
+//! F1(τ) = τ  [cos φ · g1(x) − sin φ · x·g2(x)]      g1(x) = sin x / x        → 1
+//! F2(τ) = τ² [cos φ · g2(x) − sin φ · x·g3(x)]      g2(x) = (1 − cos x)/x²   → 1/2
+//!                                                   g3(x) = (x − sin x)/x³   → 1/6
+//! ```
+//! This form has no `1/Ω` blow-up: it is exact at `Ω = 0` (F1 = τ cos φ,
+//! F2 = τ² cos φ / 2) and keeps full relative accuracy for small `Ωτ`, where the textbook
+//! form cancels (g3 uses its Taylor series below |x| = 0.25).
+//!
+//! # Frames and units
+//! Unit-free: multiply by the term's amplitude (N) to get N (F1: N per unit τ, etc.).
+//!
+//! # References
+//! Spec stance-model §5 ("closed form, any Ω"), which corrects the paper's eq 20–22.
+
+use std::f64::consts::TAU;
+
+/// Below this |x| = |Ωτ|, `g3` uses its Taylor series (next term < 2e-16 relative).
+const G3_SERIES_BELOW: f64 = 0.25;
+
+/// `sin x / x`, 1 at 0.
+fn g1(x: f64) -> f64 {
+    if x == 0.0 {
+        1.0
+    } else {
+        x.sin() / x
+    }
+}
+
+/// `(1 − cos x)/x² = 2 sin²(x/2)/x²`, ½ at 0 (the half-angle form does not cancel).
+fn g2(x: f64) -> f64 {
+    if x == 0.0 {
+        0.5
+    } else {
+        let s = (0.5 * x).sin();
+        2.0 * s * s / (x * x)
+    }
+}
+
+/// `(x − sin x)/x³`, 1/6 at 0.
+fn g3(x: f64) -> f64 {
+    if x.abs() < G3_SERIES_BELOW {
+        // Σₙ (−1)ⁿ x²ⁿ/(2n+3)!, n = 0…4
+        let x2 = x * x;
+        1.0 / 6.0 - x2 / 120.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0 * (1.0 - x2 / 110.0)))
+    } else {
+        (x - x.sin()) / (x * x * x)
+    }
+}
+
+/// `F1(τ) = ∫₀^τ cos(Ωu + φ) du` for any `Ω` (rad per unit τ), `φ` (rad).
+pub fn f1(omega: f64, phi: f64, tau: f64) -> f64 {
+    let x = omega * tau;
+    tau * (phi.cos() * g1(x) - phi.sin() * x * g2(x))
+}
+
+/// `F2(τ) = ∫₀^τ∫₀ˢ cos(Ωu + φ) du ds` for any `Ω` (rad per unit τ), `φ` (rad).
+pub fn f2(omega: f64, phi: f64, tau: f64) -> f64 {
+    let x = omega * tau;
+    tau * tau * (phi.cos() * g2(x) - phi.sin() * x * g3(x))
+}
+
+/// `I1 = ∫₀¹ cos(Ωτ + φ) dτ` (0 for `Ω = 2πj`, `j ≥ 1`).
+pub fn i1(omega: f64, phi: f64) -> f64 {
+    f1(omega, phi, 1.0)
+}
+
+/// `D = ∫₀¹∫₀ˢ cos(Ωu + φ) du ds = I1 − M1`.
+pub fn d(omega: f64, phi: f64) -> f64 {
+    f2(omega, phi, 1.0)
+}
+
+/// `M1 = ∫₀¹ τ cos(Ωτ + φ) dτ = I1 − D`.
+pub fn m1(omega: f64, phi: f64) -> f64 {
+    i1(omega, phi) - d(omega, phi)
+}
+
+/// `Ω = 2πj` for an integer harmonic `j` (rad per unit τ).
+pub fn omega_of(j: u32) -> f64 {
+    TAU * f64::from(j)
+}
+
+/// `I1` for the integer harmonic `j`: exactly 0 for `j ≥ 1`, `cos φ` for `j = 0`.
+pub fn i1_harmonic(j: u32, phi: f64) -> f64 {
+    if j == 0 {
+        phi.cos()
+    } else {
+        0.0
+    }
+}
+
+/// `M1` for the integer harmonic `j`: `sin φ/(2πj)` for `j ≥ 1`, `cos φ / 2` for `j = 0`.
+pub fn m1_harmonic(j: u32, phi: f64) -> f64 {
+    if j == 0 {
+        0.5 * phi.cos()
+    } else {
+        phi.sin() / omega_of(j)
+    }
+}
+
+/// Composite Simpson rule of `f` over `[a, b]` with `n` (made even) intervals; tests only.
+#[cfg(test)]
+pub(crate) fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+    let n = (n + n % 2).max(2);
+    let h = (b - a) / n as f64;
+    let inner: f64 = (1..n)
+        .map(|i| f(a + h * i as f64) * if i % 2 == 1 { 4.0 } else { 2.0 })
+        .sum();
+    (f(a) + f(b) + inner) * h / 3.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Intervals for Simpson; error ≤ (b−a)h⁴/180·Ω⁴ ≈ 4e-12 at Ω = 40, h = 1/4000.
+    const N_SIMPSON: usize = 4000;
+
+    fn simpson_tol(omega: f64) -> f64 {
+        // Simpson bound for |f⁗| ≤ Ω⁴ (×τ² ≤ 1 for F2's (τ−s) weight, whose extra
+        // derivatives add ≤ 4Ω³), plus 1e-13 for summing 4000 terms.
+        let h = 1.0 / N_SIMPSON as f64;
+        h.powi(4) / 180.0 * (omega.powi(4) + 4.0 * omega.powi(3)) + 1e-13
+    }
+
+    #[test]
+    fn closed_forms_match_simpson_for_any_omega() {
+        // Integer harmonics, a DCT basis Ω = πk, generic values, tiny Ω (series branch)
+        // and Ω = 0.
+        let omegas = [
+            0.0,
+            1e-7,
+            0.01,
+            0.2,
+            1.0,
+            3.7,
+            5.0 * std::f64::consts::PI,
+            TAU,
+            37.699,
+        ];
+        let phis = [0.0, 0.4, -1.3, 2.9];
+        for &om in &omegas {
+            for &ph in &phis {
+                let tol = simpson_tol(om);
+                for &tau in &[0.0, 0.13, 0.5, 0.77, 1.0] {
+                    let q1 = simpson(|u| (om * u + ph).cos(), 0.0, tau, N_SIMPSON);
+                    let q2 = simpson(|u| (tau - u) * (om * u + ph).cos(), 0.0, tau, N_SIMPSON);
+                    assert!(
+                        (f1(om, ph, tau) - q1).abs() < tol,
+                        "F1 Ω={om} φ={ph} τ={tau}"
+                    );
+                    assert!(
+                        (f2(om, ph, tau) - q2).abs() < tol,
+                        "F2 Ω={om} φ={ph} τ={tau}"
+                    );
+                }
+                let qm = simpson(|u| u * (om * u + ph).cos(), 0.0, 1.0, N_SIMPSON);
+                assert!((m1(om, ph) - qm).abs() < tol, "M1 Ω={om} φ={ph}");
+            }
+        }
+    }
+
+    #[test]
+    fn stable_form_equals_the_textbook_form() {
+        // Moderate Ω, where the spec's literal §5 formulas do not cancel: agreement to
+        // 1e-14 (a few ulps of O(1) values).
+        for &om in &[0.9, 2.5, 3.7, TAU, 9.42, 30.0] {
+            for &ph in &[0.0, 0.7, -2.2] {
+                let i1_spec = ((om + ph).sin() - ph.sin()) / om;
+                let m1_spec = (om + ph).sin() / om + ((om + ph).cos() - ph.cos()) / (om * om);
+                let d_spec = (ph.cos() - (om + ph).cos()) / (om * om) - ph.sin() / om;
+                assert!((i1(om, ph) - i1_spec).abs() < 1e-14);
+                assert!((m1(om, ph) - m1_spec).abs() < 1e-14);
+                assert!((d(om, ph) - d_spec).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn integer_harmonics_have_the_special_values() {
+        // Ω = 2πj: I1 = 0, M1 = sin φ/Ω, D = −sin φ/Ω (a few ulps of sin(2πj) roundoff).
+        for j in 1..=31u32 {
+            let om = omega_of(j);
+            for &ph in &[0.3, -1.1, 3.0] {
+                assert!(i1(om, ph).abs() < 1e-14);
+                assert!((m1(om, ph) - m1_harmonic(j, ph)).abs() < 1e-14);
+                assert!((d(om, ph) + ph.sin() / om).abs() < 1e-14);
+                assert_eq!(i1_harmonic(j, ph), 0.0);
+            }
+        }
+        assert!((m1_harmonic(0, 0.5) - m1(0.0, 0.5)).abs() < 1e-15);
+        assert!((i1_harmonic(0, 0.5) - i1(0.0, 0.5)).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,282 @@
+//! All stances of one clip, from its ingest outputs (pure).
+
+use super::params::{self, heading, model_consistent, Heading};
+use super::segment::{segment, Boundary, Segment, SegmentInput, V_QUIET};
+use super::{FlightRef, Stance};
+use crate::constraints::{precompute, StanceContext};
+use crate::contacts::flight::Flight;
+use crate::contacts::EFFECTORS;
+use crate::force_model::{fit_stage_a, FitOptions, FitWorkspace};
+use crate::ingest::{ClipFrames, ClipSummary};
+use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
+use crate::math::spline::NaturalSpline;
+use crate::math::stats::median;
+
+type V3 = [f64; 3];
+
+/// Options of the stance stage.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StanceOptions {
+    /// Force-model fit.
+    pub fit: FitOptions,
+}
+
+/// Natural cubic splines of the three coordinates of a per-frame vector series.
+struct Splines([NaturalSpline; 3]);
+
+impl Splines {
+    fn new(t: &[f64], v: &[V3]) -> Option<Splines> {
+        let axis = |i: usize| NaturalSpline::new(t, &v.iter().map(|p| p[i]).collect::<Vec<_>>());
+        Some(Splines([axis(0)?, axis(1)?, axis(2)?]))
+    }
+
+    fn at(&self, t: f64) -> V3 {
+        std::array::from_fn(|i| self.0[i].eval(t))
+    }
+}
+
+fn label(seg: &Segment, contact: &[Vec<bool>; 4]) -> (String, Vec<String>) {
+    let used: Vec<bool> = (0..4)
+        .map(|e| (seg.i0..=seg.i1).any(|k| contact[e][k]))
+        .collect();
+    let effectors: Vec<String> = {
+        let mut v: Vec<String> = (0..4)
+            .filter(|&e| used[e])
+            .map(|e| EFFECTORS[e].to_string())
+            .collect();
+        v.sort();
+        v
+    };
+    let feet = match seg.walking_foot {
+        Some(0) => "L",
+        Some(_) => "R",
+        None => match (used[0], used[1]) {
+            (true, true) => "LR",
+            (true, false) => "L",
+            (false, true) => "R",
+            _ => "",
+        },
+    };
+    let mut parts: Vec<&str> = Vec::new();
+    if !feet.is_empty() {
+        parts.push(feet);
+    }
+    if seg.walking_foot.is_none() {
+        if used[2] {
+            parts.push("LH");
+        }
+        if used[3] {
+            parts.push("RH");
+        }
+    }
+    (parts.join("+"), effectors)
+}
+
+/// Mean ground point of the effectors in contact, over the stance frames (spec §8.1):
+/// a foot is the ankle–toe-tip midpoint, a hand its wrist.
+fn contact_point(seg: &Segment, fr: &ClipFrames) -> Option<V3> {
+    let mut acc = [0.0; 3];
+    let mut n = 0.0;
+    for k in seg.i0..=seg.i1 {
+        let mut pts: Vec<V3> = Vec::new();
+        for e in 0..4 {
+            if !fr.contact[e][k] {
+                continue;
+            }
+            let Some(pos) = &fr.effector_pos[e] else {
+                continue;
+            };
+            pts.push(if e < 2 {
+                std::array::from_fn(|i| 0.5 * (pos[k][i] + fr.toe[e][k][i]))
+            } else {
+                pos[k]
+            });
+        }
+        if pts.is_empty() {
+            continue;
+        }
+        for p in &pts {
+            (0..3).for_each(|i| acc[i] += p[i] / pts.len() as f64);
+        }
+        n += 1.0;
+    }
+    (n > 0.0).then(|| acc.map(|v| v / n))
+}
+
+fn flight_ref(f: &Flight, t: f64) -> Option<FlightRef> {
+    let fit = f.fit.as_ref()?;
+    Some(FlightRef {
+        first_frame: f.first_frame,
+        last_frame: f.last_frame,
+        n_int: (f.last_frame - f.first_frame - 3).max(0),
+        free: f.tested,
+        a_z: fit.axes[2].curvature(),
+        vel: fit.velocity(t),
+    })
+}
+
+/// Build every stance of a clip. Returns the stances and clip-level warnings.
+pub fn build_clip(
+    clip: &str,
+    fr: &ClipFrames,
+    summary: &ClipSummary,
+    mass_kg: f64,
+    opts: &StanceOptions,
+) -> (Vec<Stance>, Vec<String>) {
+    let n = fr.frame.len();
+    let dt = summary.frame_time_s;
+    let mut warnings = Vec::new();
+    let Some(sg) = SavGol::new(window_for_rate(1.0 / dt), DEFAULT_ORDER) else {
+        return (Vec::new(), warnings);
+    };
+    let smooth: Vec<V3> = {
+        let cols: [Vec<f64>; 3] = std::array::from_fn(|i| {
+            sg.apply(&fr.com.iter().map(|c| c[i]).collect::<Vec<_>>(), 0, dt)
+        });
+        if cols[0].len() != n {
+            return (Vec::new(), warnings);
+        }
+        (0..n)
+            .map(|k| [cols[0][k], cols[1][k], cols[2][k]])
+            .collect()
+    };
+    let (Some(pos), Some(vel), Some(acc)) = (
+        Splines::new(&fr.time_s, &smooth),
+        Splines::new(&fr.time_s, &fr.com_v),
+        Splines::new(&fr.time_s, &fr.com_a),
+    ) else {
+        warnings.push("cannot build splines of the COM (too few frames)".into());
+        return (Vec::new(), warnings);
+    };
+    let speed: Vec<f64> = fr
+        .com_v
+        .iter()
+        .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
+        .collect();
+    let frame0 = fr.frame[0];
+    let flight_at = |a: usize| {
+        summary
+            .flights
+            .iter()
+            .find(|f| f.first_frame == frame0 + a as i64)
+    };
+    let ballistic = |a: usize, _b: usize| flight_at(a).is_some_and(|f| f.ballistic);
+    let (segments, w) = segment(&SegmentInput {
+        contact: &fr.contact,
+        speed: &speed,
+        ballistic: &ballistic,
+        dt,
+    });
+    warnings.extend(w);
+    let mut ws = FitWorkspace::new(opts.fit.samples);
+    let mut previous: Option<V3> = None;
+    let mut out = Vec::with_capacity(segments.len());
+    for seg in segments {
+        let t_td = if seg.i0 == 0 {
+            fr.time_s[0]
+        } else {
+            fr.time_s[seg.i0] - dt / 2.0
+        };
+        let t_lo = if seg.i1 + 1 == n {
+            fr.time_s[n - 1]
+        } else {
+            fr.time_s[seg.i1] + dt / 2.0
+        };
+        let dt_s = t_lo - t_td;
+        let (p_td, v_td) = (pos.at(t_td), vel.at(t_td));
+        let h: Heading = heading(v_td, fr.facing[seg.i0], previous);
+        previous = Some(h.e_h);
+        let z_c = median(&fr.ground_z[seg.i0..=seg.i1]).unwrap_or(0.0);
+        let (label, effectors) = label(&seg, &fr.contact);
+        let model = match fit_stage_a(
+            &mut ws,
+            &acc.0,
+            t_td,
+            dt_s,
+            h.rotation(),
+            mass_kg,
+            seg.i1 - seg.i0 + 1,
+            &opts.fit,
+        ) {
+            Ok(m) => m,
+            Err(e) => {
+                warnings.push(format!(
+                    "stance at frame {}: force fit failed: {e}",
+                    fr.frame[seg.i0]
+                ));
+                continue;
+            }
+        };
+        let (j, p) = (model.j(), model.p());
+        let v_td_s = h.to_stance(v_td);
+        let z_td = p_td[2] - z_c;
+        let prm = model_consistent(v_td_s, z_td, j, p, dt_s);
+        let (p_lo, v_lo) = (pos.at(t_lo), vel.at(t_lo));
+        let dp = h.to_stance(std::array::from_fn(|i| p_lo[i] - p_td[i]));
+        let measured = params::from_states(v_td_s, z_td, dp, h.to_stance(v_lo), dt_s);
+        let cp = contact_point(&seg, fr).map_or([0.0, 0.0], |c| {
+            let d = h.to_stance(std::array::from_fn(|i| c[i] - p_td[i]));
+            [d[0], d[1]]
+        });
+        let ctx = StanceContext {
+            vs: prm.vs,
+            vps: prm.vps,
+            t_td: prm.t_td,
+            z_td,
+            cp,
+        };
+        let coef = precompute(&model, &ctx);
+        let mut sw = Vec::new();
+        if !coef.unilateral_ok {
+            sw.push("unilateral test failed: the model pulls on the ground (ringing)".to_string());
+        }
+        if !coef.support_ok {
+            sw.push(
+                "J_v ≤ 0: the stance cannot support the body; excluded from scaling".to_string(),
+            );
+        }
+        let edge_rest = |k: usize| speed[k] < V_QUIET;
+        let rest_at_edge = (seg.start == Boundary::ClipEdge && edge_rest(seg.i0))
+            || (seg.end == Boundary::ClipEdge && edge_rest(seg.i1));
+        let before = (seg.start == Boundary::Flight)
+            .then(|| {
+                summary
+                    .flights
+                    .iter()
+                    .find(|f| f.last_frame == frame0 + seg.i0 as i64 - 1)
+            })
+            .flatten()
+            .and_then(|f| flight_ref(f, t_td));
+        let after = (seg.end == Boundary::Flight)
+            .then(|| flight_at(seg.i1 + 1))
+            .flatten()
+            .and_then(|f| flight_ref(f, t_lo));
+        out.push(Stance {
+            stance_id: format!("{clip}:{label}:{}", fr.frame[seg.i0]),
+            clip: clip.to_string(),
+            character_id: summary.character_id.clone().unwrap_or_default(),
+            label,
+            effectors,
+            first_frame: fr.frame[seg.i0],
+            last_frame: fr.frame[seg.i1],
+            td_clip_s: t_td,
+            lo_clip_s: t_lo,
+            dt_s,
+            boundary_start: seg.start,
+            boundary_end: seg.end,
+            rest_at_edge,
+            flight_before: before,
+            flight_after: after,
+            heading: h,
+            z_c,
+            params: prm,
+            measured,
+            mass_kg,
+            model,
+            cp,
+            coef,
+            warnings: sw,
+        });
+    }
+    (out, warnings)
+}
