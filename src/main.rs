@@ -1,5 +1,5 @@
 //! `stancelib`: thin entry point. Parse arguments, run, map the outcome to an exit code
-//! (0 ok, 1 finished with per-clip failures, 2 fatal).
+//! (0 ok, 1 finished with per-clip failures, 2 fatal or every clip failed).
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -9,6 +9,7 @@ fn main() -> ExitCode {
     match stancelib::cli::run(args) {
         Ok(stancelib::cli::Outcome::Clean) => ExitCode::SUCCESS,
         Ok(stancelib::cli::Outcome::SomeFailed) => ExitCode::from(1),
+        Ok(stancelib::cli::Outcome::AllFailed) => ExitCode::from(2),
         Err(e) => {
             eprintln!("stancelib: error: {e:#}");
             ExitCode::from(2)

@@ -258,3 +258,65 @@ fn the_demo_pipeline_runs() {
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(dir.path().join("out/frames.parquet").is_file());
 }
+
+#[test]
+fn a_batch_where_every_clip_fails_exits_2_with_its_tables() {
+    let out = tmp();
+    let bad = root().join("fixtures/bvh/bad").display().to_string();
+    let lib = out.path().join("lib");
+    let (code, _, stderr) = stancelib(&["build", &bad, "--out", &lib.display().to_string()]);
+    assert_eq!(code, 2, "{stderr}");
+    let errors = read_parquet(&lib.join("errors.parquet")).unwrap();
+    assert_eq!(errors.height(), 15);
+    assert!(strings(&errors, "stage").iter().all(|s| s == "parse"));
+}
+
+#[test]
+fn an_incremental_build_equals_a_full_rebuild() {
+    let (inc, full) = (tmp(), tmp());
+    let (lib_inc, lib_full) = (inc.path().join("lib"), full.path().join("lib"));
+    let f = good_fixtures();
+    let lib = |p: &Path| p.display().to_string();
+    // First a library of two clips, then an incremental build of all five: two reused.
+    assert_eq!(stancelib(&["build", &f[0], &f[1], "--out", &lib(&lib_inc)]).0, 0);
+    let mut args: Vec<&str> = vec!["build"];
+    args.extend(f.iter().map(String::as_str));
+    let li = lib(&lib_inc);
+    args.extend(["--out", &li, "--incremental"]);
+    let (code, stdout, stderr) = stancelib(&args);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("2 clips reused"), "{stdout}");
+    let lf = lib(&lib_full);
+    let mut full_args: Vec<&str> = vec!["build"];
+    full_args.extend(f.iter().map(String::as_str));
+    full_args.extend(["--out", &lf]);
+    assert_eq!(stancelib(&full_args).0, 0);
+    for t in ["frames", "contacts", "clips", "stances", "errors"] {
+        let name = format!("{t}.parquet");
+        assert!(std::fs::read(lib_inc.join(&name)).unwrap() == std::fs::read(lib_full.join(&name)).unwrap(), "{name} differs");
+    }
+    // Nothing of the swap is left beside the library.
+    let leftovers: Vec<_> = std::fs::read_dir(inc.path()).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+}
+
+#[test]
+fn a_library_does_not_depend_on_threads_or_input_order() {
+    let (a, b) = (tmp(), tmp());
+    let mut f = good_fixtures();
+    let la = a.path().join("lib").display().to_string();
+    let lb = b.path().join("lib").display().to_string();
+    let mut args: Vec<&str> = vec!["build"];
+    args.extend(f.iter().map(String::as_str));
+    args.extend(["--out", &la, "--threads", "1"]);
+    assert_eq!(stancelib(&args).0, 0);
+    f.reverse();
+    let mut args: Vec<&str> = vec!["build"];
+    args.extend(f.iter().map(String::as_str));
+    args.extend(["--out", &lb, "--threads", "2"]);
+    assert_eq!(stancelib(&args).0, 0);
+    for t in ["frames", "contacts", "clips", "stances", "errors"] {
+        let name = format!("{t}.parquet");
+        assert!(std::fs::read(a.path().join("lib").join(&name)).unwrap() == std::fs::read(b.path().join("lib").join(&name)).unwrap(), "{name} differs");
+    }
+}

@@ -7,6 +7,7 @@
 //! - `util`: shared helpers (paths to `../shared`, skip messages, temp dirs, running the binary).
 //! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
 //! - `props`: property tests: mutated and extreme inputs never panic the reader or the ingest.
+//! - `readers`: pyarrow and DuckDB open the library (row counts, metadata, values).
 //! - `real_data`: every shared BVH loads; flight physics, walk/run contact patterns, invariance.
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 mod bad_input;
@@ -15,6 +16,7 @@ mod fixtures;
 mod forceplate;
 mod multicontact;
 mod props;
+mod readers;
 mod real_data;
 mod stances;
 mod util;

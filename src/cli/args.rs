@@ -116,6 +116,9 @@ pub struct BuildArgs {
     /// Library folder (replaced atomically).
     #[arg(long)]
     pub out: PathBuf,
+    /// Reuse the rows of clips whose path, content and options are unchanged.
+    #[arg(long)]
+    pub incremental: bool,
     /// Body and contact options.
     #[command(flatten)]
     pub body: BodyArgs,
@@ -126,6 +129,9 @@ pub struct BuildArgs {
 pub struct RunArgs {
     /// Pipeline file.
     pub pipeline: PathBuf,
+    /// Reuse the rows of clips whose path, content and options are unchanged.
+    #[arg(long)]
+    pub incremental: bool,
     /// Body and contact options (override the pipeline file).
     #[command(flatten)]
     pub body: BodyArgs,

@@ -12,6 +12,8 @@ pub enum Outcome {
     Clean,
     /// Finished, but some inputs failed (exit code 1).
     SomeFailed,
+    /// Every input failed: nothing could be done (exit code 2; the tables still say why).
+    AllFailed,
 }
 
 /// Run a parsed command line.

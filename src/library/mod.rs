@@ -47,6 +47,8 @@ pub struct ClipRecord {
     pub status: Status,
     /// Skip reason or error message.
     pub message: Option<String>,
+    /// Where an `error` happened: `parse`, `mapping` or `frames` (`errors.parquet`).
+    pub error_stage: Option<&'static str>,
     /// Body mass used, kg.
     pub mass_kg: f64,
     /// Per-clip fields (defaults when the file did not parse).

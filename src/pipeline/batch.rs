@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use super::names::clip_names;
-use crate::error::{Error, Result};
+use crate::error::{Error, ErrorKind, Result};
 use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions};
 use crate::library::{ClipRecord, Status};
 
@@ -80,6 +80,7 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
         content_sha256: String::new(),
         status: Status::Error,
         message: None,
+        error_stage: None,
         mass_kg: opts.mass_kg,
         summary: ClipSummary::default(),
         frames: None,
@@ -89,6 +90,7 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
         Ok(f) => f,
         Err(e) => {
             rec.message = Some(format!("{}: cannot open: {e}", path.display()));
+            rec.error_stage = Some("parse");
             return rec;
         }
     };
@@ -100,11 +102,22 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
     // Hash the rest of a file whose parse stopped early, so the hash is of the whole file.
     let _ = std::io::copy(&mut rdr, &mut std::io::sink());
     rec.content_sha256 = hex(&rdr.hasher.finalize());
-    let outcome = parsed.and_then(|b| {
-        ingest(&b, opts).map_err(|e| Error::skeleton(format!("{}: {e}", path.display())))
-    });
+    let outcome = match parsed {
+        Err(e) => Err(("parse", e)),
+        Ok(b) => ingest(&b, opts).map_err(|e| {
+            let stage = if matches!(e.kind, ErrorKind::Skeleton { .. }) {
+                "mapping"
+            } else {
+                "frames"
+            };
+            (stage, Error::skeleton(format!("{}: {e}", path.display())))
+        }),
+    };
     match outcome {
-        Err(e) => rec.message = Some(e.to_string()),
+        Err((stage, e)) => {
+            rec.message = Some(e.to_string());
+            rec.error_stage = Some(stage);
+        }
         Ok(ClipOutcome::Skipped { summary, reason }) => {
             rec.status = Status::Skipped;
             rec.message = Some(reason);
@@ -124,22 +137,31 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
     rec
 }
 
-/// Ingest every file in parallel; records sorted by clip name. A progress bar is drawn on
-/// a terminal (stderr) and hidden otherwise.
-pub fn ingest_all(files: &[PathBuf], opts: &IngestOptions) -> Vec<ClipRecord> {
-    let names = clip_names(files);
-    let bar = ProgressBar::new(files.len() as u64);
+/// A progress bar for `len` items, drawn on a terminal (stderr) and hidden otherwise.
+pub fn progress(len: usize, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len as u64);
     if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
-    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} clips {msg}") {
+    if let Ok(style) = ProgressStyle::with_template(&format!("{{bar:40}} {{pos}}/{{len}} {what}")) {
         bar.set_style(style);
     }
+    bar
+}
+
+/// Ingest every file in parallel; records sorted by clip name.
+pub fn ingest_all(files: &[PathBuf], opts: &IngestOptions) -> Vec<ClipRecord> {
+    let named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
+    ingest_named(&named, opts)
+}
+
+/// Ingest `(file, clip name)` pairs in parallel; records sorted by clip name.
+pub fn ingest_named(files: &[(PathBuf, String)], opts: &IngestOptions) -> Vec<ClipRecord> {
+    let bar = progress(files.len(), "clips ingested");
     let mut recs: Vec<ClipRecord> = files
         .par_iter()
-        .zip(names)
         .map(|(p, n)| {
-            let r = ingest_file(p, n, opts);
+            let r = ingest_file(p, n.clone(), opts);
             bar.inc(1);
             r
         })
@@ -147,4 +169,12 @@ pub fn ingest_all(files: &[PathBuf], opts: &IngestOptions) -> Vec<ClipRecord> {
     bar.finish_and_clear();
     recs.sort_by(|a, b| a.clip.cmp(&b.clip));
     recs
+}
+
+/// SHA-256 of a file's bytes, hex (`None` when unreadable).
+pub fn file_sha256(path: &Path) -> Option<String> {
+    let mut f = std::fs::File::open(path).ok()?;
+    let mut h = Sha256::new();
+    std::io::copy(&mut f, &mut h).ok()?;
+    Some(hex(&h.finalize()))
 }

@@ -2,24 +2,31 @@
 //! per-character limits, and write every table plus `manifest.json` into a temporary
 //! folder that replaces the library folder in one step.
 //!
+//! With `incremental`, the rows of clips whose path, content hash and options are those
+//! of the previous library are taken from it instead of being rebuilt; the result is the
+//! same, byte for byte, as a full rebuild (rows are re-sorted by the same keys and cast to
+//! the same schema).
+//!
 //! Layout of a library folder: `frames.parquet`, `contacts.parquet`, `clips.parquet`,
 //! `stances.parquet`, `errors.parquet`, `manifest.json` (spec stance-model §11).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use polars::prelude::*;
 use rayon::prelude::*;
-use serde::Serialize;
 
-use super::batch::ingest_all;
+use super::batch::{file_sha256, ingest_named, progress};
+use super::names::clip_names;
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
+use crate::library::read::read_parquet;
 use crate::library::schema::SCHEMA_VERSION;
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, write_atomic};
 use crate::library::{ClipRecord, Status};
-use crate::stances::limits::{limits, ClipFacts, Limits};
+use crate::stances::limits::{limits, ClipFacts, Limits, StanceFacts};
 use crate::stances::{build_clip, Stance, StanceOptions};
 
 /// Options of a library build.
@@ -31,98 +38,321 @@ pub struct BuildOptions {
     pub stances: StanceOptions,
 }
 
-/// What a build produced (for the report and the exit code).
+impl BuildOptions {
+    /// The options as recorded in the manifest and the Parquet metadata.
+    pub fn fingerprint(&self) -> String {
+        format!("{self:?}")
+    }
+}
+
+/// What a build produced in memory (the rebuilt clips only, with `incremental`).
 #[derive(Debug)]
 pub struct BuildReport {
-    /// One record per input file, sorted by clip.
+    /// One record per rebuilt input file, sorted by clip.
     pub records: Vec<ClipRecord>,
-    /// Every stance, sorted by (clip, first frame, label).
+    /// Every stance of those clips, sorted by (clip, first frame, label).
     pub stances: Vec<Stance>,
     /// Failed inputs and stages.
     pub errors: Vec<ErrorRow>,
-    /// Limits per character.
-    pub limits: BTreeMap<String, Limits>,
-}
-
-/// Provenance written to `manifest.json` and (without timings) to the Parquet metadata.
-#[derive(Debug, Serialize)]
-struct Provenance<'a> {
-    schema_version: &'a str,
-    tool_version: &'a str,
-    options: String,
-    inputs: BTreeMap<String, String>,
-    limits: &'a BTreeMap<String, Limits>,
-}
-
-fn stage_of(message: &str) -> &'static str {
-    if message.contains("skeleton:") {
-        "mapping"
-    } else if message.contains(": line ") || message.contains("cannot open") {
-        "parse"
-    } else {
-        "frames"
-    }
 }
 
 /// Ingest and build (pure apart from reading the input files).
 pub fn build(files: &[PathBuf], opts: &BuildOptions) -> BuildReport {
-    let records = ingest_all(files, &opts.ingest);
+    let named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
+    build_named(&named, opts)
+}
+
+fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport {
+    let records = ingest_named(named, &opts.ingest);
+    let bar = progress(records.len(), "clips segmented and fitted");
     let per_clip: Vec<(Vec<Stance>, Vec<String>)> = records
         .par_iter()
-        .map(|r| match (&r.frames, r.status) {
-            (Some(fr), Status::Ok) => build_clip(&r.clip, fr, &r.summary, r.mass_kg, &opts.stances),
-            _ => (Vec::new(), Vec::new()),
+        .map(|r| {
+            let out = match (&r.frames, r.status) {
+                (Some(fr), Status::Ok) => {
+                    build_clip(&r.clip, fr, &r.summary, r.mass_kg, &opts.stances)
+                }
+                _ => (Vec::new(), Vec::new()),
+            };
+            bar.inc(1);
+            out
         })
         .collect();
+    bar.finish_and_clear();
+    let mut errors: Vec<ErrorRow> = records
+        .iter()
+        .filter(|r| r.status == Status::Error)
+        .map(|r| ErrorRow {
+            path: r.path.clone(),
+            clip: Some(r.clip.clone()),
+            stage: r.error_stage.unwrap_or("frames").to_string(),
+            message: r.message.clone().unwrap_or_default(),
+        })
+        .collect();
+    for (r, (_, warnings)) in records.iter().zip(&per_clip) {
+        for w in warnings.iter().filter(|w| w.contains("failed")) {
+            errors.push(ErrorRow {
+                path: r.path.clone(),
+                clip: Some(r.clip.clone()),
+                stage: "stances".into(),
+                message: w.clone(),
+            });
+        }
+    }
     let mut stances: Vec<Stance> = per_clip.into_iter().flat_map(|(s, _)| s).collect();
     stances.sort_by(|a, b| {
         (&a.clip, a.first_frame, &a.label).cmp(&(&b.clip, b.first_frame, &b.label))
     });
-    let errors: Vec<ErrorRow> = records
-        .iter()
-        .filter(|r| r.status == Status::Error)
-        .map(|r| {
-            let message = r.message.clone().unwrap_or_default();
-            ErrorRow {
-                path: r.path.clone(),
-                clip: Some(r.clip.clone()),
-                stage: stage_of(&message).into(),
-                message,
-            }
-        })
-        .collect();
-    let facts: BTreeMap<String, ClipFacts> = records
-        .iter()
-        .map(|r| {
-            (
-                r.clip.clone(),
-                ClipFacts {
-                    s_eff: r.summary.s_eff,
-                    leg_m: r.summary.leg_length_m.unwrap_or(1.0),
-                },
-            )
-        })
-        .collect();
-    let limits = limits(&stances, &facts);
     BuildReport {
         records,
         stances,
         errors,
-        limits,
     }
 }
 
-/// Write a built library into `out` atomically: everything goes to a sibling temporary
-/// folder, which then takes the place of `out` (the previous library stays intact until
-/// that moment, and is removed after it).
+/// The five tables of a library, in memory.
+struct Tables {
+    frames: DataFrame,
+    contacts: DataFrame,
+    clips: DataFrame,
+    stances: DataFrame,
+    errors: DataFrame,
+}
+
+fn pe(name: &str, e: PolarsError) -> Error {
+    Error::io(name, "cannot build table", e)
+}
+
+impl Tables {
+    fn from_report(r: &BuildReport) -> Result<Tables> {
+        Ok(Tables {
+            frames: frames_table(&r.records).map_err(|e| pe("frames.parquet", e))?,
+            contacts: contacts_table(&r.records).map_err(|e| pe("contacts.parquet", e))?,
+            clips: clips_table(&r.records).map_err(|e| pe("clips.parquet", e))?,
+            stances: stances_table(&r.stances).map_err(|e| pe("stances.parquet", e))?,
+            errors: errors_table(&r.errors).map_err(|e| pe("errors.parquet", e))?,
+        })
+    }
+
+    fn named(&mut self) -> [(&'static str, &mut DataFrame); 5] {
+        [
+            ("frames.parquet", &mut self.frames),
+            ("contacts.parquet", &mut self.contacts),
+            ("clips.parquet", &mut self.clips),
+            ("stances.parquet", &mut self.stances),
+            ("errors.parquet", &mut self.errors),
+        ]
+    }
+}
+
+/// Sort keys per table (the order a full build writes).
+fn sort_keys(name: &str) -> &'static [&'static str] {
+    match name {
+        "frames.parquet" => &["clip", "frame"],
+        "contacts.parquet" => &["clip", "effector", "first_frame"],
+        "clips.parquet" => &["clip"],
+        "stances.parquet" => &["clip", "first_frame", "label"],
+        _ => &["path", "stage", "message"],
+    }
+}
+
+fn strings(df: &DataFrame, col: &str) -> Vec<String> {
+    df.column(col)
+        .ok()
+        .and_then(|c| {
+            c.str().ok().map(|s| {
+                s.iter()
+                    .map(|v| v.unwrap_or_default().to_string())
+                    .collect()
+            })
+        })
+        .unwrap_or_default()
+}
+
+fn floats(df: &DataFrame, col: &str) -> Vec<Option<f64>> {
+    df.column(col)
+        .ok()
+        .and_then(|c| c.f64().ok().map(|s| s.iter().collect()))
+        .unwrap_or_default()
+}
+
+/// Clips of the previous library at `out` that can be reused for `named`.
+fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTreeSet<String> {
+    let manifest: Option<serde_json::Value> = std::fs::read_to_string(out.join("manifest.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    if manifest
+        .as_ref()
+        .and_then(|m| m.get("options"))
+        .and_then(|o| o.as_str())
+        != Some(fingerprint)
+    {
+        return BTreeSet::new();
+    }
+    let Ok(clips) = read_parquet(&out.join("clips.parquet")) else {
+        return BTreeSet::new();
+    };
+    let prev: BTreeMap<String, (String, String, String)> = strings(&clips, "clip")
+        .into_iter()
+        .zip(
+            strings(&clips, "path")
+                .into_iter()
+                .zip(strings(&clips, "content_sha256"))
+                .zip(strings(&clips, "status")),
+        )
+        .map(|(c, ((p, h), s))| (c, (p, h, s)))
+        .collect();
+    named
+        .par_iter()
+        .filter_map(|(path, clip)| {
+            let (p, h, s) = prev.get(clip)?;
+            let same = *p == path.display().to_string()
+                && s != "error"
+                && file_sha256(path).as_deref() == Some(h.as_str());
+            same.then(|| clip.clone())
+        })
+        .collect()
+}
+
+/// Rows of a previous table for the reused clips, cast to the fresh table's schema.
+fn previous_rows(
+    out: &Path,
+    name: &str,
+    reuse: &BTreeSet<String>,
+    schema_of: &DataFrame,
+) -> Result<DataFrame> {
+    let path = out.join(name);
+    let df = read_parquet(&path)?;
+    let mask: BooleanChunked = strings(&df, "clip")
+        .iter()
+        .map(|c| reuse.contains(c))
+        .collect();
+    let df = df
+        .filter(&mask)
+        .map_err(|e| Error::io(&path, "cannot filter previous rows", e))?;
+    let cols = schema_of
+        .columns()
+        .iter()
+        .map(|c| df.column(c.name()).and_then(|p| p.cast(c.dtype())))
+        .collect::<PolarsResult<Vec<Column>>>()
+        .map_err(|e| Error::io(&path, "previous library has another schema", e))?;
+    DataFrame::new_infer_height(cols)
+        .map_err(|e| Error::io(&path, "cannot rebuild previous rows", e))
+}
+
+fn merge(fresh: &DataFrame, old: DataFrame, name: &str) -> Result<DataFrame> {
+    let mut all = fresh.vstack(&old).map_err(|e| pe(name, e))?;
+    let keys: Vec<PlSmallStr> = sort_keys(name).iter().map(|k| (*k).into()).collect();
+    all = all
+        .sort(
+            keys,
+            SortMultipleOptions::default().with_maintain_order(true),
+        )
+        .map_err(|e| pe(name, e))?;
+    all.rechunk_mut();
+    Ok(all)
+}
+
+/// Per-character limits from the (merged) stance and clip tables.
+fn limits_of(t: &Tables) -> BTreeMap<String, Limits> {
+    let s = &t.stances;
+    let (clip, ch, b0, b1) = (
+        strings(s, "clip"),
+        strings(s, "character_id"),
+        strings(s, "boundary_start"),
+        strings(s, "boundary_end"),
+    );
+    let (m, fp, e0, e1) = (
+        floats(s, "mass_kg"),
+        floats(s, "f_peak"),
+        floats(s, "ext_min"),
+        floats(s, "ext_max"),
+    );
+    let facts: Vec<StanceFacts> = (0..s.height())
+        .map(|i| StanceFacts {
+            clip: clip[i].clone(),
+            character_id: ch[i].clone(),
+            mass_kg: m[i].unwrap_or(f64::NAN),
+            f_peak: fp[i].unwrap_or(0.0),
+            ext_min: e0[i].unwrap_or(f64::INFINITY),
+            ext_max: e1[i].unwrap_or(0.0),
+            unsupported: b0[i] == "unsupported" || b1[i] == "unsupported",
+        })
+        .collect();
+    let c = &t.clips;
+    let clips: BTreeMap<String, ClipFacts> = strings(c, "clip")
+        .into_iter()
+        .zip(
+            floats(c, "s_eff")
+                .into_iter()
+                .zip(floats(c, "leg_length_m")),
+        )
+        .map(|(k, (s_eff, leg))| {
+            (
+                k,
+                ClipFacts {
+                    s_eff,
+                    leg_m: leg.unwrap_or(1.0),
+                },
+            )
+        })
+        .collect();
+    limits(&facts, &clips)
+}
+
+/// Build the library for `files` into `out` (see the module docs); returns what was
+/// rebuilt in memory and the number of reused clips.
 ///
 /// # Errors
 /// A table that cannot be built or written, or a folder that cannot be renamed.
-pub fn write_library(
+pub fn build_and_write(
+    files: &[PathBuf],
     out: &Path,
-    report: &BuildReport,
     opts: &BuildOptions,
-    wall_s: f64,
+    incremental: bool,
+) -> Result<(BuildReport, usize)> {
+    let t0 = Instant::now();
+    let named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
+    let fingerprint = opts.fingerprint();
+    let reuse = if incremental {
+        reusable(out, &named, &fingerprint)
+    } else {
+        BTreeSet::new()
+    };
+    let todo: Vec<(PathBuf, String)> = named
+        .iter()
+        .filter(|(_, c)| !reuse.contains(c))
+        .cloned()
+        .collect();
+    let report = build_named(&todo, opts);
+    let mut tables = Tables::from_report(&report)?;
+    if !reuse.is_empty() {
+        for (name, df) in tables.named() {
+            let old = previous_rows(out, name, &reuse, df)?;
+            *df = merge(df, old, name)?;
+        }
+    }
+    let lim = limits_of(&tables);
+    replace_library(out, &mut tables, &lim, &fingerprint, t0)?;
+    Ok((report, reuse.len()))
+}
+
+/// Write an in-memory build as the library at `out` (a full build; see [`build_and_write`]).
+///
+/// # Errors
+/// A table that cannot be built or written, or a folder that cannot be renamed.
+pub fn write_library(out: &Path, report: &BuildReport, opts: &BuildOptions) -> Result<()> {
+    let mut tables = Tables::from_report(report)?;
+    let lim = limits_of(&tables);
+    replace_library(out, &mut tables, &lim, &opts.fingerprint(), Instant::now())
+}
+
+fn replace_library(
+    out: &Path,
+    t: &mut Tables,
+    lim: &BTreeMap<String, Limits>,
+    fingerprint: &str,
+    t0: Instant,
 ) -> Result<()> {
     let parent = out
         .parent()
@@ -136,25 +366,25 @@ pub fn write_library(
     let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(|e| Error::io(&tmp, "cannot create folder", e))?;
-    let result = write_tables(&tmp, report, opts, wall_s).and_then(|_| swap_into_place(&tmp, out));
+    let result =
+        write_tables(&tmp, t, lim, fingerprint, t0).and_then(|_| swap_into_place(&tmp, out));
     if result.is_err() {
         let _ = std::fs::remove_dir_all(&tmp);
     }
     result
 }
 
-fn write_tables(dir: &Path, report: &BuildReport, opts: &BuildOptions, wall_s: f64) -> Result<()> {
-    let prov = Provenance {
-        schema_version: SCHEMA_VERSION,
-        tool_version: env!("CARGO_PKG_VERSION"),
-        options: format!("{opts:?}"),
-        inputs: report
-            .records
-            .iter()
-            .map(|r| (r.clip.clone(), r.content_sha256.clone()))
-            .collect(),
-        limits: &report.limits,
-    };
+fn write_tables(
+    dir: &Path,
+    t: &mut Tables,
+    lim: &BTreeMap<String, Limits>,
+    fingerprint: &str,
+    t0: Instant,
+) -> Result<()> {
+    let inputs: BTreeMap<String, String> = strings(&t.clips, "clip")
+        .into_iter()
+        .zip(strings(&t.clips, "content_sha256"))
+        .collect();
     let json = |v: &dyn erased::Json| v.to_json();
     let kv: Vec<(String, String)> = vec![
         ("stancelib.schema_version".into(), SCHEMA_VERSION.into()),
@@ -162,52 +392,29 @@ fn write_tables(dir: &Path, report: &BuildReport, opts: &BuildOptions, wall_s: f
             "stancelib.tool_version".into(),
             env!("CARGO_PKG_VERSION").into(),
         ),
-        ("stancelib.options".into(), prov.options.clone()),
-        ("stancelib.inputs".into(), json(&prov.inputs)),
-        ("stancelib.limits".into(), json(&report.limits)),
+        ("stancelib.options".into(), fingerprint.to_string()),
+        ("stancelib.inputs".into(), json(&inputs)),
+        ("stancelib.limits".into(), json(lim)),
     ];
-    let recs = &report.records;
-    let e = |f: &str, err: polars::prelude::PolarsError| {
-        Error::io(dir.join(f), "cannot build table", err)
-    };
-    let mut tables = [
-        (
-            "frames.parquet",
-            frames_table(recs).map_err(|x| e("frames.parquet", x))?,
-        ),
-        (
-            "contacts.parquet",
-            contacts_table(recs).map_err(|x| e("contacts.parquet", x))?,
-        ),
-        (
-            "clips.parquet",
-            clips_table(recs).map_err(|x| e("clips.parquet", x))?,
-        ),
-        (
-            "stances.parquet",
-            stances_table(&report.stances).map_err(|x| e("stances.parquet", x))?,
-        ),
-        (
-            "errors.parquet",
-            errors_table(&report.errors).map_err(|x| e("errors.parquet", x))?,
-        ),
-    ];
-    for (name, df) in tables.iter_mut() {
+    let status = strings(&t.clips, "status");
+    let count = |s: &str| status.iter().filter(|v| *v == s).count();
+    let (n_clips, n_stances) = (t.clips.height(), t.stances.height());
+    let failures = strings(&t.errors, "message");
+    for (name, df) in t.named() {
         write_atomic(dir, name, df, &kv)?;
     }
-    let count = |s: Status| recs.iter().filter(|r| r.status == s).count();
     let manifest = serde_json::json!({
         "schema_version": SCHEMA_VERSION,
         "tool_version": env!("CARGO_PKG_VERSION"),
-        "options": prov.options,
-        "inputs": prov.inputs,
-        "limits": report.limits,
+        "options": fingerprint,
+        "inputs": inputs,
+        "limits": lim,
         "counts": {
-            "clips": recs.len(), "ok": count(Status::Ok), "skipped": count(Status::Skipped),
-            "failed": count(Status::Error), "stances": report.stances.len(),
+            "clips": n_clips, "ok": count("ok"), "skipped": count("skipped"),
+            "failed": count("error"), "stances": n_stances,
         },
-        "failures": report.errors.iter().map(|e| &e.message).collect::<Vec<_>>(),
-        "wall_time_s": wall_s,
+        "failures": failures,
+        "wall_time_s": t0.elapsed().as_secs_f64(),
     });
     let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
     std::fs::write(dir.join("manifest.json"), text)
@@ -236,17 +443,6 @@ fn swap_into_place(tmp: &Path, out: &Path) -> Result<()> {
             .map_err(|e| Error::io(out, "cannot move the new library into place", e))?;
     }
     Ok(())
-}
-
-/// Build and write; the wall time goes to the manifest only.
-///
-/// # Errors
-/// As [`write_library`].
-pub fn build_and_write(files: &[PathBuf], out: &Path, opts: &BuildOptions) -> Result<BuildReport> {
-    let t0 = Instant::now();
-    let report = build(files, opts);
-    write_library(out, &report, opts, t0.elapsed().as_secs_f64())?;
-    Ok(report)
 }
 
 mod erased {

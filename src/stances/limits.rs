@@ -16,6 +16,40 @@ use serde::Serialize;
 use super::segment::Boundary;
 use super::Stance;
 
+/// What the limits need of one stance (from a `Stance` or a `stances.parquet` row).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceFacts {
+    /// Clip name.
+    pub clip: String,
+    /// Character id.
+    pub character_id: String,
+    /// Body mass, kg.
+    pub mass_kg: f64,
+    /// Original peak force, N.
+    pub f_peak: f64,
+    /// Original smallest COM–contact distance, m.
+    pub ext_min: f64,
+    /// Original largest COM–contact distance, m.
+    pub ext_max: f64,
+    /// An `unsupported` boundary on either side.
+    pub unsupported: bool,
+}
+
+impl From<&Stance> for StanceFacts {
+    fn from(s: &Stance) -> Self {
+        StanceFacts {
+            clip: s.clip.clone(),
+            character_id: s.character_id.clone(),
+            mass_kg: s.mass_kg,
+            f_peak: s.coef.f_peak,
+            ext_min: s.coef.ext_min,
+            ext_max: s.coef.ext_max,
+            unsupported: s.boundary_start == Boundary::Unsupported
+                || s.boundary_end == Boundary::Unsupported,
+        }
+    }
+}
+
 /// Absolute friction limit.
 pub const DEFAULT_MU: f64 = 0.7;
 /// Margin on the extremes of the example stances.
@@ -50,9 +84,8 @@ pub struct ClipFacts {
     pub leg_m: f64,
 }
 
-fn eligible(s: &Stance, clip: Option<&ClipFacts>) -> bool {
-    let unsupported =
-        s.boundary_start == Boundary::Unsupported || s.boundary_end == Boundary::Unsupported;
+fn eligible(s: &StanceFacts, clip: Option<&ClipFacts>) -> bool {
+    let unsupported = s.unsupported;
     let s_eff_ok = clip
         .and_then(|c| c.s_eff)
         .is_none_or(|v| (S_EFF_RANGE.0..=S_EFF_RANGE.1).contains(&v));
@@ -60,12 +93,15 @@ fn eligible(s: &Stance, clip: Option<&ClipFacts>) -> bool {
 }
 
 /// Limits per `character_id` (sorted map, deterministic).
-pub fn limits(stances: &[Stance], clips: &BTreeMap<String, ClipFacts>) -> BTreeMap<String, Limits> {
-    let ok: Vec<&Stance> = stances
+pub fn limits(
+    stances: &[StanceFacts],
+    clips: &BTreeMap<String, ClipFacts>,
+) -> BTreeMap<String, Limits> {
+    let ok: Vec<&StanceFacts> = stances
         .iter()
         .filter(|s| eligible(s, clips.get(&s.clip)))
         .collect();
-    let leg = |s: &Stance| clips.get(&s.clip).map_or(1.0, |c| c.leg_m);
+    let leg = |s: &StanceFacts| clips.get(&s.clip).map_or(1.0, |c| c.leg_m);
     let mut chars: BTreeMap<String, (f64, f64)> = BTreeMap::new(); // character → (mass, leg)
     for s in stances {
         chars
@@ -75,7 +111,7 @@ pub fn limits(stances: &[Stance], clips: &BTreeMap<String, ClipFacts>) -> BTreeM
     chars
         .into_iter()
         .map(|(id, (mass, leg_c))| {
-            let own: Vec<&Stance> = ok
+            let own: Vec<&StanceFacts> = ok
                 .iter()
                 .copied()
                 .filter(|s| s.character_id == id)
@@ -86,19 +122,19 @@ pub fn limits(stances: &[Stance], clips: &BTreeMap<String, ClipFacts>) -> BTreeM
             } else {
                 (&ok, Some((mass, leg_c)), "library")
             };
-            let m_scale = |s: &Stance| scale.map_or(1.0, |(m, _)| m / s.mass_kg);
-            let l_scale = |s: &Stance| scale.map_or(1.0, |(_, l)| l / leg(s));
+            let m_scale = |s: &StanceFacts| scale.map_or(1.0, |(m, _)| m / s.mass_kg);
+            let l_scale = |s: &StanceFacts| scale.map_or(1.0, |(_, l)| l / leg(s));
             let f_peak = pool
                 .iter()
-                .map(|s| s.coef.f_peak * m_scale(s))
+                .map(|s| s.f_peak * m_scale(s))
                 .fold(0.0, f64::max);
             let ext_max = pool
                 .iter()
-                .map(|s| s.coef.ext_max * l_scale(s))
+                .map(|s| s.ext_max * l_scale(s))
                 .fold(0.0, f64::max);
             let ext_min = pool
                 .iter()
-                .map(|s| s.coef.ext_min * l_scale(s))
+                .map(|s| s.ext_min * l_scale(s))
                 .fold(f64::INFINITY, f64::min);
             let lim = Limits {
                 mu: DEFAULT_MU,

@@ -21,7 +21,13 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
         ingest: resolve(body.as_ref(), None, &cli),
         ..Default::default()
     };
-    execute(&discover(&a.inputs)?, &a.out, &opts, a.body.threads)
+    execute(
+        &discover(&a.inputs)?,
+        &a.out,
+        &opts,
+        a.body.threads,
+        a.incremental,
+    )
 }
 
 /// Build `files` into the library folder `out`.
@@ -33,6 +39,7 @@ pub fn execute(
     out: &Path,
     opts: &BuildOptions,
     threads: usize,
+    incremental: bool,
 ) -> anyhow::Result<Outcome> {
     if files.is_empty() {
         anyhow::bail!("no .bvh files found in the inputs");
@@ -41,10 +48,16 @@ pub fn execute(
         .num_threads(threads)
         .build()
         .context("starting the worker threads")?;
-    let report = pool
-        .install(|| build_and_write(files, out, opts))
+    let (report, reused) = pool
+        .install(|| build_and_write(files, out, opts, incremental))
         .with_context(|| format!("writing the library to {}", out.display()))?;
     let outcome = super::frames::report(&report.records, out);
-    println!("{} stances", report.stances.len());
+    println!(
+        "{} stances rebuilt, {reused} clips reused",
+        report.stances.len()
+    );
+    if reused > 0 && outcome == Outcome::AllFailed {
+        return Ok(Outcome::SomeFailed);
+    }
     Ok(outcome)
 }

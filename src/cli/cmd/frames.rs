@@ -68,9 +68,9 @@ pub fn report(records: &[ClipRecord], out: &Path) -> Outcome {
         failed,
         out.display()
     );
-    if failed > 0 {
-        Outcome::SomeFailed
-    } else {
-        Outcome::Clean
+    match failed {
+        0 => Outcome::Clean,
+        f if f == records.len() => Outcome::AllFailed,
+        _ => Outcome::SomeFailed,
     }
 }

@@ -29,5 +29,11 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
         ingest: opts,
         ..Default::default()
     };
-    super::build::execute(&files, &relative_to(&a.pipeline, &pipe.out), &opts, threads)
+    super::build::execute(
+        &files,
+        &relative_to(&a.pipeline, &pipe.out),
+        &opts,
+        threads,
+        a.incremental,
+    )
 }
