@@ -17,9 +17,10 @@ lint:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets -- -D warnings
 
-## Criterion benchmarks (parse, FK+COM, ingest) on the shared clips.
+## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances (library).
 bench:
 	$(CARGO) bench --bench stages
+	$(CARGO) bench --bench library
 
 ## The nightly job over ../shared/data (pipelines/nightly.toml).
 nightly:

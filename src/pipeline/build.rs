@@ -421,28 +421,64 @@ fn write_tables(
         .map_err(|err| Error::io(dir.join("manifest.json"), "cannot write", err))
 }
 
-/// Put `tmp` in the place of `out`: rename the old library aside, rename the new one in,
-/// remove the old one. A run killed between the two renames leaves the old library at
-/// `.<name>.old-<pid>` beside it, intact.
+/// Put `tmp` in the place of `out`. On Linux the two folders are exchanged in one step
+/// (`renameat2` with `RENAME_EXCHANGE`), so `out` always names a complete library; the old
+/// one, now at `tmp`, is then removed. Elsewhere (or on a file system without the flag) the
+/// old library is renamed aside first: a run killed between the two renames leaves it
+/// intact at `.<name>.old-<pid>` beside `out`.
 fn swap_into_place(tmp: &Path, out: &Path) -> Result<()> {
-    if out.exists() {
-        let old = out.with_file_name(format!(
-            ".{}.old-{}",
-            out.file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default(),
-            std::process::id()
-        ));
-        std::fs::rename(out, &old)
-            .map_err(|e| Error::io(out, "cannot move the previous library aside", e))?;
-        std::fs::rename(tmp, out)
-            .map_err(|e| Error::io(out, "cannot move the new library into place", e))?;
-        let _ = std::fs::remove_dir_all(&old);
-    } else {
-        std::fs::rename(tmp, out)
-            .map_err(|e| Error::io(out, "cannot move the new library into place", e))?;
+    if !out.exists() {
+        return std::fs::rename(tmp, out)
+            .map_err(|e| Error::io(out, "cannot move the new library into place", e));
     }
+    if exchange(tmp, out) {
+        let _ = std::fs::remove_dir_all(tmp);
+        return Ok(());
+    }
+    let old = out.with_file_name(format!(
+        ".{}.old-{}",
+        out.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        std::process::id()
+    ));
+    std::fs::rename(out, &old)
+        .map_err(|e| Error::io(out, "cannot move the previous library aside", e))?;
+    std::fs::rename(tmp, out)
+        .map_err(|e| Error::io(out, "cannot move the new library into place", e))?;
+    let _ = std::fs::remove_dir_all(&old);
     Ok(())
+}
+
+/// Atomically exchange two paths (Linux `renameat2(RENAME_EXCHANGE)`); false when the
+/// system or file system cannot.
+#[cfg(target_os = "linux")]
+fn exchange(a: &Path, b: &Path) -> bool {
+    use std::ffi::CString;
+    use std::os::unix::ffi::OsStrExt;
+    let (Ok(ca), Ok(cb)) = (
+        CString::new(a.as_os_str().as_bytes()),
+        CString::new(b.as_os_str().as_bytes()),
+    ) else {
+        return false;
+    };
+    // SAFETY: both arguments are valid NUL-terminated paths that outlive the call;
+    // renameat2 reads them and touches no other memory.
+    let rc = unsafe {
+        libc::renameat2(
+            libc::AT_FDCWD,
+            ca.as_ptr(),
+            libc::AT_FDCWD,
+            cb.as_ptr(),
+            libc::RENAME_EXCHANGE,
+        )
+    };
+    rc == 0
+}
+
+#[cfg(not(target_os = "linux"))]
+fn exchange(_: &Path, _: &Path) -> bool {
+    false
 }
 
 mod erased {

@@ -41,14 +41,7 @@ pub fn execute(
     threads: usize,
     incremental: bool,
 ) -> anyhow::Result<Outcome> {
-    if files.is_empty() {
-        anyhow::bail!("no .bvh files found in the inputs");
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("starting the worker threads")?;
-    let (report, reused) = pool
+    let (report, reused) = super::frames::worker_pool(files, threads)?
         .install(|| build_and_write(files, out, opts, incremental))
         .with_context(|| format!("writing the library to {}", out.display()))?;
     let outcome = super::frames::report(&report.records, out);

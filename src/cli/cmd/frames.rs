@@ -33,17 +33,24 @@ pub fn execute(
     opts: &IngestOptions,
     threads: usize,
 ) -> anyhow::Result<Outcome> {
-    if files.is_empty() {
-        anyhow::bail!("no .bvh files found in the inputs");
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("starting the worker threads")?;
-    let records = pool.install(|| ingest_all(files, opts));
+    let records = worker_pool(files, threads)?.install(|| ingest_all(files, opts));
     write_all(out, &records, opts.joints)
         .with_context(|| format!("writing tables to {}", out.display()))?;
     Ok(report(&records, out))
+}
+
+/// Check there is work, then start the rayon pool with `threads` workers (0 = all cores).
+///
+/// # Errors
+/// No input files, or a pool that cannot start.
+pub fn worker_pool(files: &[PathBuf], threads: usize) -> anyhow::Result<rayon::ThreadPool> {
+    if files.is_empty() {
+        anyhow::bail!("no .bvh files found in the inputs");
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the worker threads")
 }
 
 /// Print the per-clip failures and a one-line summary; the outcome for the exit code.

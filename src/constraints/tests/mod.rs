@@ -7,7 +7,6 @@
 mod extension;
 mod force;
 mod impulse;
-mod timing;
 
 use super::StanceContext;
 use crate::force_model::{AxisModel, ForceModel, GRAVITY};
