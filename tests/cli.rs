@@ -278,7 +278,10 @@ fn an_incremental_build_equals_a_full_rebuild() {
     let f = good_fixtures();
     let lib = |p: &Path| p.display().to_string();
     // First a library of two clips, then an incremental build of all five: two reused.
-    assert_eq!(stancelib(&["build", &f[0], &f[1], "--out", &lib(&lib_inc)]).0, 0);
+    assert_eq!(
+        stancelib(&["build", &f[0], &f[1], "--out", &lib(&lib_inc)]).0,
+        0
+    );
     let mut args: Vec<&str> = vec!["build"];
     args.extend(f.iter().map(String::as_str));
     let li = lib(&lib_inc);
@@ -293,10 +296,18 @@ fn an_incremental_build_equals_a_full_rebuild() {
     assert_eq!(stancelib(&full_args).0, 0);
     for t in ["frames", "contacts", "clips", "stances", "errors"] {
         let name = format!("{t}.parquet");
-        assert!(std::fs::read(lib_inc.join(&name)).unwrap() == std::fs::read(lib_full.join(&name)).unwrap(), "{name} differs");
+        assert!(
+            std::fs::read(lib_inc.join(&name)).unwrap()
+                == std::fs::read(lib_full.join(&name)).unwrap(),
+            "{name} differs"
+        );
     }
     // Nothing of the swap is left beside the library.
-    let leftovers: Vec<_> = std::fs::read_dir(inc.path()).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(inc.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name())
+        .collect();
     assert_eq!(leftovers.len(), 1, "{leftovers:?}");
 }
 
@@ -317,6 +328,47 @@ fn a_library_does_not_depend_on_threads_or_input_order() {
     assert_eq!(stancelib(&args).0, 0);
     for t in ["frames", "contacts", "clips", "stances", "errors"] {
         let name = format!("{t}.parquet");
-        assert!(std::fs::read(a.path().join("lib").join(&name)).unwrap() == std::fs::read(b.path().join("lib").join(&name)).unwrap(), "{name} differs");
+        assert!(
+            std::fs::read(a.path().join("lib").join(&name)).unwrap()
+                == std::fs::read(b.path().join("lib").join(&name)).unwrap(),
+            "{name} differs"
+        );
     }
+}
+
+#[test]
+fn stage_b_is_opt_in_and_recorded_per_stance() {
+    let dir = tmp();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    let f = fixture("run_120hz_m_yup.bvh");
+    assert_eq!(
+        stancelib(&["build", &f, "--out", &a.display().to_string()]).0,
+        0
+    );
+    assert_eq!(
+        stancelib(&["build", &f, "--out", &b.display().to_string(), "--stage-b"]).0,
+        0
+    );
+    let (sa, sb) = (
+        read_parquet(&a.join("stances.parquet")).unwrap(),
+        read_parquet(&b.join("stances.parquet")).unwrap(),
+    );
+    assert!(strings(&sa, "stage").iter().all(|s| s == "A"));
+    assert!(sa.column("fit_pos_rms_m").unwrap().null_count() == sa.height());
+    // Every fixture stance refits (no fallback on noise-free data), with a position residual.
+    assert!(
+        strings(&sb, "stage").iter().all(|s| s == "B"),
+        "{:?}",
+        strings(&sb, "stage")
+    );
+    let rms: Vec<f64> = sb
+        .column("fit_pos_rms_m")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .iter()
+        .map(|v| v.unwrap())
+        .collect();
+    // Noise-free fixture: the residual is the model's bias only (millimetres at most).
+    assert!(rms.iter().all(|r| *r < 5e-3), "{rms:?}");
 }

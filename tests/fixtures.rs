@@ -1,100 +1,18 @@
 //! The project's own generated clips (`fixtures/bvh`): they equal the generator's output,
 //! and ingest recovers their known COM, contacts, unit and up axis.
 
-use std::path::{Path, PathBuf};
-
 use stancelib::contacts::runs;
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
-use stancelib::synth::{generate, SynthMotion, SynthOptions, SynthUp};
+use stancelib::synth::generate;
 
-/// One committed fixture: the generator options and what ingest must detect.
-struct Case {
-    file: &'static str,
-    motion: SynthMotion,
-    rate: f64,
-    duration: f64,
-    unit_m: f64,
-    unit: &'static str,
-    up: SynthUp,
-    up_axis: &'static str,
-}
-
-const CASES: [Case; 5] = [
-    Case {
-        file: "run_120hz_m_yup",
-        motion: SynthMotion::Run,
-        rate: 120.0,
-        duration: 1.5,
-        unit_m: 1.0,
-        unit: "m",
-        up: SynthUp::Y,
-        up_axis: "+Y",
-    },
-    Case {
-        file: "run_60hz_cm_zup",
-        motion: SynthMotion::Run,
-        rate: 60.0,
-        duration: 1.5,
-        unit_m: 0.01,
-        unit: "cm",
-        up: SynthUp::Z,
-        up_axis: "+Z",
-    },
-    Case {
-        file: "run_30hz_in_yup",
-        motion: SynthMotion::Run,
-        rate: 30.0,
-        duration: 2.0,
-        unit_m: 0.0254,
-        unit: "in",
-        up: SynthUp::Y,
-        up_axis: "+Y",
-    },
-    Case {
-        file: "jump_120hz_cmu_yup",
-        motion: SynthMotion::Jump,
-        rate: 120.0,
-        duration: 2.2,
-        unit_m: 0.056444,
-        unit: "cmu",
-        up: SynthUp::Y,
-        up_axis: "+Y",
-    },
-    Case {
-        file: "jump_100hz_m_zup",
-        motion: SynthMotion::Jump,
-        rate: 100.0,
-        duration: 2.2,
-        unit_m: 1.0,
-        unit: "m",
-        up: SynthUp::Z,
-        up_axis: "+Z",
-    },
-];
-
-fn opts(c: &Case) -> SynthOptions {
-    SynthOptions {
-        motion: c.motion,
-        frame_rate_hz: c.rate,
-        duration_s: c.duration,
-        unit_m: c.unit_m,
-        up: c.up,
-        seed: 1,
-    }
-}
-
-fn path(c: &Case) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures/bvh")
-        .join(format!("{}.bvh", c.file))
-}
+use crate::util;
 
 #[test]
 fn committed_fixtures_match_the_generator() {
-    for c in &CASES {
-        let on_disk = std::fs::read_to_string(path(c)).unwrap();
+    for c in &util::FIXTURES {
+        let on_disk = std::fs::read_to_string(util::fixture_path(c)).unwrap();
         assert!(
-            on_disk == generate(&opts(c)).bvh,
+            on_disk == generate(&util::fixture_opts(c)).bvh,
             "{} differs from the generator: run `make fixtures`",
             c.file
         );
@@ -103,9 +21,9 @@ fn committed_fixtures_match_the_generator() {
 
 #[test]
 fn ingest_recovers_com_contacts_unit_and_axis_of_the_fixtures() {
-    for c in &CASES {
-        let truth = generate(&opts(c));
-        let bvh = stancelib::bvh::parse_file(&path(c)).unwrap();
+    for c in &util::FIXTURES {
+        let truth = generate(&util::fixture_opts(c));
+        let bvh = stancelib::bvh::parse_file(&util::fixture_path(c)).unwrap();
         let ClipOutcome::Body {
             summary, frames, ..
         } = ingest(&bvh, &IngestOptions::default()).unwrap()
@@ -168,8 +86,8 @@ fn ingest_recovers_com_contacts_unit_and_axis_of_the_fixtures() {
 #[test]
 fn fixture_flights_are_ballistic() {
     // 120 Hz run: 14-frame flights, exactly ballistic in the generator.
-    let c = &CASES[0];
-    let bvh = stancelib::bvh::parse_file(&path(c)).unwrap();
+    let c = &util::FIXTURES[0];
+    let bvh = stancelib::bvh::parse_file(&util::fixture_path(c)).unwrap();
     let ClipOutcome::Body { summary, .. } = ingest(&bvh, &IngestOptions::default()).unwrap() else {
         panic!()
     };

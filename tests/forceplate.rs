@@ -5,8 +5,6 @@
 //! spec com-from-bvh §7.3 (timing requirement); CORRECTIONS issue 2 item 4;
 //! `data/forceplate/SOURCES.md`.
 
-use std::path::Path;
-
 use serde_json::Value;
 use stancelib::bvh::parse_file;
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
@@ -26,48 +24,6 @@ macro_rules! outln {
 const CLIPS: [&str; 2] = ["hamner_s02_run_4ms", "opencap_s4_DJ1_dropjump"];
 /// g used by the data (meta.json `g_mps2`) and by the flight fits, m/s².
 const G: f64 = 9.81;
-
-/// Columns of a numeric CSV with a header; empty cells are NaN.
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-    let header: Vec<String> = lines
-        .next()
-        .expect("header")
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
-    let mut cols = vec![Vec::new(); header.len()];
-    for (i, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        assert_eq!(
-            cells.len(),
-            header.len(),
-            "{}: row {} has {} cells",
-            path.display(),
-            i + 2,
-            cells.len()
-        );
-        for (c, cell) in cells.iter().enumerate() {
-            let cell = cell.trim();
-            cols[c].push(if cell.is_empty() {
-                f64::NAN
-            } else {
-                cell.parse()
-                    .unwrap_or_else(|_| panic!("{}: bad number {cell:?}", path.display()))
-            });
-        }
-    }
-    (header, cols)
-}
-
-fn col<'a>(h: &[String], cols: &'a [Vec<f64>], name: &str) -> &'a [f64] {
-    let i = h
-        .iter()
-        .position(|c| c == name)
-        .unwrap_or_else(|| panic!("no column {name} in {h:?}"));
-    &cols[i]
-}
 
 fn pearson(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len() as f64;
@@ -257,9 +213,9 @@ fn contact_events_and_kinematic_force_match_the_force_plates() {
         }
 
         // ---- Kinematic vertical force (CORRECTIONS issue 2 item 4) ----
-        let (h, cols) = read_csv(&dir.join("grf.csv"));
-        let t_grf = col(&h, &cols, "time_s");
-        let fvert = col(&h, &cols, "fvert_n");
+        let (h, cols) = util::read_csv(&dir.join("grf.csv"));
+        let t_grf = util::csv_col(&h, &cols, "time_s");
+        let fvert = util::csv_col(&h, &cols, "fvert_n");
         assert!(
             fvert.iter().all(|f| f.is_finite()),
             "{clip}: fvert_n has empty cells"

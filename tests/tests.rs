@@ -10,13 +10,17 @@
 //! - `readers`: pyarrow and DuckDB open the library (row counts, metadata, values).
 //! - `real_data`: every shared BVH loads; flight physics, walk/run contact patterns, invariance.
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
+//! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
+//! - `stances_truth`: stances of the fixtures against the generator's truth; Parquet round trip.
 mod bad_input;
 mod cli;
 mod fixtures;
 mod forceplate;
+mod forceplate_stances;
 mod multicontact;
 mod props;
 mod readers;
 mod real_data;
 mod stances;
+mod stances_truth;
 mod util;

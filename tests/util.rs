@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use stancelib::synth::{SynthMotion, SynthOptions, SynthUp};
+
 /// `../shared/data` beside the checkout, if present.
 pub fn shared_data() -> Option<PathBuf> {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
@@ -16,4 +18,128 @@ pub fn shared_or_skip(test: &str) -> Option<PathBuf> {
         eprintln!("SKIPPED {test}: ../shared/data is absent (CI always has it)");
     }
     d
+}
+
+/// One committed fixture: the generator options and what ingest must detect.
+pub struct FixtureCase {
+    pub file: &'static str,
+    pub motion: SynthMotion,
+    pub rate: f64,
+    pub duration: f64,
+    pub unit_m: f64,
+    pub unit: &'static str,
+    pub up: SynthUp,
+    pub up_axis: &'static str,
+}
+
+pub const FIXTURES: [FixtureCase; 5] = [
+    FixtureCase {
+        file: "run_120hz_m_yup",
+        motion: SynthMotion::Run,
+        rate: 120.0,
+        duration: 1.5,
+        unit_m: 1.0,
+        unit: "m",
+        up: SynthUp::Y,
+        up_axis: "+Y",
+    },
+    FixtureCase {
+        file: "run_60hz_cm_zup",
+        motion: SynthMotion::Run,
+        rate: 60.0,
+        duration: 1.5,
+        unit_m: 0.01,
+        unit: "cm",
+        up: SynthUp::Z,
+        up_axis: "+Z",
+    },
+    FixtureCase {
+        file: "run_30hz_in_yup",
+        motion: SynthMotion::Run,
+        rate: 30.0,
+        duration: 2.0,
+        unit_m: 0.0254,
+        unit: "in",
+        up: SynthUp::Y,
+        up_axis: "+Y",
+    },
+    FixtureCase {
+        file: "jump_120hz_cmu_yup",
+        motion: SynthMotion::Jump,
+        rate: 120.0,
+        duration: 2.2,
+        unit_m: 0.056444,
+        unit: "cmu",
+        up: SynthUp::Y,
+        up_axis: "+Y",
+    },
+    FixtureCase {
+        file: "jump_100hz_m_zup",
+        motion: SynthMotion::Jump,
+        rate: 100.0,
+        duration: 2.2,
+        unit_m: 1.0,
+        unit: "m",
+        up: SynthUp::Z,
+        up_axis: "+Z",
+    },
+];
+
+pub fn fixture_opts(c: &FixtureCase) -> SynthOptions {
+    SynthOptions {
+        motion: c.motion,
+        frame_rate_hz: c.rate,
+        duration_s: c.duration,
+        unit_m: c.unit_m,
+        up: c.up,
+        seed: 1,
+    }
+}
+
+pub fn fixture_path(c: &FixtureCase) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/bvh")
+        .join(format!("{}.bvh", c.file))
+}
+
+/// Columns of a numeric CSV with a header; empty cells are NaN.
+pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<String> = lines
+        .next()
+        .expect("header")
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .collect();
+    let mut cols = vec![Vec::new(); header.len()];
+    for (i, line) in lines.enumerate() {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(
+            cells.len(),
+            header.len(),
+            "{}: row {} has {} cells",
+            path.display(),
+            i + 2,
+            cells.len()
+        );
+        for (c, cell) in cells.iter().enumerate() {
+            let cell = cell.trim();
+            cols[c].push(if cell.is_empty() {
+                f64::NAN
+            } else {
+                cell.parse()
+                    .unwrap_or_else(|_| panic!("{}: bad number {cell:?}", path.display()))
+            });
+        }
+    }
+    (header, cols)
+}
+
+pub fn csv_col<'a>(h: &[String], cols: &'a [Vec<f64>], name: &str) -> &'a [f64] {
+    let i = h
+        .iter()
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("no column {name} in {h:?}"));
+    &cols[i]
 }

@@ -53,6 +53,9 @@ pub struct BodyArgs {
     /// Also write joints.parquet (every joint's world position).
     #[arg(long)]
     pub joints: bool,
+    /// Refit each stance by least squares on the raw COM positions (Stage B).
+    #[arg(long = "stage-b")]
+    pub stage_b: bool,
     /// Worker threads (0 = all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,

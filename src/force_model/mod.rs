@@ -11,7 +11,7 @@
 //! ```
 //! Modules: [`basis`] (closed forms of one term, any Ω), [`model`] ([`AxisModel`],
 //! [`ForceModel`], grid and flags), [`fit`] ([`fit_stage_a`], [`FitWorkspace`]).
-//! Stage B (§4.2) is not implemented here.
+//! Stage B (§4.2, off by default) refits by least squares on the raw COM positions: [`stage_b`].
 //!
 //! # Frames and units
 //! Stance frame `h, p, v` (index 0, 1, 2; spec §2): `f_stance = R_s · f_world`, with `R_s`
@@ -45,9 +45,11 @@
 pub mod basis;
 pub mod fit;
 pub mod model;
+pub mod stage_b;
 
 pub use fit::{fit_axis, fit_stage_a, j_cap, k_max, FitWorkspace};
 pub use model::{AxisModel, ForceModel};
+pub use stage_b::{fit_stage_b, to_stance_model, StageBFit, StageBInput, MAX_CONDITION};
 
 /// Gravity magnitude `g` (m/s²); the gravity vector is `g⃗ = (0, 0, −g)` (spec preamble).
 pub const GRAVITY: f64 = 9.81;

@@ -185,8 +185,14 @@ pub fn stances_table(rows: &[Stance]) -> PolarsResult<DataFrame> {
             f(&|r| r.model.axes[a].fit_rms),
         ));
     }
-    cols.push(col("fit_pos_rms_m", vec![None::<f64>; rows.len()]));
-    cols.push(col("stage", vec!["A"; rows.len()]));
+    cols.push(col(
+        "fit_pos_rms_m",
+        rows.iter().map(|r| r.fit_pos_rms_m).collect::<Vec<_>>(),
+    ));
+    cols.push(col(
+        "stage",
+        rows.iter().map(|r| r.stage).collect::<Vec<_>>(),
+    ));
     for (q, get) in [("j", 0usize), ("k", 1)] {
         for (a, name) in axis.iter().enumerate() {
             cols.push(col(

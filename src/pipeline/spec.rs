@@ -16,6 +16,7 @@ use crate::error::{Error, Result};
 use crate::ingest::{IngestOptions, DEFAULT_MASS_KG};
 use crate::skeleton::com::Sex;
 use crate::skeleton::units::{parse_unit, UpAxis};
+use crate::stances::StanceOptions;
 
 /// A unit given as metres per file unit or by name.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
@@ -225,6 +226,27 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
         return Err(bad("inputs", "inputs must list at least one glob".into()));
     }
     check_common(path, text, p.mass_kg, p.unit.as_ref(), p.up_axis.as_deref())?;
+    if let Some(f) = &p.fit {
+        if f.stage_b_time_refinement == Some(true) {
+            return Err(bad(
+                "stage_b_time_refinement",
+                "stage_b_time_refinement is not implemented (spec stance-model §4.2, optional)"
+                    .into(),
+            ));
+        }
+        if f.energy.is_some_and(|e| !(0.0..=1.0).contains(&e)) {
+            return Err(bad("energy", "energy must lie in [0, 1]".into()));
+        }
+        if f.samples.is_some_and(|n| !(2..=1 << 20).contains(&n)) {
+            return Err(bad("samples", "samples must lie in [2, 1048576]".into()));
+        }
+        if f.max_harmonics == Some(0) {
+            return Err(bad(
+                "max_harmonics",
+                "max_harmonics must be at least 1".into(),
+            ));
+        }
+    }
     if let Some(l) = p.constraints.as_ref().and_then(|c| c.limits.as_ref()) {
         if !["per_query", "absolute", "relative"].contains(&l.as_str()) {
             return Err(bad(
@@ -312,6 +334,19 @@ fn apply_contacts(o: &mut ContactOptions, c: &ContactsTable) {
     set(&mut o.min_on_s, c.min_on_s);
     set(&mut o.min_gap_s, c.min_gap_s);
     set(&mut o.floor_window_s, c.floor_window_s);
+}
+
+/// Stance options from a pipeline's `[fit]` table and the command line (`--stage-b`).
+pub fn resolve_fit(pipe: Option<&PipelineFile>, cli_stage_b: bool) -> StanceOptions {
+    let mut o = StanceOptions::default();
+    if let Some(f) = pipe.and_then(|p| p.fit.as_ref()) {
+        o.stage_b = f.stage_b.unwrap_or(false);
+        o.fit.max_harmonics = f.max_harmonics.map_or(o.fit.max_harmonics, |v| v as usize);
+        o.fit.energy = f.energy.unwrap_or(o.fit.energy);
+        o.fit.samples = f.samples.map_or(o.fit.samples, |v| v as usize);
+    }
+    o.stage_b |= cli_stage_b;
+    o
 }
 
 /// Expand a pipeline's input globs (relative to the pipeline file's folder).

@@ -6,7 +6,11 @@ use super::{FlightRef, Stance};
 use crate::constraints::{precompute, StanceContext};
 use crate::contacts::flight::Flight;
 use crate::contacts::EFFECTORS;
-use crate::force_model::{fit_stage_a, FitOptions, FitWorkspace};
+use crate::force_model::fit::j_cap;
+use crate::force_model::stage_b::{
+    fit_stage_b, to_stance_model, StageBFit, StageBInput, MAX_CONDITION,
+};
+use crate::force_model::{fit_stage_a, FitOptions, FitWorkspace, ForceModel};
 use crate::ingest::{ClipFrames, ClipSummary};
 use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
 use crate::math::spline::NaturalSpline;
@@ -17,8 +21,10 @@ type V3 = [f64; 3];
 /// Options of the stance stage.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct StanceOptions {
-    /// Force-model fit.
+    /// Force-model fit (Stage A).
     pub fit: FitOptions,
+    /// Refit by least squares on the raw COM positions (Stage B, spec §4.2; off by default).
+    pub stage_b: bool,
 }
 
 /// Natural cubic splines of the three coordinates of a per-frame vector series.
@@ -115,6 +121,67 @@ fn flight_ref(f: &Flight, t: f64) -> Option<FlightRef> {
     })
 }
 
+/// The inputs of one stance's Stage B refit (spec §4.2).
+struct StageB<'a> {
+    seg: &'a Segment,
+    fr: &'a ClipFrames,
+    summary: &'a ClipSummary,
+    model: &'a ForceModel,
+    t_td: f64,
+    dt_s: f64,
+    mass_kg: f64,
+    state: (V3, V3),
+}
+
+impl StageB<'_> {
+    /// Fit window: the stance frames, extended over an adjacent flight's frames (only where
+    /// the boundary is a flight); harmonics: the union of Stage A's, capped at `j_cap`;
+    /// touchdown state fixed to the SG one when neither side is a flight.
+    fn fit(&self) -> crate::Result<StageBFit> {
+        let (seg, fr) = (self.seg, self.fr);
+        let frame0 = fr.frame[0];
+        let kept = |f: i64| (f - frame0).max(0) as usize;
+        let start = match seg.start {
+            Boundary::Flight => self
+                .summary
+                .flights
+                .iter()
+                .find(|f| f.last_frame == fr.frame[seg.i0] - 1)
+                .map_or(seg.i0, |f| kept(f.first_frame)),
+            _ => seg.i0,
+        };
+        let end = match seg.end {
+            Boundary::Flight => self
+                .summary
+                .flights
+                .iter()
+                .find(|f| f.first_frame == fr.frame[seg.i1] + 1)
+                .map_or(seg.i1, |f| kept(f.last_frame)),
+            _ => seg.i1,
+        };
+        let cap = j_cap(seg.i1 - seg.i0 + 1);
+        let mut harmonics: Vec<u32> = self
+            .model
+            .axes
+            .iter()
+            .flat_map(|a| a.harmonics.iter().copied())
+            .filter(|&j| j <= cap)
+            .collect();
+        harmonics.sort_unstable();
+        harmonics.dedup();
+        let no_flight = seg.start != Boundary::Flight && seg.end != Boundary::Flight;
+        fit_stage_b(&StageBInput {
+            t: &fr.time_s[start..=end],
+            com: &fr.com[start..=end],
+            t_td: self.t_td,
+            dt: self.dt_s,
+            mass_kg: self.mass_kg,
+            harmonics: &harmonics,
+            fixed_state: no_flight.then_some(self.state),
+        })
+    }
+}
+
 /// Build every stance of a clip. Returns the stances and clip-level warnings.
 pub fn build_clip(
     clip: &str,
@@ -183,12 +250,11 @@ pub fn build_clip(
             fr.time_s[seg.i1] + dt / 2.0
         };
         let dt_s = t_lo - t_td;
-        let (p_td, v_td) = (pos.at(t_td), vel.at(t_td));
-        let h: Heading = heading(v_td, fr.facing[seg.i0], previous);
-        previous = Some(h.e_h);
+        let (mut p_td, mut v_td) = (pos.at(t_td), vel.at(t_td));
+        let mut h: Heading = heading(v_td, fr.facing[seg.i0], previous);
         let z_c = median(&fr.ground_z[seg.i0..=seg.i1]).unwrap_or(0.0);
         let (label, effectors) = label(&seg, &fr.contact);
-        let model = match fit_stage_a(
+        let mut model = match fit_stage_a(
             &mut ws,
             &acc.0,
             t_td,
@@ -207,6 +273,35 @@ pub fn build_clip(
                 continue;
             }
         };
+        let mut sw = Vec::new();
+        let (mut stage, mut fit_pos_rms_m) = ("A", None);
+        if opts.stage_b {
+            let refit = StageB {
+                seg: &seg,
+                fr,
+                summary,
+                model: &model,
+                t_td,
+                dt_s,
+                mass_kg,
+                state: (p_td, v_td),
+            }
+            .fit();
+            match refit {
+                Ok(fit) if fit.condition <= MAX_CONDITION => {
+                    (p_td, v_td) = (fit.p_td, fit.v_td);
+                    h = heading(v_td, fr.facing[seg.i0], previous);
+                    model = to_stance_model(&fit, h.rotation(), mass_kg, dt_s);
+                    (stage, fit_pos_rms_m) = ("B", Some(fit.pos_rms_m));
+                }
+                Ok(fit) => sw.push(format!(
+                    "stage B fallback to A: condition {:.2e} above {MAX_CONDITION:e}",
+                    fit.condition
+                )),
+                Err(e) => sw.push(format!("stage B fallback to A: {e}")),
+            }
+        }
+        previous = Some(h.e_h);
         let (j, p) = (model.j(), model.p());
         let v_td_s = h.to_stance(v_td);
         let z_td = p_td[2] - z_c;
@@ -226,7 +321,6 @@ pub fn build_clip(
             cp,
         };
         let coef = precompute(&model, &ctx);
-        let mut sw = Vec::new();
         if !coef.unilateral_ok {
             sw.push("unilateral test failed: the model pulls on the ground (ringing)".to_string());
         }
@@ -275,6 +369,8 @@ pub fn build_clip(
             model,
             cp,
             coef,
+            stage,
+            fit_pos_rms_m,
             warnings: sw,
         });
     }

@@ -86,6 +86,10 @@ pub struct Stance {
     pub cp: [f64; 2],
     /// Precomputed constraint coefficients and extremes.
     pub coef: Coefficients,
+    /// `A` or `B` (Stage B without fallback).
+    pub stage: &'static str,
+    /// Stage B position residual RMS, m.
+    pub fit_pos_rms_m: Option<f64>,
     /// Advisory messages.
     pub warnings: Vec<String>,
 }

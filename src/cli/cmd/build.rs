@@ -8,7 +8,7 @@ use super::super::args::BuildArgs;
 use super::super::Outcome;
 use crate::pipeline::batch::discover;
 use crate::pipeline::build::{build_and_write, BuildOptions};
-use crate::pipeline::spec::{load_body, resolve};
+use crate::pipeline::spec::{load_body, resolve, resolve_fit};
 
 /// Run `build`.
 ///
@@ -19,7 +19,7 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
     let body = a.body.body.as_deref().map(load_body).transpose()?;
     let opts = BuildOptions {
         ingest: resolve(body.as_ref(), None, &cli),
-        ..Default::default()
+        stances: resolve_fit(None, a.body.stage_b),
     };
     execute(
         &discover(&a.inputs)?,

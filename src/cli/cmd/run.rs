@@ -27,7 +27,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
     };
     let opts = crate::pipeline::build::BuildOptions {
         ingest: opts,
-        ..Default::default()
+        stances: crate::pipeline::spec::resolve_fit(Some(&pipe), a.body.stage_b),
     };
     super::build::execute(
         &files,

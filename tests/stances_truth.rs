@@ -1,0 +1,810 @@
+//! Stances of the generated fixtures against the generator's ground truth: segmentation
+//! (count, labels, frames, Δt), the six stance parameters against the exact ballistic
+//! flights, the Stage A force model against the true applied force, and a round trip of
+//! the force model through `stances.parquet`.
+//!
+//! # Truth
+//! The generator (`src/synth.rs`, module doc) integrates the COM in closed form from a
+//! piecewise force model whose phase edges fall on frames; in flight the COM is exactly
+//! ballistic (`c̈ = −g e_z`, g = 9.81 m/s²), and the truth contact flags mark the closed
+//! frame range `k_a..=k_b` of each contact phase (the force is 0 at both edge frames).
+//! Contact edges are therefore exact on the fixtures: a contact phase starts and ends on a
+//! frame, and no noise blurs them.
+//!
+//! # References
+//! spec stance-model §1 (segmentation, half-frame convention), §3 (parameters), §4.1 and
+//! §4.2 (Stage A and its error table), §11 (columns, reconstructing the force);
+//! CORRECTIONS issue 3 item 9 (fixture force target).
+
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+use polars::prelude::*;
+use stancelib::contacts::runs;
+use stancelib::ingest::{ingest, ClipOutcome, IngestOptions, DEFAULT_MASS_KG};
+use stancelib::library::read::read_parquet;
+use stancelib::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
+use stancelib::pipeline::build::{build, write_library, BuildOptions};
+use stancelib::stances::segment::Boundary;
+use stancelib::stances::{build_clip, Stance, StanceOptions};
+
+use crate::util;
+use stancelib::synth::{generate, SynthClip, SynthMotion};
+
+/// Gravity of the generator and of the spec, m/s².
+const G: f64 = 9.81;
+
+/// A fixture with its truth and what the library made of it.
+struct Loaded {
+    truth: SynthClip,
+    stances: Vec<Stance>,
+    /// Frame time, s.
+    dt: f64,
+}
+
+fn load(c: &util::FixtureCase) -> Loaded {
+    let truth = generate(&util::fixture_opts(c));
+    let text = std::fs::read_to_string(util::fixture_path(c)).unwrap();
+    // The truth below is the generator's; the committed file must be its output.
+    assert!(
+        text == truth.bvh,
+        "{}: differs from the generator (run `make fixtures`)",
+        c.file
+    );
+    let bvh = stancelib::bvh::parse_file(&util::fixture_path(c)).unwrap();
+    let ClipOutcome::Body {
+        summary, frames, ..
+    } = ingest(&bvh, &IngestOptions::default()).unwrap()
+    else {
+        panic!("{} skipped", c.file)
+    };
+    assert_eq!(frames.frame.len(), truth.com.len(), "{}", c.file);
+    let (stances, _) = build_clip(
+        c.file,
+        &frames,
+        &summary,
+        DEFAULT_MASS_KG,
+        &StanceOptions::default(),
+    );
+    let dt = summary.frame_time_s;
+    Loaded { truth, stances, dt }
+}
+
+/// One true support run.
+#[derive(Debug, Clone)]
+struct TrueStance {
+    /// First and last truth contact frame (closed range; the force is 0 at both).
+    k0: usize,
+    k1: usize,
+    /// `L`, `R` or `LR`.
+    label: &'static str,
+    /// The contact phase in clip time: from frame `k0` to frame `k1`, or the clip edge.
+    t0: f64,
+    t1: f64,
+}
+
+fn true_stances(truth: &SynthClip, dt: f64) -> Vec<TrueStance> {
+    let n = truth.com.len();
+    let support: Vec<bool> = (0..n)
+        .map(|k| truth.contact_left[k] || truth.contact_right[k])
+        .collect();
+    runs(&support)
+        .into_iter()
+        .map(|(k0, k1)| {
+            let l = (k0..=k1).any(|k| truth.contact_left[k]);
+            let r = (k0..=k1).any(|k| truth.contact_right[k]);
+            let label = match (l, r) {
+                (true, true) => "LR",
+                (true, false) => "L",
+                _ => "R",
+            };
+            TrueStance {
+                k0,
+                k1,
+                label,
+                t0: k0 as f64 * dt,
+                t1: k1 as f64 * dt,
+            }
+        })
+        .collect()
+}
+
+// ------------------------------------------------------------------ the true force
+
+/// The generator's force model (module doc of `src/synth.rs`) in continuous time: the
+/// applied force per unit mass (m/s², world Z up) at clip time `t`.
+struct TrueForce {
+    motion: SynthMotion,
+    dt: f64,
+    /// Run: (touchdown time, left foot) of every stance.
+    run_stances: Vec<(f64, bool)>,
+}
+
+impl TrueForce {
+    fn new(c: &util::FixtureCase, truth: &SynthClip, dt: f64) -> Self {
+        let run_stances = true_stances(truth, dt)
+            .iter()
+            .map(|s| (s.t0, s.label == "L"))
+            .collect();
+        TrueForce {
+            motion: c.motion,
+            dt,
+            run_stances,
+        }
+    }
+
+    /// Frames of a duration, `round(s·F)` half away from zero (the generator's rule).
+    fn frames(&self, s: f64) -> f64 {
+        (s / self.dt).round()
+    }
+
+    fn at(&self, t: f64) -> [f64; 3] {
+        match self.motion {
+            SynthMotion::Run => {
+                // Ts = round(0.25 s·F)/F, Tf = 2·round(0.06 s·F)/F, Tc = Ts + Tf.
+                let ts = self.frames(0.25).max(2.0) * self.dt;
+                let tf = 2.0 * self.frames(0.06).max(1.0) * self.dt;
+                let tc = ts + tf;
+                let a = PI * G * tc / (2.0 * ts);
+                let b = 4.0;
+                let cc = PI * 0.1 / ts;
+                for &(t_a, left) in &self.run_stances {
+                    let tau = t - t_a;
+                    if (0.0..=ts).contains(&tau) {
+                        let s1 = (PI * tau / ts).sin();
+                        let s2 = (2.0 * PI * tau / ts).sin();
+                        let sway = if left { -cc } else { cc };
+                        return [-b * s2, sway * s1, a * s1];
+                    }
+                }
+                [0.0; 3]
+            }
+            SynthMotion::Jump => {
+                let (ns, np, nf) = (
+                    self.frames(0.3).max(2.0),
+                    self.frames(0.6).max(2.0),
+                    self.frames(0.35).max(2.0),
+                );
+                let (tp, tf) = (np * self.dt, nf * self.dt);
+                let v0 = G * tf / 2.0;
+                let b1 = PI * (v0 + G * tp / 2.0) / (2.0 * tp);
+                let b2 = 2.0 * PI * G * (0.25 - 1.0 / (PI * PI)) - 2.0 * b1;
+                let push = |tau: f64, s: f64| {
+                    let (w1, w2) = (PI * tau / tp, 2.0 * PI * tau / tp);
+                    G / 2.0 + s * (G / 2.0) * w1.cos() + b1 * w1.sin() + s * b2 * w2.sin()
+                };
+                let t_push = ns * self.dt;
+                let t_flight = t_push + tp;
+                let t_land = t_flight + tf;
+                let fz = if t < t_push {
+                    G
+                } else if t <= t_flight {
+                    push(t - t_push, 1.0)
+                } else if t < t_land {
+                    0.0
+                } else if t <= t_land + tp {
+                    push(t - t_land, -1.0)
+                } else {
+                    G
+                };
+                [0.0, 0.0, fz]
+            }
+        }
+    }
+}
+
+// ------------------------------------------------------------------ helpers
+
+/// `writeln!` into a per-test buffer, printed in one piece (tests run in parallel).
+macro_rules! outln {
+    ($buf:expr, $($t:tt)*) => {{
+        use std::fmt::Write as _;
+        writeln!($buf, $($t)*).unwrap();
+    }};
+}
+
+/// SG COM speed per frame from the true COM (spec stance-model §1 step 3 defines the quiet
+/// periods on the SG speed; computed here from the generator's COM, not from ingest).
+fn sg_speed(truth: &SynthClip, dt: f64) -> Vec<f64> {
+    let sg = SavGol::new(window_for_rate(1.0 / dt), DEFAULT_ORDER).unwrap();
+    let v: Vec<Vec<f64>> = (0..3)
+        .map(|i| sg.apply(&truth.com.iter().map(|c| c[i]).collect::<Vec<_>>(), 1, dt))
+        .collect();
+    (0..truth.com.len())
+        .map(|k| (v[0][k].powi(2) + v[1][k].powi(2) + v[2][k].powi(2)).sqrt())
+        .collect()
+}
+
+/// The quiet periods (spec §1 step 3: speed < 0.15 m/s for ≥ 0.3 s) inside frames `a..=b`.
+fn quiet_periods(speed: &[f64], a: usize, b: usize, dt: f64) -> Vec<(usize, usize)> {
+    let q: Vec<bool> = speed[a..=b].iter().map(|v| *v < 0.15).collect();
+    runs(&q)
+        .into_iter()
+        .map(|(x, y)| (a + x, a + y))
+        // A run of n frames lasts n·dt (the library's convention); 1e-9 s: round-off.
+        .filter(|(x, y)| (y - x + 1) as f64 * dt >= 0.3 - 1e-9)
+        .collect()
+}
+
+/// The world applied force (N) of a stance's model at clip time `t`: 0 outside
+/// [`td_clip_s`, `lo_clip_s`] (spec §11).
+fn model_world(s: &Stance, t: f64) -> [f64; 3] {
+    if t < s.td_clip_s || t > s.lo_clip_s {
+        return [0.0; 3];
+    }
+    let tau = (t - s.td_clip_s) / s.dt_s;
+    let f: [f64; 3] = std::array::from_fn(|a| s.model.axes[a].eval(tau));
+    // R_s rows are e_h, e_p, e_v: world = R_sᵀ · f_stance.
+    let r = s.heading.rotation();
+    std::array::from_fn(|i| (0..3).map(|a| r[a][i] * f[a]).sum())
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// The true stance interval each detected stance is compared with, in clip time: the
+/// contact phase (frame `k0` to frame `k1`, where the true force starts and ends), except at
+/// an end where the stance is bounded by a quiet period (no contact event there: the split
+/// is a rule on the SG speed, checked separately) or by the clip edge.
+fn true_interval(s: &Stance, t: &TrueStance) -> (f64, f64) {
+    let a = match s.boundary_start {
+        Boundary::Rest => s.td_clip_s,
+        _ => t.t0,
+    };
+    let b = match s.boundary_end {
+        Boundary::Rest => s.lo_clip_s,
+        _ => t.t1,
+    };
+    (a, b)
+}
+
+// ------------------------------------------------------------------ tests
+
+/// Stance count, labels, frames and Δt of every fixture against the true contact runs.
+#[test]
+fn fixture_stances_match_the_true_contact_runs() {
+    let mut out = String::new();
+    let mut failures = Vec::new();
+    for c in &util::FIXTURES {
+        let l = load(c);
+        let n = l.truth.com.len();
+        let truth = true_stances(&l.truth, l.dt);
+        let speed = sg_speed(&l.truth, l.dt);
+        outln!(
+            out,
+            "== {} ({n} frames at {} Hz): {} true support runs, {} stances",
+            c.file,
+            c.rate,
+            truth.len(),
+            l.stances.len()
+        );
+        // Here a stance is a support run: no walking split (no alternating single supports
+        // within a run) and a quiet split never leaves two parts of one run (the quiet
+        // periods of the jump's runs touch the clip edges).
+        if l.stances.len() != truth.len() {
+            failures.push(format!(
+                "{}: {} stances, {} true contact runs",
+                c.file,
+                l.stances.len(),
+                truth.len()
+            ));
+            continue;
+        }
+        match c.motion {
+            SynthMotion::Run => {
+                for w in l.stances.windows(2) {
+                    if w[0].label == w[1].label {
+                        failures.push(format!(
+                            "{}: run stances do not alternate: {} then {}",
+                            c.file, w[0].stance_id, w[1].stance_id
+                        ));
+                    }
+                }
+            }
+            SynthMotion::Jump => {
+                // Jump: two-footed stances (CORRECTIONS issue 3 item 1: one flight, one stance
+                // with a flight after it and one with a flight before it).
+                let flights: Vec<_> = l
+                    .stances
+                    .iter()
+                    .map(|s| (s.boundary_start, s.boundary_end))
+                    .collect();
+                if flights.iter().filter(|b| b.1 == Boundary::Flight).count() != 1
+                    || flights.iter().filter(|b| b.0 == Boundary::Flight).count() != 1
+                {
+                    failures.push(format!("{}: boundaries {flights:?}", c.file));
+                }
+            }
+        }
+        for (s, t) in l.stances.iter().zip(&truth) {
+            if s.label != t.label {
+                failures.push(format!(
+                    "{}: {} label, truth {}",
+                    s.stance_id, s.label, t.label
+                ));
+            }
+            let (f0, f1) = (s.first_frame as usize, s.last_frame as usize);
+            // Contact edges are exact on the fixtures (phase edges on frames, no noise):
+            // the detector is allowed one frame (spec com-from-bvh §7.3).
+            let mut frames_ok = true;
+            let mut note = String::new();
+            if s.boundary_start == Boundary::Rest {
+                // The part after a quiet period starts at its last frame (spec §1 step 3).
+                let q = quiet_periods(&speed, t.k0, t.k1, l.dt);
+                frames_ok &= q.iter().any(|&(_, qb)| qb == f0);
+                note += &format!(" quiet periods {q:?} (start at a quiet end)");
+            } else {
+                frames_ok &= f0.abs_diff(t.k0) <= 1;
+            }
+            if s.boundary_end == Boundary::Rest {
+                // The part before a quiet period ends at its first frame.
+                let q = quiet_periods(&speed, t.k0, t.k1, l.dt);
+                frames_ok &= q.iter().any(|&(qa, _)| qa == f1);
+                note += &format!(" quiet periods {q:?} (end at a quiet start)");
+            } else {
+                frames_ok &= f1.abs_diff(t.k1) <= 1;
+            }
+            if !frames_ok {
+                failures.push(format!(
+                    "{}: frames {f0}..{f1}, true run {}..{}{note}",
+                    s.stance_id, t.k0, t.k1
+                ));
+            }
+            let (a, b) = true_interval(s, t);
+            let err_dt = s.dt_s - (b - a);
+            outln!(
+                out,
+                "  {:<24} {:?}/{:?}: frames {f0}..{f1} (true run {}..{}), td {:.5} lo {:.5} s (true contact {a:.5}..{b:.5}), Δt {:.5} s, true {:.5}, Δt − true = {:+.3} frames{note}",
+                s.stance_id,
+                s.boundary_start,
+                s.boundary_end,
+                t.k0,
+                t.k1,
+                s.td_clip_s,
+                s.lo_clip_s,
+                s.dt_s,
+                b - a,
+                err_dt / l.dt
+            );
+            // One frame time: the true force starts and ends on a frame (closed flag run),
+            // the half-frame convention (spec §1 step 5) adds half a frame at each contact
+            // edge; 1e-9 s: round-off of the frame-time arithmetic.
+            if err_dt.abs() > l.dt + 1e-9 {
+                failures.push(format!(
+                    "{}: Δt {:.5} s vs true {:.5} s",
+                    s.stance_id,
+                    s.dt_s,
+                    b - a
+                ));
+            }
+        }
+    }
+    print!("{out}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The ballistic flight state (position, velocity) at clip time `t` from two consecutive
+/// flight frames `k`, `k + 1` of the true COM: exact for a parabola of curvature −g.
+fn ballistic_at(truth: &SynthClip, dt: f64, k: usize, t: f64) -> ([f64; 3], [f64; 3]) {
+    let (c0, c1) = (truth.com[k], truth.com[k + 1]);
+    let a = [0.0, 0.0, -G];
+    // The chord slope is the velocity at the mid time, exactly, for a parabola.
+    let t_mid = (k as f64 + 0.5) * dt;
+    let v_mid: [f64; 3] = std::array::from_fn(|i| (c1[i] - c0[i]) / dt);
+    let v0: [f64; 3] = std::array::from_fn(|i| v_mid[i] - a[i] * (t_mid - k as f64 * dt));
+    let s = t - k as f64 * dt;
+    let p = std::array::from_fn(|i| c0[i] + v0[i] * s + 0.5 * a[i] * s * s);
+    let v = std::array::from_fn(|i| v0[i] + a[i] * s);
+    (p, v)
+}
+
+/// Apex of the ballistic parabola through a state: (horizontal position, height, velocity).
+fn apex(p: [f64; 3], v: [f64; 3]) -> ([f64; 2], f64, [f64; 2]) {
+    let e = v[2] / G; // time from the state to the apex
+    (
+        [p[0] + v[0] * e, p[1] + v[1] * e],
+        p[2] + v[2] * v[2] / (2.0 * G),
+        [v[0], v[1]],
+    )
+}
+
+/// Stage A tolerances per frame rate: (|Δv| m/s, |Δz| m, |Δx| m).
+fn param_tolerances(rate: f64) -> (f64, f64, f64) {
+    // Spec §4.2 table, Stage A only at 1 mm noise: the ceiling of every tolerance here.
+    let spec: (f64, f64, f64) = if rate <= 30.0 {
+        (0.08, 0.032, 0.12)
+    } else if rate <= 60.0 {
+        (0.07, 0.020, 0.06)
+    } else {
+        (0.06, 0.019, 0.05)
+    };
+    // Measured on these noise-free fixtures (the SG window straddling the contact edges is
+    // the only error source), worst over the stances with flights on both sides, × 1.5.
+    let measured = if rate <= 30.0 {
+        (MEAS_30[0], MEAS_30[1], MEAS_30[2])
+    } else if rate <= 60.0 {
+        (MEAS_60[0], MEAS_60[1], MEAS_60[2])
+    } else {
+        (MEAS_120[0], MEAS_120[1], MEAS_120[2])
+    };
+    (
+        spec.0.min(1.5 * measured.0),
+        spec.1.min(1.5 * measured.1),
+        spec.2.min(1.5 * measured.2),
+    )
+}
+
+/// Worst |Δv| (m/s: vs, ve, vp), |Δz| (m: zs, ze), |Δx| (m) measured on the noise-free run
+/// fixtures (printed by the test), rounded up. The model-consistent `ze` and `x` (spec §3)
+/// carry the Stage A force model's impulse error; the measured-LO values are 3-10× closer.
+const MEAS_120: [f64; 3] = [0.0024, 0.0087, 0.0124];
+const MEAS_60: [f64; 3] = [0.0018, 0.0082, 0.0103];
+const MEAS_30: [f64; 3] = [0.0032, 0.0110, 0.0114];
+
+/// zs, vs, ze, ve, vp, x of the run stances with flights on both sides against the apices
+/// of the generator's exact ballistic flights.
+#[test]
+fn run_stance_parameters_match_the_ballistic_truth() {
+    let mut out = String::new();
+    let mut failures = Vec::new();
+    for c in util::FIXTURES
+        .iter()
+        .filter(|c| c.motion == SynthMotion::Run)
+    {
+        let l = load(c);
+        let truth = true_stances(&l.truth, l.dt);
+        let (tol_v, tol_z, tol_x) = param_tolerances(c.rate);
+        outln!(
+            out,
+            "== {} at {} Hz: tolerances |Δv| {tol_v:.4} m/s, |Δz| {tol_z:.4} m, |Δx| {tol_x:.4} m",
+            c.file,
+            c.rate
+        );
+        let mut worst = [0.0f64; 3];
+        let mut checked = 0;
+        for (i, s) in l.stances.iter().enumerate() {
+            if s.boundary_start != Boundary::Flight || s.boundary_end != Boundary::Flight {
+                continue;
+            }
+            let t = &truth[i];
+            let (prev, next) = (&truth[i - 1], &truth[i + 1]);
+            // The flights: frames prev.k1..=t.k0 and t.k1..=next.k0 are on one parabola each
+            // (the force is 0 from the contact's last frame to the next one's first).
+            assert!(
+                t.k0 - prev.k1 >= 3 && next.k0 - t.k1 >= 3,
+                "flight too short"
+            );
+            let kb = t.k0 - 2; // frames t.k0 − 2, t.k0 − 1: inside the flight before
+            let ka = t.k1 + 1; // frames t.k1 + 1, t.k1 + 2: inside the flight after
+                               // The truth is exactly ballistic: a third flight frame lies on the parabola
+                               // through two (1e-9 m: f64 round-off of the closed-form integration).
+            for (k, k3) in [(kb, prev.k1 + 1), (ka, next.k0 - 1)] {
+                let (p, _) = ballistic_at(&l.truth, l.dt, k, k3 as f64 * l.dt);
+                let d = norm(std::array::from_fn(|j| p[j] - l.truth.com[k3][j]));
+                assert!(
+                    d < 1e-9,
+                    "{}: flight frame {k3} off the parabola by {d:e} m",
+                    c.file
+                );
+            }
+            let (pb, vb) = ballistic_at(&l.truth, l.dt, kb, s.td_clip_s);
+            let (pa, va) = ballistic_at(&l.truth, l.dt, ka, s.lo_clip_s);
+            let (hs, zs, vhs) = apex(pb, vb);
+            let (he, ze, vhe) = apex(pa, va);
+            // True heading: the horizontal velocity of the flight before (spec §2); the true
+            // contact height is the floor, z = 0 (toe tips on it).
+            let vn = vhs[0].hypot(vhs[1]);
+            let eh = [vhs[0] / vn, vhs[1] / vn];
+            let ep = [-eh[1], eh[0]];
+            let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+            let tr = [
+                zs,
+                dot(vhs, eh),
+                ze,
+                dot(vhe, eh),
+                dot(vhe, ep),
+                dot([he[0] - hs[0], he[1] - hs[1]], eh),
+            ];
+            let p = &s.params;
+            let got = [p.zs, p.vs, p.ze, p.ve, p.vp, p.x];
+            let m = &s.measured;
+            let meas = [m.zs, m.vs, m.ze, m.ve, m.vp, m.x];
+            let names = ["zs", "vs", "ze", "ve", "vp", "x"];
+            let tols = [tol_z, tol_v, tol_z, tol_v, tol_v, tol_x];
+            let kind = [1, 0, 1, 0, 0, 2]; // index into worst: v, z, x
+            outln!(
+                out,
+                "  {:<24} z_c {:+.2e} m, heading error {:.3}°",
+                s.stance_id,
+                s.z_c,
+                (s.heading.e_h[1].atan2(s.heading.e_h[0]) - eh[1].atan2(eh[0])).to_degrees()
+            );
+            for j in 0..6 {
+                let err = got[j] - tr[j];
+                worst[kind[j]] = worst[kind[j]].max(err.abs());
+                outln!(
+                    out,
+                    "    {:<2} truth {:+.5}  model-consistent {:+.5} (err {:+.5})  measured-LO {:+.5} (err {:+.5})",
+                    names[j],
+                    tr[j],
+                    got[j],
+                    err,
+                    meas[j],
+                    meas[j] - tr[j]
+                );
+                if err.abs() > tols[j] {
+                    failures.push(format!(
+                        "{}: {} = {:.5}, truth {:.5}, |err| {:.5} > {:.5}",
+                        s.stance_id,
+                        names[j],
+                        got[j],
+                        tr[j],
+                        err.abs(),
+                        tols[j]
+                    ));
+                }
+            }
+            checked += 1;
+        }
+        outln!(
+            out,
+            "  worst over {checked} stances: |Δv| {:.5} m/s, |Δz| {:.5} m, |Δx| {:.5} m",
+            worst[0],
+            worst[1],
+            worst[2]
+        );
+        if checked == 0 {
+            failures.push(format!("{}: no stance with flights on both sides", c.file));
+        }
+    }
+    print!("{out}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// CORRECTIONS issue 3 item 9: the Stage A model against the true applied force over the
+/// union of the detected and the true stance.
+#[test]
+fn fixture_force_models_match_the_true_force() {
+    let mut out = String::new();
+    let mut failures = Vec::new();
+    for c in &util::FIXTURES {
+        let l = load(c);
+        let n = l.truth.com.len();
+        let truth = true_stances(&l.truth, l.dt);
+        let tf = TrueForce::new(c, &l.truth, l.dt);
+        // The continuous truth is the generator's documented model: it must reproduce the
+        // per-frame truth (1e-9 m/s²: round-off of two closed-form evaluations).
+        for k in 0..n {
+            let a = tf.at(k as f64 * l.dt);
+            let b = l.truth.force_n_per_kg[k];
+            let d = (0..3).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max);
+            assert!(
+                d < 1e-9,
+                "{} frame {k}: formula {a:?} vs truth {b:?}",
+                c.file
+            );
+        }
+        // CORRECTIONS item 9, Stage A: ≤ 6 % at 120 Hz, ≤ 10 % at 30 Hz (the 0.1 s SG
+        // window's floor is 5 % / 9 %); 60 and 100 Hz take the 120 Hz target (their SG
+        // windows are also ~0.1 s wide).
+        let target = if c.rate <= 30.0 { 0.10 } else { 0.06 };
+        let m = DEFAULT_MASS_KG;
+        outln!(
+            out,
+            "== {} at {} Hz (target RMS < {:.0} % of the true peak)",
+            c.file,
+            c.rate,
+            target * 100.0
+        );
+        assert_eq!(l.stances.len(), truth.len(), "{}: stance count", c.file);
+        for (s, t) in l.stances.iter().zip(&truth) {
+            let (a, b) = true_interval(s, t);
+            let (u0, u1) = (a.min(s.td_clip_s), b.max(s.lo_clip_s));
+            // A dense grid (2001 points) over the union: the true force is continuous, the
+            // model is 0 outside [t_TD, t_LO].
+            let pts = 2001;
+            let mut peak = 0.0f64;
+            let (mut se, mut se_axis) = (0.0, [0.0; 3]);
+            for j in 0..pts {
+                let tt = u0 + (u1 - u0) * j as f64 / (pts - 1) as f64;
+                let f_true = if tt >= a && tt <= b {
+                    tf.at(tt).map(|x| x * m)
+                } else {
+                    [0.0; 3]
+                };
+                let f_mod = model_world(s, tt);
+                peak = peak.max(norm(f_true));
+                let e: [f64; 3] = std::array::from_fn(|i| f_mod[i] - f_true[i]);
+                se += norm(e).powi(2);
+                (0..3).for_each(|i| se_axis[i] += e[i] * e[i]);
+            }
+            let rms = (se / pts as f64).sqrt();
+            let rms_axis = se_axis.map(|x| (x / pts as f64).sqrt());
+            // The same at the frames in the union, against force_n_per_kg × m (reported).
+            let (mut se_f, mut nf) = (0.0, 0);
+            for k in 0..n {
+                let tt = k as f64 * l.dt;
+                if tt < u0 - 1e-9 || tt > u1 + 1e-9 {
+                    continue;
+                }
+                let f_true = if tt >= a - 1e-9 && tt <= b + 1e-9 {
+                    l.truth.force_n_per_kg[k].map(|x| x * m)
+                } else {
+                    [0.0; 3]
+                };
+                let f_mod = model_world(s, tt);
+                se_f += norm(std::array::from_fn(|i| f_mod[i] - f_true[i])).powi(2);
+                nf += 1;
+            }
+            let rms_frames = (se_f / nf as f64).sqrt();
+            outln!(
+                out,
+                "  {:<24} union {u0:.4}..{u1:.4} s: RMS {:6.1} N = {:5.2} % of peak {:6.1} N (x {:.1}, y {:.1}, z {:.1} N); at the {nf} frames {:5.2} %; fit_rms (h,p,v) ({:.1}, {:.1}, {:.1}) N, harmonics (h,p,v) {:?} {:?} {:?}",
+                s.stance_id,
+                rms,
+                100.0 * rms / peak,
+                peak,
+                rms_axis[0],
+                rms_axis[1],
+                rms_axis[2],
+                100.0 * rms_frames / peak,
+                s.model.axes[0].fit_rms,
+                s.model.axes[1].fit_rms,
+                s.model.axes[2].fit_rms,
+                s.model.axes[0].harmonics,
+                s.model.axes[1].harmonics,
+                s.model.axes[2].harmonics,
+            );
+            if rms >= target * peak {
+                failures.push(format!(
+                    "{}: force RMS {:.2} % of the true peak ≥ {:.0} %",
+                    s.stance_id,
+                    100.0 * rms / peak,
+                    target * 100.0
+                ));
+            }
+        }
+    }
+    print!("{out}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Reading a `stances.parquet` list column entry as f64 values.
+fn list_f64(df: &DataFrame, name: &str, i: usize) -> Vec<f64> {
+    let s = df
+        .column(name)
+        .unwrap()
+        .list()
+        .unwrap()
+        .get_as_series(i)
+        .unwrap();
+    s.f64().unwrap().iter().map(|v| v.unwrap()).collect()
+}
+
+/// The force model survives `stances.parquet`: the §11 reconstruction from the stored
+/// columns alone equals the in-process model; row count and order.
+#[test]
+fn force_models_round_trip_through_parquet() {
+    let files: Vec<PathBuf> = util::FIXTURES.iter().map(util::fixture_path).collect();
+    let opts = BuildOptions::default();
+    let report = build(&files, &opts);
+    let dir = tempfile::tempdir().unwrap();
+    let lib = dir.path().join("lib");
+    write_library(&lib, &report, &opts).unwrap();
+    let df = read_parquet(&lib.join("stances.parquet")).unwrap();
+
+    // In process, independently of the pipeline: ingest and build_clip per fixture.
+    let mut in_process: Vec<Stance> = util::FIXTURES
+        .iter()
+        .flat_map(|c| load(c).stances)
+        .collect();
+    in_process.sort_by(|a, b| a.stance_id.cmp(&b.stance_id));
+    assert_eq!(
+        df.height(),
+        in_process.len(),
+        "row count vs in-process stances"
+    );
+    assert_eq!(report.stances.len(), in_process.len());
+
+    let clip = df.column("clip").unwrap().str().unwrap().clone();
+    let label = df.column("label").unwrap().str().unwrap().clone();
+    let id = df.column("stance_id").unwrap().str().unwrap().clone();
+    let first = df.column("first_frame").unwrap().i64().unwrap().clone();
+    let f64col = |name: &str| -> Vec<f64> {
+        df.column(name)
+            .unwrap()
+            .f64()
+            .unwrap()
+            .iter()
+            .map(|v| v.unwrap())
+            .collect()
+    };
+    let (td, dts, hx, hy) = (
+        f64col("td_clip_s"),
+        f64col("dt_s"),
+        f64col("heading_x"),
+        f64col("heading_y"),
+    );
+    let c0: Vec<Vec<f64>> = ["c0_h", "c0_p", "c0_v"].iter().map(|n| f64col(n)).collect();
+    let mut keys = Vec::new();
+    let mut worst = 0.0f64;
+    for i in 0..df.height() {
+        let key = (
+            clip.get(i).unwrap().to_string(),
+            first.get(i).unwrap(),
+            label.get(i).unwrap().to_string(),
+        );
+        keys.push(key);
+        let sid = id.get(i).unwrap();
+        let s = in_process
+            .iter()
+            .find(|s| s.stance_id == sid)
+            .unwrap_or_else(|| panic!("row {i}: {sid} not built in process"));
+        // Per stance axis, from the stored columns only (spec §11).
+        let axes: Vec<StoredAxis> = ["h", "p", "v"]
+            .iter()
+            .enumerate()
+            .map(|(a, ax)| {
+                let h = df
+                    .column(&format!("harmonic_{ax}"))
+                    .unwrap()
+                    .list()
+                    .unwrap()
+                    .get_as_series(i)
+                    .unwrap();
+                let h: Vec<i32> = h.i32().unwrap().iter().map(|v| v.unwrap()).collect();
+                let amp = list_f64(&df, &format!("amp_{ax}"), i);
+                let ph = list_f64(&df, &format!("phase_{ax}"), i);
+                assert_eq!((h.len(), amp.len()), (ph.len(), ph.len()), "{sid} {ax}");
+                (c0[a][i], h, amp, ph)
+            })
+            .collect();
+        let (eh, ep) = ([hx[i], hy[i], 0.0], [-hy[i], hx[i], 0.0]);
+        let ev = [0.0, 0.0, 1.0];
+        // 50 points from τ = −0.1 to 1.1: both sides of the stance (0 there) and inside.
+        for j in 0..50 {
+            let t = td[i] + dts[i] * (-0.1 + 1.2 * j as f64 / 49.0);
+            let tau = (t - td[i]) / dts[i];
+            let f: Vec<f64> = axes
+                .iter()
+                .map(|(c0, h, amp, ph)| {
+                    if !(0.0..=1.0).contains(&tau) {
+                        return 0.0;
+                    }
+                    c0 + h
+                        .iter()
+                        .zip(amp)
+                        .zip(ph)
+                        .map(|((&h, &a), &p)| a * (2.0 * PI * h as f64 * tau + p).cos())
+                        .sum::<f64>()
+                })
+                .collect();
+            let stored: [f64; 3] =
+                std::array::from_fn(|d| f[0] * eh[d] + f[1] * ep[d] + f[2] * ev[d]);
+            let mine = model_world(s, t);
+            let d = norm(std::array::from_fn(|d| stored[d] - mine[d]));
+            worst = worst.max(d);
+            // 1e-9 N: the columns hold the model's f64 values exactly; only the order of
+            // the floating-point operations differs.
+            assert!(
+                d < 1e-9,
+                "{sid} t {t}: stored {stored:?} vs in process {mine:?}"
+            );
+        }
+    }
+    let mut sorted = keys.clone();
+    sorted.sort();
+    assert_eq!(
+        keys, sorted,
+        "rows not sorted by (clip, first_frame, label)"
+    );
+    println!(
+        "{} rows = {} in-process stances; sorted; worst reconstruction difference {worst:.2e} N over 50 points each",
+        df.height(),
+        in_process.len()
+    );
+}
+
+/// One stance axis as stored: (c0, harmonics, amplitudes, phases).
+type StoredAxis = (f64, Vec<i32>, Vec<f64>, Vec<f64>);
