@@ -1,6 +1,8 @@
 //! The one integration-test binary. Table of contents:
 //!
 //! - `bad_input`: malformed files name file and line; a 300 MB stream loads.
+//! - `bvh_oracle`: differential test of the BVH reader against the `bvh_anim` crate on every
+//!   shared clip it reads (f32 precision), and a write-and-reread round trip.
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
 //! - `stances`: stances of real clips: flights on both sides, impulse–momentum, walks, running forces.
@@ -13,6 +15,7 @@
 //! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
 //! - `stances_truth`: stances of the fixtures against the generator's truth; Parquet round trip.
 mod bad_input;
+mod bvh_oracle;
 mod cli;
 mod fixtures;
 mod forceplate;
