@@ -354,10 +354,9 @@ pub fn resolve_fit(pipe: Option<&PipelineFile>, cli_stage_b: bool) -> StanceOpti
 /// # Errors
 /// An invalid glob pattern, or a glob that matches nothing.
 pub fn expand_inputs(pipeline_path: &Path, p: &PipelineFile) -> Result<Vec<PathBuf>> {
-    let base = pipeline_path.parent().unwrap_or(Path::new("."));
     let mut out = Vec::new();
     for g in &p.inputs {
-        let pat = base.join(g);
+        let pat = relative_to(pipeline_path, g);
         let pat_s = pat.to_string_lossy();
         let matches = glob::glob(&pat_s).map_err(|e| {
             Error::config(
@@ -379,9 +378,27 @@ pub fn expand_inputs(pipeline_path: &Path, p: &PipelineFile) -> Result<Vec<PathB
     Ok(out)
 }
 
-/// The pipeline's output and body paths, resolved against its folder.
+/// The pipeline's output and body paths, resolved against its folder, with `.` and `..`
+/// folded lexically (`pipelines/../out/demo` → `out/demo`).
 pub fn relative_to(pipeline_path: &Path, p: &str) -> PathBuf {
-    pipeline_path.parent().unwrap_or(Path::new(".")).join(p)
+    use std::path::Component;
+    let joined = pipeline_path.parent().unwrap_or(Path::new(".")).join(p);
+    let mut out = PathBuf::new();
+    for c in joined.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir
+                if matches!(out.components().next_back(), Some(Component::Normal(_))) =>
+            {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    if out.as_os_str().is_empty() {
+        out.push(".");
+    }
+    out
 }
 
 #[cfg(test)]
@@ -403,6 +420,20 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("x.toml:2:"), "{e}");
+    }
+
+    #[test]
+    fn relative_paths_fold_dot_dot() {
+        let p = Path::new("pipelines/demo.toml");
+        assert_eq!(relative_to(p, "../out/demo"), PathBuf::from("out/demo"));
+        assert_eq!(
+            relative_to(p, "../../shared/x"),
+            PathBuf::from("../shared/x")
+        );
+        assert_eq!(
+            relative_to(Path::new("demo.toml"), "out"),
+            PathBuf::from("out")
+        );
     }
 
     #[test]

@@ -391,39 +391,50 @@ fn bench_fk_com(c: &mut Criterion) {
             black_box(acc)
         })
     });
-    // The proposed change (module `proposal`): batched polynomial sin/cos, same products,
-    // checked against `fk::forward` before it is timed.
+    // The proposed changes (module `proposal`), cumulatively, each checked against
+    // `fk::forward` before it is timed.
+    type Fk = fn(&Skeleton, &mut proposal::FlatFk, &[f64], &mut [[f64; 3]]);
+    let variants: [(&str, Fk); 3] = [
+        (
+            "full_proposal_1_const_axis",
+            proposal::forward::<false, false>,
+        ),
+        (
+            "full_proposal_2_local_product",
+            proposal::forward::<false, true>,
+        ),
+        (
+            "full_proposal_3_batched_trig",
+            proposal::forward::<true, true>,
+        ),
+    ];
     let mut flat = proposal::FlatFk::new(&p.skel);
     let mut pts2 = pts.clone();
-    let mut worst: f64 = 0.0;
-    for f in 0..n {
-        fk::forward(&p.skel, &mut ws, p.bvh.motion.row(f), &mut pts);
-        proposal::forward(&p.skel, &mut flat, p.bvh.motion.row(f), &mut pts2);
-        for (a, b) in pts.iter().zip(&pts2) {
-            worst = (0..3).fold(worst, |w, k| w.max((a[k] - b[k]).abs()));
+    for (name, fwd) in variants {
+        let mut worst: f64 = 0.0;
+        for f in 0..n {
+            fk::forward(&p.skel, &mut ws, p.bvh.motion.row(f), &mut pts);
+            fwd(&p.skel, &mut flat, p.bvh.motion.row(f), &mut pts2);
+            for (a, b) in pts.iter().zip(&pts2) {
+                worst = (0..3).fold(worst, |w, k| w.max((a[k] - b[k]).abs()));
+            }
         }
-    }
-    eprintln!("fk_com: proposal vs fk::forward: largest point difference {worst:.1e} file units");
-    assert!(
-        worst < 1e-9,
-        "the prototype disagrees with fk::forward by {worst}"
-    );
-    g.bench_function(
-        BenchmarkId::new("full_proposal_batched_trig", &label),
-        |b| {
+        eprintln!("fk_com: {name} vs fk::forward: largest point difference {worst:.1e} file units");
+        assert!(worst < 1e-9, "{name} disagrees with fk::forward by {worst}");
+        g.bench_function(BenchmarkId::new(name, &label), |b| {
             b.iter(|| {
                 let m = &p.bvh.motion;
                 out.clear();
                 contacts.clear();
                 for f in 0..n {
-                    proposal::forward(&p.skel, &mut flat, m.row(f), &mut pts);
+                    fwd(&p.skel, &mut flat, m.row(f), &mut pts);
                     out.push(units_com(&p, &pts, &mut pts_m));
                     contacts.push(contact_points(&p, &pts_m));
                 }
                 black_box((&out, &contacts));
             })
-        },
-    );
+        });
+    }
     let rot_idx: Vec<usize> = p
         .skel
         .channels
@@ -574,18 +585,24 @@ mod proposal {
         }
     }
 
-    /// `fk::rotate_right` with the sine and cosine given.
+    /// `fk::rotate_right` with the sine and cosine given, and constant column indices in
+    /// each arm so that the matrix stays in registers (with `m[a]`, `m[b]` for runtime
+    /// `a`, `b` it lives on the stack, and its scalar stores followed by 16-byte loads
+    /// defeat store-to-load forwarding).
     #[inline(always)]
     fn rotate_right_sc(m: &mut Mat3, axis: u8, s: f64, c: f64) {
-        let (a, b) = match axis {
-            0 => (1, 2),
-            1 => (2, 0),
-            _ => (0, 1),
-        };
-        let (ca, cb) = (m[a], m[b]);
-        for r in 0..3 {
-            m[a][r] = c * ca[r] + s * cb[r];
-            m[b][r] = -s * ca[r] + c * cb[r];
+        #[inline(always)]
+        fn mix<const A: usize, const B: usize>(m: &mut Mat3, s: f64, c: f64) {
+            let (ca, cb) = (m[A], m[B]);
+            for r in 0..3 {
+                m[A][r] = c * ca[r] + s * cb[r];
+                m[B][r] = -s * ca[r] + c * cb[r];
+            }
+        }
+        match axis {
+            0 => mix::<1, 2>(m, s, c),
+            1 => mix::<2, 0>(m, s, c),
+            _ => mix::<0, 1>(m, s, c),
         }
     }
 
@@ -595,18 +612,32 @@ mod proposal {
         [mul_vec(a, &b[0]), mul_vec(a, &b[1]), mul_vec(a, &b[2])]
     }
 
-    /// Same output as `fk::forward` (to rounding). Changes: (1) one batched sin/cos pass
-    /// over the frame's rotation channels; (2) the local rotation is built from its
-    /// channels alone, which does not wait for the parent, and the world rotation is one
-    /// `parent · local` product, so the parent-to-child dependency chain is one 3×3
-    /// product per joint instead of one column mix per channel; (3) a joint whose angles
-    /// are all 0 in this frame takes its parent's rotation without a product.
-    pub fn forward(skel: &Skeleton, w: &mut FlatFk, row: &[f64], points: &mut [[f64; 3]]) {
+    /// Same output as `fk::forward` (to rounding). Changes, each switchable:
+    /// - always: constant column indices in the per-channel rotation (`rotate_right_sc`);
+    /// - `BATCH`: one batched sin/cos pass over the frame's rotation channels
+    ///   (`sincos_all`) instead of one libm `sin_cos` call per channel;
+    /// - `LOCAL`: the local rotation is built from its channels alone, which does not wait
+    ///   for the parent, and the world rotation is one `parent · local` product, so the
+    ///   parent-to-child dependency chain is one 3×3 product per joint instead of one
+    ///   column mix per channel; a joint whose angles are all 0 in this frame takes its
+    ///   parent's rotation without a product.
+    pub fn forward<const BATCH: bool, const LOCAL: bool>(
+        skel: &Skeleton,
+        w: &mut FlatFk,
+        row: &[f64],
+        points: &mut [[f64; 3]],
+    ) {
         assert!(row.len() >= skel.n_channels && points.len() >= skel.n_points());
         for (a, &i) in w.angles.iter_mut().zip(&w.rot_idx) {
             *a = row[i];
         }
-        sincos_all(w.avx2, &w.angles, &mut w.sin, &mut w.cos);
+        if BATCH {
+            sincos_all(w.avx2, &w.angles, &mut w.sin, &mut w.cos);
+        } else {
+            for ((a, s), c) in w.angles.iter().zip(w.sin.iter_mut()).zip(w.cos.iter_mut()) {
+                (*s, *c) = a.to_radians().sin_cos();
+            }
+        }
         for j in 0..skel.n_joints() {
             let ch = &skel.channels[j];
             let off = skel.offsets[j];
@@ -620,22 +651,31 @@ mod proposal {
                 }
             };
             let (k0, k1) = w.joint_rot[j];
-            let zero = w.angles[k0..k1].iter().all(|&a| a == 0.0);
-            let mut local = IDENTITY;
-            if !zero {
-                for k in k0..k1 {
-                    rotate_right_sc(&mut local, w.rot_axis[k], w.sin[k], w.cos[k]);
-                }
-            }
-            let (r, p) = match skel.parents[j] {
-                None => (local, t),
+            let (rp, p) = match skel.parents[j] {
+                None => (IDENTITY, t),
                 Some(pj) => {
-                    let rp = &w.rot[pj];
-                    let d = mul_vec(rp, &t);
+                    let rp = w.rot[pj];
+                    let d = mul_vec(&rp, &t);
                     let pp = points[pj];
-                    let r = if zero { *rp } else { mul_mat(rp, &local) };
-                    (r, [pp[0] + d[0], pp[1] + d[1], pp[2] + d[2]])
+                    (rp, [pp[0] + d[0], pp[1] + d[1], pp[2] + d[2]])
                 }
+            };
+            let r = if LOCAL {
+                if w.angles[k0..k1].iter().all(|&a| a == 0.0) {
+                    rp
+                } else {
+                    let mut local = IDENTITY;
+                    for k in k0..k1 {
+                        rotate_right_sc(&mut local, w.rot_axis[k], w.sin[k], w.cos[k]);
+                    }
+                    mul_mat(&rp, &local)
+                }
+            } else {
+                let mut r = rp;
+                for k in k0..k1 {
+                    rotate_right_sc(&mut r, w.rot_axis[k], w.sin[k], w.cos[k]);
+                }
+                r
             };
             w.rot[j] = r;
             points[j] = p;
