@@ -18,6 +18,13 @@ pub const CLIPS_FILE: &str = "clips.parquet";
 pub const CONTACTS_FILE: &str = "contacts.parquet";
 /// Joint-position table (`--joints`).
 pub const JOINTS_FILE: &str = "joints.parquet";
+/// Stance table of a library.
+pub const STANCES_FILE: &str = "stances.parquet";
+/// Failed inputs and stages of a library.
+pub const ERRORS_FILE: &str = "errors.parquet";
+/// Reserved in the library layout for the kinematic polytopes of the multi-contact stage
+/// (spec two-pac §3; not written yet).
+pub const KINEMATICS_FILE: &str = "kinematics.parquet";
 
 /// Columns of `clips.parquet`, in order.
 pub const CLIPS_COLUMNS: [&str; 23] = [

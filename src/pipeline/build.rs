@@ -22,7 +22,9 @@ use super::names::clip_names;
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
 use crate::library::read::read_parquet;
-use crate::library::schema::SCHEMA_VERSION;
+use crate::library::schema::{
+    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, SCHEMA_VERSION, STANCES_FILE,
+};
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, write_atomic};
 use crate::library::{ClipRecord, Status};
@@ -126,21 +128,21 @@ fn pe(name: &str, e: PolarsError) -> Error {
 impl Tables {
     fn from_report(r: &BuildReport) -> Result<Tables> {
         Ok(Tables {
-            frames: frames_table(&r.records).map_err(|e| pe("frames.parquet", e))?,
-            contacts: contacts_table(&r.records).map_err(|e| pe("contacts.parquet", e))?,
-            clips: clips_table(&r.records).map_err(|e| pe("clips.parquet", e))?,
-            stances: stances_table(&r.stances).map_err(|e| pe("stances.parquet", e))?,
-            errors: errors_table(&r.errors).map_err(|e| pe("errors.parquet", e))?,
+            frames: frames_table(&r.records).map_err(|e| pe(FRAMES_FILE, e))?,
+            contacts: contacts_table(&r.records).map_err(|e| pe(CONTACTS_FILE, e))?,
+            clips: clips_table(&r.records).map_err(|e| pe(CLIPS_FILE, e))?,
+            stances: stances_table(&r.stances).map_err(|e| pe(STANCES_FILE, e))?,
+            errors: errors_table(&r.errors).map_err(|e| pe(ERRORS_FILE, e))?,
         })
     }
 
     fn named(&mut self) -> [(&'static str, &mut DataFrame); 5] {
         [
-            ("frames.parquet", &mut self.frames),
-            ("contacts.parquet", &mut self.contacts),
-            ("clips.parquet", &mut self.clips),
-            ("stances.parquet", &mut self.stances),
-            ("errors.parquet", &mut self.errors),
+            (FRAMES_FILE, &mut self.frames),
+            (CONTACTS_FILE, &mut self.contacts),
+            (CLIPS_FILE, &mut self.clips),
+            (STANCES_FILE, &mut self.stances),
+            (ERRORS_FILE, &mut self.errors),
         ]
     }
 }
@@ -148,10 +150,10 @@ impl Tables {
 /// Sort keys per table (the order a full build writes).
 fn sort_keys(name: &str) -> &'static [&'static str] {
     match name {
-        "frames.parquet" => &["clip", "frame"],
-        "contacts.parquet" => &["clip", "effector", "first_frame"],
-        "clips.parquet" => &["clip"],
-        "stances.parquet" => &["clip", "first_frame", "label"],
+        FRAMES_FILE => &["clip", "frame"],
+        CONTACTS_FILE => &["clip", "effector", "first_frame"],
+        CLIPS_FILE => &["clip"],
+        STANCES_FILE => &["clip", "first_frame", "label"],
         _ => &["path", "stage", "message"],
     }
 }
@@ -189,7 +191,7 @@ fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTree
     {
         return BTreeSet::new();
     }
-    let Ok(clips) = read_parquet(&out.join("clips.parquet")) else {
+    let Ok(clips) = read_parquet(&out.join(CLIPS_FILE)) else {
         return BTreeSet::new();
     };
     let prev: BTreeMap<String, (String, String, String)> = strings(&clips, "clip")
