@@ -6,7 +6,6 @@
 //! `data/forceplate/SOURCES.md`.
 
 use serde_json::Value;
-use stancelib::bvh::parse_file;
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
 use stancelib::math::savgol::{window_for_rate, SavGol};
 
@@ -56,19 +55,15 @@ fn contact_events_and_kinematic_force_match_the_force_plates() {
     let mut failures: Vec<String> = Vec::new();
     let mut out = String::new();
     for clip in CLIPS {
-        let dir = data.join("forceplate").join(clip);
-        let meta: Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join("meta.json")).expect("meta.json"),
-        )
-        .expect("meta.json is JSON");
-        let mass = meta["subject_mass_kg"].as_f64().expect("subject_mass_kg");
-        let bw = meta["body_weight_n"].as_f64().expect("body_weight_n");
+        let util::ForcePlateClip {
+            dir,
+            meta,
+            mass,
+            bw,
+            window,
+            bvh,
+        } = util::forceplate_clip(&data, clip);
         let grf_rate = meta["grf_rate_hz"].as_f64().expect("grf_rate_hz");
-        let window = [
-            meta["window"][0].as_f64().expect("window"),
-            meta["window"][1].as_f64().expect("window"),
-        ];
-        let bvh = parse_file(&dir.join("clip.bvh")).expect("clip.bvh parses");
         let opts = IngestOptions {
             mass_kg: mass,
             ..Default::default()

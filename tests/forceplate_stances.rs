@@ -19,7 +19,6 @@
 //! CORRECTIONS issue 3 item 4; spec stance-model §1, §2, §4.3, §11; `data/forceplate/SOURCES.md`.
 
 use serde_json::Value;
-use stancelib::bvh::parse_file;
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
 use stancelib::stances::{build_clip, Stance, StanceOptions};
 
@@ -104,18 +103,14 @@ fn stance_force_models_match_the_force_plates() {
     let mut out = String::new();
     let mut failures: Vec<String> = Vec::new();
     for (clip, target) in CLIPS {
-        let dir = data.join("forceplate").join(clip);
-        let meta: Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join("meta.json")).expect("meta.json"),
-        )
-        .expect("meta.json is JSON");
-        let mass = meta["subject_mass_kg"].as_f64().expect("subject_mass_kg");
-        let bw = meta["body_weight_n"].as_f64().expect("body_weight_n");
-        let window = [
-            meta["window"][0].as_f64().expect("window"),
-            meta["window"][1].as_f64().expect("window"),
-        ];
-        let bvh = parse_file(&dir.join("clip.bvh")).expect("clip.bvh parses");
+        let util::ForcePlateClip {
+            dir,
+            meta,
+            mass,
+            bw,
+            window,
+            bvh,
+        } = util::forceplate_clip(&data, clip);
         let opts = IngestOptions {
             mass_kg: mass,
             ..Default::default()

@@ -21,7 +21,7 @@ use std::path::PathBuf;
 
 use polars::prelude::*;
 use stancelib::contacts::runs;
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions, DEFAULT_MASS_KG};
+use stancelib::ingest::DEFAULT_MASS_KG;
 use stancelib::library::read::read_parquet;
 use stancelib::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
 use stancelib::pipeline::build::{build, write_library, BuildOptions};
@@ -51,13 +51,7 @@ fn load(c: &util::FixtureCase) -> Loaded {
         "{}: differs from the generator (run `make fixtures`)",
         c.file
     );
-    let bvh = stancelib::bvh::parse_file(&util::fixture_path(c)).unwrap();
-    let ClipOutcome::Body {
-        summary, frames, ..
-    } = ingest(&bvh, &IngestOptions::default()).unwrap()
-    else {
-        panic!("{} skipped", c.file)
-    };
+    let (summary, frames) = util::ingest_fixture(c);
     assert_eq!(frames.frame.len(), truth.com.len(), "{}", c.file);
     let (stances, _) = build_clip(
         c.file,

@@ -143,3 +143,65 @@ pub fn csv_col<'a>(h: &[String], cols: &'a [Vec<f64>], name: &str) -> &'a [f64] 
         .unwrap_or_else(|| panic!("no column {name} in {h:?}"));
     &cols[i]
 }
+
+/// A force-plate clip of `../shared/data/forceplate`: metadata, mass, body weight, valid
+/// window and the parsed kinematics.
+pub struct ForcePlateClip {
+    /// The clip folder.
+    pub dir: PathBuf,
+    /// `meta.json`.
+    pub meta: serde_json::Value,
+    /// Subject mass, kg.
+    pub mass: f64,
+    /// Body weight, N.
+    pub bw: f64,
+    /// `[t0, t1]` in which kinematics and plates are both valid, s.
+    pub window: [f64; 2],
+    /// `clip.bvh`, parsed.
+    pub bvh: stancelib::bvh::Bvh,
+}
+
+/// Load one force-plate clip (panics with the file name on a malformed input: test data).
+pub fn forceplate_clip(data: &Path, clip: &str) -> ForcePlateClip {
+    let dir = data.join("forceplate").join(clip);
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).expect("meta.json"))
+            .expect("meta.json is JSON");
+    let num =
+        |v: &serde_json::Value, what: &str| v.as_f64().unwrap_or_else(|| panic!("{clip}: {what}"));
+    let (mass, bw) = (
+        num(&meta["subject_mass_kg"], "subject_mass_kg"),
+        num(&meta["body_weight_n"], "body_weight_n"),
+    );
+    let window = [
+        num(&meta["window"][0], "window"),
+        num(&meta["window"][1], "window"),
+    ];
+    let bvh = stancelib::bvh::parse_file(&dir.join("clip.bvh")).expect("clip.bvh parses");
+    ForcePlateClip {
+        dir,
+        meta,
+        mass,
+        bw,
+        window,
+        bvh,
+    }
+}
+
+/// Ingest a committed fixture with default options.
+pub fn ingest_fixture(
+    c: &FixtureCase,
+) -> (
+    stancelib::ingest::ClipSummary,
+    stancelib::ingest::ClipFrames,
+) {
+    let bvh = stancelib::bvh::parse_file(&fixture_path(c)).unwrap();
+    match stancelib::ingest::ingest(&bvh, &stancelib::ingest::IngestOptions::default()).unwrap() {
+        stancelib::ingest::ClipOutcome::Body {
+            summary, frames, ..
+        } => (summary, frames),
+        stancelib::ingest::ClipOutcome::Skipped { reason, .. } => {
+            panic!("{} skipped: {reason}", c.file)
+        }
+    }
+}
