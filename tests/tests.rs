@@ -5,6 +5,7 @@
 //!   shared clip it reads (f32 precision), and a write-and-reread round trip.
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
+//! - `regression`: one test per review finding, named after it.
 //! - `stances`: stances of real clips: flights on both sides, impulse–momentum, walks, running forces.
 //! - `util`: shared helpers (paths to `../shared`, skip messages, temp dirs, running the binary).
 //! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
@@ -24,6 +25,7 @@ mod multicontact;
 mod props;
 mod readers;
 mod real_data;
+mod regression;
 mod stances;
 mod stances_truth;
 mod util;

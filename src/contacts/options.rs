@@ -31,9 +31,11 @@ pub const STATIC_V_ON: f64 = 0.15;
 pub const STATIC_V_OFF: f64 = 0.30;
 /// Static mode: minimum run, s.
 pub const STATIC_MIN_ON_S: f64 = 0.2;
+/// Static mode: gaps shorter than this are filled, s (fixed by spec §7.4, not configurable).
+pub const STATIC_MIN_GAP_S: f64 = 0.03;
 
 /// Thresholds of one effector kind.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, Debug, Clone, Copy, PartialEq)]
 pub struct Thresholds {
     /// Enter when some point is at most this high, m.
     pub h_on: f64,
@@ -46,7 +48,7 @@ pub struct Thresholds {
 }
 
 /// Contact detection options.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, Debug, Clone, Copy, PartialEq)]
 pub struct ContactOptions {
     /// Foot thresholds.
     pub foot: Thresholds,

@@ -63,7 +63,7 @@ pub const DEFAULT_ENERGY: f64 = 0.99;
 pub const UNILATERAL_FRACTION: f64 = 0.05;
 
 /// Stage A tuning knobs (pipeline `fit.*`); see the `DEFAULT_*` constants.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, Debug, Clone, Copy, PartialEq)]
 pub struct FitOptions {
     /// Samples `N` per stance (≥ 2), at `τ_j = j/N`; default [`DEFAULT_SAMPLES`].
     pub samples: usize,

@@ -6,7 +6,7 @@ use super::{ClipFrames, ClipSummary, IngestOptions};
 use crate::bvh::Bvh;
 use crate::contacts::detect::{clean, hysteresis, static_hysteresis, PointTrack};
 use crate::contacts::flight::{clip_summary, fit_run};
-use crate::contacts::options::STATIC_MIN_ON_S;
+use crate::contacts::options::{STATIC_MIN_GAP_S, STATIC_MIN_ON_S};
 use crate::contacts::{floor, raw_speed, runs};
 use crate::error::{Error, Result};
 use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
@@ -37,7 +37,8 @@ fn norm(a: V3) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Horizontal facing direction from the hips: normalize((HJC_L − HJC_R) × e_z).
+/// Horizontal facing direction from the hips: normalize((HJC_L − HJC_R) × e_z); the zero
+/// vector when the hips are vertically aligned.
 pub fn facing(hip_l: V3, hip_r: V3) -> V3 {
     let d = sub(hip_l, hip_r);
     let f = [d[1], -d[0], 0.0];
@@ -45,7 +46,7 @@ pub fn facing(hip_l: V3, hip_r: V3) -> V3 {
     if n > 0.0 {
         f.map(|v| v / n)
     } else {
-        [1.0, 0.0, 0.0]
+        [0.0; 3] // hips vertical: no facing (callers fall back, stance-model §2)
     }
 }
 
@@ -62,17 +63,15 @@ fn fk_frames(skel: &Skeleton, bvh: &Bvh, skip: usize) -> Vec<V3> {
 }
 
 fn choose_toe(
-    skel: &Skeleton,
     lm: &Landmarks,
     s: Side,
     rest: &[V3],
     frames: &[&[V3]],
     fwd: &[V3],
-    min_end: f64,
 ) -> (ToeTipRule, Option<usize>) {
     let ankle = lm.limb(s).ankle;
     let rest_fwd = facing(rest[lm.left.hip], rest[lm.right.hip]);
-    for (rule, p) in lm.toe_candidates(skel, s, min_end) {
+    for (rule, p) in lm.toe_candidates(s) {
         let w = sub(rest[p], rest[ankle]);
         let rest_ok = norm(w) > 0.0 && dot(w, rest_fwd) >= TTIP_MIN_FORWARD_COS * norm(w);
         let cosines: Vec<f64> = frames
@@ -178,10 +177,9 @@ pub(super) fn run(
         .iter()
         .map(|fp| facing(fp[lm.left.hip], fp[lm.right.hip]))
         .collect();
-    let min_end = crate::skeleton::landmarks::DEGENERATE_END_SITE_FRACTION * leg_file;
     let mut toe: [Vec<V3>; 2] = Default::default();
     for (k, s) in [Side::L, Side::R].into_iter().enumerate() {
-        let (rule, p) = choose_toe(skel, lm, s, &rest, &frames, &fwd, min_end);
+        let (rule, p) = choose_toe(lm, s, &rest, &frames, &fwd);
         summary.toe_tip_rule[k] = Some(rule.as_str().to_string());
         let ankle = lm.limb(s).ankle;
         toe[k] = (0..n)
@@ -227,7 +225,11 @@ pub(super) fn run(
             com(&b, opts.sex)
         })
         .collect();
-    summary.handedness_ok = Some(handedness(&frames, lm, &toe));
+    // With fallback toe tips on both feet "forward" comes from the hips, so the check
+    // could not fail: it is not made (null).
+    let fallback = |r: &Option<String>| r.as_deref() == Some(ToeTipRule::Fallback.as_str());
+    summary.handedness_ok =
+        (!summary.toe_tip_rule.iter().all(fallback)).then(|| handedness(&frames, lm, &toe));
     if summary.handedness_ok == Some(false) {
         summary.warnings.push(
             "handedness check failed: left/right labels swapped or the file is mirrored".into(),
@@ -311,7 +313,7 @@ pub(super) fn run(
         clean(&mut flags, rate, c.min_gap_s, c.min_on_s);
         if c.static_mode {
             let (mut sflags, trig) = static_hysteresis(&tracks[e]);
-            clean(&mut sflags, rate, c.min_gap_s, STATIC_MIN_ON_S);
+            clean(&mut sflags, rate, STATIC_MIN_GAP_S, STATIC_MIN_ON_S);
             surf[e] = vec![None; n];
             for (a, b) in runs(&sflags) {
                 let p = trig[a].unwrap_or(0);

@@ -31,7 +31,7 @@ pub use contact_runs::ContactRun;
 pub const DEFAULT_MASS_KG: f64 = 70.0;
 
 /// Options of the ingest stage.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(serde::Serialize, Debug, Clone, PartialEq)]
 pub struct IngestOptions {
     /// Body mass, kg (scales forces downstream; does not move the COM).
     pub mass_kg: f64,

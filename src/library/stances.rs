@@ -61,7 +61,10 @@ fn flight_col(name: &str, rows: Vec<Option<&FlightRef>>) -> PolarsResult<Column>
     };
     let vel: ListChunked = rows
         .iter()
-        .map(|r| r.map(|f| Series::new("".into(), f.vel.to_vec())))
+        .map(|r| {
+            r.and_then(|f| f.vel)
+                .map(|v| Series::new("".into(), v.to_vec()))
+        })
         .collect();
     let fields = [
         Series::new("first_frame".into(), geti(&|f| f.first_frame)),

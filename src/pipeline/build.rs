@@ -32,7 +32,7 @@ use crate::stances::limits::{limits, ClipFacts, Limits, StanceFacts};
 use crate::stances::{build_clip, Stance, StanceOptions};
 
 /// Options of a library build.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(serde::Serialize, Debug, Clone, PartialEq, Default)]
 pub struct BuildOptions {
     /// Ingest options.
     pub ingest: IngestOptions,
@@ -41,9 +41,12 @@ pub struct BuildOptions {
 }
 
 impl BuildOptions {
-    /// The options as recorded in the manifest and the Parquet metadata.
+    /// The options as recorded in the manifest and the Parquet metadata: canonical JSON
+    /// (object keys sorted; spec stance-model §11).
     pub fn fingerprint(&self) -> String {
-        format!("{self:?}")
+        serde_json::to_value(self)
+            .map(|v| v.to_string())
+            .unwrap_or_default()
     }
 }
 
@@ -65,7 +68,7 @@ pub fn build(files: &[PathBuf], opts: &BuildOptions) -> BuildReport {
 }
 
 fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport {
-    let records = ingest_named(named, &opts.ingest);
+    let mut records = ingest_named(named, &opts.ingest);
     let bar = progress(records.len(), "clips segmented and fitted");
     let per_clip: Vec<(Vec<Stance>, Vec<String>)> = records
         .par_iter()
@@ -91,7 +94,12 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport 
             message: r.message.clone().unwrap_or_default(),
         })
         .collect();
-    for (r, (_, warnings)) in records.iter().zip(&per_clip) {
+    for (r, (_, warnings)) in records.iter_mut().zip(&per_clip) {
+        // Every stance-stage warning is kept with its clip (clips.parquet `warnings`);
+        // failed fits are also errors.
+        r.summary
+            .warnings
+            .extend(warnings.iter().map(|w| format!("stances: {w}")));
         for w in warnings.iter().filter(|w| w.contains("failed")) {
             errors.push(ErrorRow {
                 path: r.path.clone(),
@@ -183,12 +191,8 @@ fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTree
     let manifest: Option<serde_json::Value> = std::fs::read_to_string(out.join("manifest.json"))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
-    if manifest
-        .as_ref()
-        .and_then(|m| m.get("options"))
-        .and_then(|o| o.as_str())
-        != Some(fingerprint)
-    {
+    let current: Option<serde_json::Value> = serde_json::from_str(fingerprint).ok();
+    if current.is_none() || manifest.as_ref().and_then(|m| m.get("options")) != current.as_ref() {
         return BTreeSet::new();
     }
     let Ok(clips) = read_parquet(&out.join(CLIPS_FILE)) else {
@@ -408,7 +412,7 @@ fn write_tables(
     let manifest = serde_json::json!({
         "schema_version": SCHEMA_VERSION,
         "tool_version": env!("CARGO_PKG_VERSION"),
-        "options": fingerprint,
+        "options": serde_json::from_str::<serde_json::Value>(fingerprint).unwrap_or_default(),
         "inputs": inputs,
         "limits": lim,
         "counts": {

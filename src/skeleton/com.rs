@@ -37,7 +37,7 @@
 //! ```
 
 /// Which de Leva column to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(serde::Serialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Sex {
     /// Male column (default).
     #[default]

@@ -25,6 +25,10 @@ use crate::error::{Error, Result};
 
 /// An End Site shorter than this fraction of `L_leg` counts as absent (spec §4.2).
 pub const DEGENERATE_END_SITE_FRACTION: f64 = 0.02;
+/// An End Site longer than this fraction of `L_leg` counts as absent too: no hand, toe or
+/// head segment is that long. The MASS files' right hand has a 161.8-unit (1.6 m) End Site
+/// where spec §4.2 assumed 0.9 units like the left hand's.
+pub const IMPLAUSIBLE_END_SITE_FRACTION: f64 = 0.5;
 /// MET3 extrapolation beyond the wrist along the forearm (spec §4.2).
 pub const MET3_EXTRAPOLATION: f64 = 0.32;
 
@@ -80,6 +84,10 @@ pub struct Limb {
     pub ankle: usize,
     /// Toe joint, when the foot has one.
     pub toe_joint: Option<usize>,
+    /// The toe joint's "end" (live End Site or `*end` child), when it has one.
+    pub toe_end: Option<usize>,
+    /// The ankle's "end", when the ankle has no toe joint.
+    pub ankle_end: Option<usize>,
     /// Arm, when the skeleton has one on this side.
     pub arm: Option<Arm>,
 }
@@ -135,20 +143,15 @@ impl Landmarks {
 
     /// Ordered toe-tip point candidates of a foot (rows 1–3 of spec §4.3; the fallback is
     /// implicit). `min_end_len` is the degenerate End Site length in file units.
-    pub fn toe_candidates(
-        &self,
-        skel: &Skeleton,
-        s: Side,
-        min_end_len: f64,
-    ) -> Vec<(ToeTipRule, usize)> {
+    pub fn toe_candidates(&self, s: Side) -> Vec<(ToeTipRule, usize)> {
         let limb = self.limb(s);
         let mut c = Vec::new();
         if let Some(t) = limb.toe_joint {
-            if let Some(e) = live_end_site(skel, t, min_end_len) {
+            if let Some(e) = limb.toe_end {
                 c.push((ToeTipRule::ToeEnd, e));
             }
             c.push((ToeTipRule::ToeJoint, t));
-        } else if let Some(e) = live_end_site(skel, limb.ankle, min_end_len) {
+        } else if let Some(e) = limb.ankle_end {
             c.push((ToeTipRule::AnkleEnd, e));
         }
         c
@@ -192,7 +195,9 @@ fn len3(v: &[f64; 3]) -> f64 {
 /// Point index of joint `j`'s End Site when it is not degenerate.
 fn live_end_site(skel: &Skeleton, j: usize, min_len: f64) -> Option<usize> {
     let e = skel.end_sites.iter().position(|(k, _)| *k == j)?;
-    (len3(&skel.end_sites[e].1) >= min_len).then_some(skel.n_joints() + e)
+    let len = len3(&skel.end_sites[e].1);
+    let max_len = min_len * IMPLAUSIBLE_END_SITE_FRACTION / DEGENERATE_END_SITE_FRACTION;
+    (len >= min_len && len <= max_len).then_some(skel.n_joints() + e)
 }
 
 /// Result of the structural mapping.
@@ -414,11 +419,17 @@ pub fn map(
             }),
     };
     let limb = |s: Side, tag: &str, [hip, knee, ankle]: [usize; 3]| -> Result<Limb> {
+        let toe_joint = f.toe(ankle, tag)?;
         Ok(Limb {
             hip,
             knee,
             ankle,
-            toe_joint: f.toe(ankle, tag)?,
+            toe_joint,
+            toe_end: toe_joint.and_then(|t| f.end_of(t, min_len)),
+            ankle_end: toe_joint
+                .is_none()
+                .then(|| f.end_of(ankle, min_len))
+                .flatten(),
             arm: f.arm(s, tag, min_len)?,
         })
     };

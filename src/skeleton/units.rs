@@ -93,7 +93,7 @@ pub fn detect_unit(leg_file: f64) -> (Unit, Option<String>) {
 }
 
 /// A signed file axis that points up.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(serde::Serialize, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum UpAxis {
     /// +X up.
     PosX,

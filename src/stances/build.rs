@@ -19,7 +19,7 @@ use crate::math::stats::median;
 type V3 = [f64; 3];
 
 /// Options of the stance stage.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(serde::Serialize, Debug, Clone, PartialEq, Default)]
 pub struct StanceOptions {
     /// Force-model fit (Stage A).
     pub fit: FitOptions,
@@ -41,10 +41,17 @@ impl Splines {
     }
 }
 
+/// The effectors that support a stance: a walking stance's single-support foot only
+/// (stance-model §1 step 4, §8.1); otherwise every effector in contact on some frame.
+fn supporting(seg: &Segment, contact: &[Vec<bool>; 4]) -> [bool; 4] {
+    match seg.walking_foot {
+        Some(f) => std::array::from_fn(|e| e == f),
+        None => std::array::from_fn(|e| (seg.i0..=seg.i1).any(|k| contact[e][k])),
+    }
+}
+
 fn label(seg: &Segment, contact: &[Vec<bool>; 4]) -> (String, Vec<String>) {
-    let used: Vec<bool> = (0..4)
-        .map(|e| (seg.i0..=seg.i1).any(|k| contact[e][k]))
-        .collect();
+    let used = supporting(seg, contact);
     let effectors: Vec<String> = {
         let mut v: Vec<String> = (0..4)
             .filter(|&e| used[e])
@@ -81,11 +88,12 @@ fn label(seg: &Segment, contact: &[Vec<bool>; 4]) -> (String, Vec<String>) {
 /// Mean ground point of the effectors in contact, over the stance frames (spec §8.1):
 /// a foot is the ankle–toe-tip midpoint, a hand its wrist.
 fn contact_point(seg: &Segment, fr: &ClipFrames) -> Option<V3> {
+    let support = supporting(seg, &fr.contact);
     let mut acc = [0.0; 3];
     let mut n = 0.0;
     for k in seg.i0..=seg.i1 {
         let mut pts: Vec<V3> = Vec::new();
-        for e in 0..4 {
+        for (e, _) in support.iter().enumerate().filter(|(_, s)| **s) {
             if !fr.contact[e][k] {
                 continue;
             }
@@ -109,16 +117,46 @@ fn contact_point(seg: &Segment, fr: &ClipFrames) -> Option<V3> {
     (n > 0.0).then(|| acc.map(|v| v / n))
 }
 
-fn flight_ref(f: &Flight, t: f64) -> Option<FlightRef> {
-    let fit = f.fit.as_ref()?;
-    Some(FlightRef {
+/// The adjacent flight of a `flight` boundary; without a fit (`n_int < 2`) its curvature
+/// is the mean SG acceleration `ā_z` and its velocity is null.
+fn flight_ref(f: &Flight, t: f64) -> FlightRef {
+    FlightRef {
         first_frame: f.first_frame,
         last_frame: f.last_frame,
         n_int: (f.last_frame - f.first_frame - 3).max(0),
         free: f.tested,
-        a_z: fit.axes[2].curvature(),
-        vel: fit.velocity(t),
-    })
+        a_z: f
+            .fit
+            .as_ref()
+            .map(|fit| fit.axes[2].curvature())
+            .or(f.a_z_mean)
+            .unwrap_or(f64::NAN),
+        vel: f.fit.as_ref().map(|fit| fit.velocity(t)),
+    }
+}
+
+/// `fit_rms` of a refitted model (spec §11): RMS over the Stage A samples (taken in the
+/// frame `r_a`, rotated into the model's frame `r_b`) of sample − model.
+fn set_fit_rms(model: &mut ForceModel, samples: &[Vec<f64>; 3], r_a: [V3; 3], r_b: [V3; 3]) {
+    let n = samples[0].len();
+    if n == 0 {
+        return;
+    }
+    let mut ss = [0.0; 3];
+    #[allow(clippy::needless_range_loop)] // j indexes three parallel sample columns
+    for j in 0..n {
+        let s_a: V3 = std::array::from_fn(|a| samples[a][j]);
+        // world = R_aᵀ s_a, then s_b = R_b · world
+        let world: V3 = std::array::from_fn(|i| (0..3).map(|a| r_a[a][i] * s_a[a]).sum());
+        let tau = j as f64 / n as f64;
+        for (b, acc) in ss.iter_mut().enumerate() {
+            let s_b: f64 = (0..3).map(|i| r_b[b][i] * world[i]).sum();
+            *acc += (s_b - model.axes[b].eval(tau)).powi(2);
+        }
+    }
+    for (axis, acc) in model.axes.iter_mut().zip(ss) {
+        axis.fit_rms = (acc / n as f64).sqrt();
+    }
 }
 
 /// The inputs of one stance's Stage B refit (spec §4.2).
@@ -251,7 +289,11 @@ pub fn build_clip(
         };
         let dt_s = t_lo - t_td;
         let (mut p_td, mut v_td) = (pos.at(t_td), vel.at(t_td));
-        let mut h: Heading = heading(v_td, fr.facing[seg.i0], previous);
+        let facing_td: V3 = match seg.i0 {
+            0 => fr.facing[0],
+            i => std::array::from_fn(|a| 0.5 * (fr.facing[i - 1][a] + fr.facing[i][a])),
+        };
+        let mut h: Heading = heading(v_td, facing_td, previous);
         let z_c = median(&fr.ground_z[seg.i0..=seg.i1]).unwrap_or(0.0);
         let (label, effectors) = label(&seg, &fr.contact);
         let mut model = match fit_stage_a(
@@ -290,8 +332,10 @@ pub fn build_clip(
             match refit {
                 Ok(fit) if fit.condition <= MAX_CONDITION => {
                     (p_td, v_td) = (fit.p_td, fit.v_td);
-                    h = heading(v_td, fr.facing[seg.i0], previous);
+                    let r_a = h.rotation();
+                    h = heading(v_td, facing_td, previous);
                     model = to_stance_model(&fit, h.rotation(), mass_kg, dt_s);
+                    set_fit_rms(&mut model, ws.last_samples(), r_a, h.rotation());
                     (stage, fit_pos_rms_m) = ("B", Some(fit.pos_rms_m));
                 }
                 Ok(fit) => sw.push(format!(
@@ -340,11 +384,11 @@ pub fn build_clip(
                     .find(|f| f.last_frame == frame0 + seg.i0 as i64 - 1)
             })
             .flatten()
-            .and_then(|f| flight_ref(f, t_td));
+            .map(|f| flight_ref(f, t_td));
         let after = (seg.end == Boundary::Flight)
             .then(|| flight_at(seg.i1 + 1))
             .flatten()
-            .and_then(|f| flight_ref(f, t_lo));
+            .map(|f| flight_ref(f, t_lo));
         out.push(Stance {
             stance_id: format!("{clip}:{label}:{}", fr.frame[seg.i0]),
             clip: clip.to_string(),

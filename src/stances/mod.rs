@@ -31,10 +31,11 @@ pub struct FlightRef {
     pub n_int: i64,
     /// Free-curvature fit (`n_int ≥ 4`).
     pub free: bool,
-    /// Fitted or fixed vertical curvature, m/s².
+    /// Fitted or fixed vertical curvature, or `ā_z` without a fit, m/s².
     pub a_z: f64,
-    /// The fit's velocity at this stance's touchdown (before) or liftoff (after), world m/s.
-    pub vel: [f64; 3],
+    /// The fit's velocity at this stance's touchdown (before) or liftoff (after), world m/s;
+    /// `None` when the flight is too short to fit (`n_int < 2`).
+    pub vel: Option<[f64; 3]>,
 }
 
 /// One stance: everything a `stances.parquet` row holds.

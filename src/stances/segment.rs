@@ -28,8 +28,9 @@ pub const T_QUIET_S: f64 = 0.3;
 pub const T_SINGLE_S: f64 = 0.1;
 /// Minimum stance length, frames.
 pub const MIN_STANCE_FRAMES: usize = 3;
-/// Tolerance on durations measured in whole frames, s.
-const DURATION_TOL_S: f64 = 1e-9;
+/// Tolerance on durations measured in whole frames, s: frame times are printed rounded
+/// (12 × 0.008333 s = 0.099996 s is 0.1 s), as for airborne intervals (com-from-bvh §7.7).
+const DURATION_TOL_S: f64 = 1e-4;
 
 /// What lies at one end of a stance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

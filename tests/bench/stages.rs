@@ -15,28 +15,46 @@
 //! - `fk_com`: parsed channels in memory → every joint and End Site (`fk::forward`),
 //!   each point to Z-up metres `(x, −z, y)·0.056444`, the toe tips, contact points (toe
 //!   tip and ankle) and the de Leva COM (`com::com`), per frame (throughput in frames).
-//!   Target: floor 0.5 M frames/s per core, goal 1.5 M. `fk_only`, `units_com_only`,
-//!   `trig_only` (libm `sin_cos` per rotation channel) and `trig_only_poly` split the cost
-//!   for diagnosis; `full_proposal_batched_trig` is `full` with the FK change proposed
-//!   below (module `proposal`, checked against `fk::forward` first).
+//!   Target: floor 0.5 M frames/s per core, goal 1.5 M. Diagnosis: `fk_only`,
+//!   `units_com_only` (given the points), `trig_only` (libm `sin_cos`, one per rotation
+//!   channel) and `trig_only_poly` (`proposal::sincos_deg`, scalar) split the cost;
+//!   `full_proposal_*` are `full` with the FK changes prototyped in module `proposal`
+//!   (cumulative; each is checked against `fk::forward` before it is timed).
 //! - `ingest`: `ingest::ingest` of the whole clip (lead-in, units, FK, COM, SG filter,
 //!   floors, contacts, flights), frames/s.
 //!
 //! # Results
-//! 2026-11-29, 2-core x86_64 sandbox (shared, noisy; single-threaded benches),
-//! rustc release profile (`debug = 1`), criterion 0.5 (no plots):
+//! 2026-11-29, 2-core x86_64 sandbox (KVM, Xeon with AVX2/FMA/AVX-512; shared and noisy,
+//! ±10 % between runs), release profile, criterion 0.5, cmu_01_01 (2752 frames):
 //!
 //! ```text
-//! parse/parse_reader                    5.05 ms   391 MiB/s
-//! parse/baseline_split_parse            4.79 ms   412 MiB/s   (parse_reader = 1.05× baseline)
-//! fk_com/full                           3.60 ms   765 k frames/s   (floor 0.5 M, goal 1.5 M)
-//! fk_com/fk_only                        3.45 ms   798 k frames/s
-//! fk_com/units_com_only                 0.22 ms   12.4 M frames/s
-//! fk_com/trig_only                      1.84 ms   1.50 M frames/s  (libm sin_cos, 93 per frame)
-//! fk_com/trig_only_poly                 2.51 ms   1.10 M frames/s
-//! fk_com/full_proposal_batched_trig     4.68 ms   587 k frames/s   (slower: not adopted)
-//! ingest/ingest                         5.96 ms   461 k frames/s   (whole clip, all stages)
+//! parse/parse_reader                      4.95 ms    399 MiB/s
+//! parse/baseline_split_parse              3.89 ms    508 MiB/s   parse_reader 1.27× slower
+//!                                                               (1.35× in a second run): < 2×
+//! fk_com/full                             3.68 ms    748 k frames/s   floor 0.5 M met, goal 1.5 M not
+//! fk_com/fk_only                          3.40 ms    809 k frames/s   FK is 92 % of `full`
+//! fk_com/units_com_only                   0.21 ms   13.0 M frames/s
+//! fk_com/trig_only                        1.80 ms   1.53 M frames/s   93 libm sin_cos a frame:
+//!                                                                     half of FK
+//! fk_com/trig_only_poly                   2.35 ms   1.17 M frames/s   scalar polynomial: no gain
+//! fk_com/full_proposal_1_const_axis       2.92 ms    942 k frames/s   +26 %
+//! fk_com/full_proposal_2_batched_trig     1.87 ms   1.47 M frames/s   +97 % (AVX2+FMA batch)
+//! fk_com/full_proposal_3_padded_avx2      2.41 ms   1.14 M frames/s   whole FK as AVX2: worse than 2
+//! fk_com/full_proposal_4_four_frames_per_lane
+//!                                         1.57 ms   1.76 M frames/s   goal met
+//! ingest/ingest                           5.91 ms    466 k frames/s   whole clip, every stage
 //! ```
+//! `perf` of `full`: 52 % in `fk::forward` itself, 39 % in glibc `__sincos_fma`, 3 % in
+//! `com::com`. Inside `fk::forward` the hot spots are the reloads of the rotation matrix
+//! that `rotate_right` keeps on the stack: it indexes columns with the runtime pair
+//! `(a, b)` from `match axis`, so the matrix cannot live in registers, and its 8-byte
+//! stores followed by 16-byte loads defeat store-to-load forwarding (≈ 30 % of the
+//! function's samples on two loads). Variant 1 fixes only that (const-generic column
+//! indices per axis arm); variant 2 adds one branch-free, vectorisable sin/cos pass over
+//! the frame's 93 angles (`sincos_deg`, exact reduction by 90°, Taylor 15/16, ≤ 4e-16
+//! from libm) compiled for AVX2+FMA behind a runtime check; variant 4 runs four frames
+//! per call, one per SIMD lane. Building each local rotation off the dependency chain and
+//! then one `parent · local` product was 15–20 % slower than variant 1 and was dropped.
 
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -393,28 +411,30 @@ fn bench_fk_com(c: &mut Criterion) {
     });
     // The proposed changes (module `proposal`), cumulatively, each checked against
     // `fk::forward` before it is timed.
-    type Fk = fn(&Skeleton, &mut proposal::FlatFk, &[f64], &mut [[f64; 3]]);
-    let variants: [(&str, Fk); 3] = [
-        (
-            "full_proposal_1_const_axis",
-            proposal::forward::<false, false>,
-        ),
-        (
-            "full_proposal_2_local_product",
-            proposal::forward::<false, true>,
-        ),
-        (
-            "full_proposal_3_batched_trig",
-            proposal::forward::<true, true>,
-        ),
-    ];
     let mut flat = proposal::FlatFk::new(&p.skel);
+    let mut padded = proposal::Padded::new(&p.skel);
+    type Fk = fn(&Skeleton, &mut proposal::FlatFk, &mut proposal::Padded, &[f64], &mut [[f64; 3]]);
+    let variants: [(&str, Fk); 3] = [
+        ("full_proposal_1_const_axis", |s, w, _, r, p| {
+            proposal::forward::<false>(s, w, r, p)
+        }),
+        ("full_proposal_2_batched_trig", |s, w, _, r, p| {
+            proposal::forward::<true>(s, w, r, p)
+        }),
+        ("full_proposal_3_padded_avx2", proposal::forward_padded),
+    ];
     let mut pts2 = pts.clone();
     for (name, fwd) in variants {
         let mut worst: f64 = 0.0;
         for f in 0..n {
             fk::forward(&p.skel, &mut ws, p.bvh.motion.row(f), &mut pts);
-            fwd(&p.skel, &mut flat, p.bvh.motion.row(f), &mut pts2);
+            fwd(
+                &p.skel,
+                &mut flat,
+                &mut padded,
+                p.bvh.motion.row(f),
+                &mut pts2,
+            );
             for (a, b) in pts.iter().zip(&pts2) {
                 worst = (0..3).fold(worst, |w, k| w.max((a[k] - b[k]).abs()));
             }
@@ -427,7 +447,7 @@ fn bench_fk_com(c: &mut Criterion) {
                 out.clear();
                 contacts.clear();
                 for f in 0..n {
-                    fwd(&p.skel, &mut flat, m.row(f), &mut pts);
+                    fwd(&p.skel, &mut flat, &mut padded, m.row(f), &mut pts);
                     out.push(units_com(&p, &pts, &mut pts_m));
                     contacts.push(contact_points(&p, &pts_m));
                 }
@@ -435,6 +455,66 @@ fn bench_fk_com(c: &mut Criterion) {
             })
         });
     }
+    // Variant 4: four frames per call (the tail, n mod 4 frames, through `fk::forward`).
+    let mut x4 = proposal::X4::new(&p.skel, &flat);
+    let mut quad = vec![vec![[0.0; 3]; np]; 4];
+    let (mut ws4, mut pts4, mut pts4_m) = (FkWorkspace::new(&p.skel), pts.clone(), pts_m.clone());
+    let mut fk_com_x4 = |out: &mut Vec<[f64; 3]>, contacts: &mut Vec<[[f64; 3]; 4]>| {
+        let m = &p.bvh.motion;
+        out.clear();
+        contacts.clear();
+        let mut f = 0;
+        while f + 4 <= n {
+            let [q0, q1, q2, q3] = &mut quad[..] else {
+                unreachable!()
+            };
+            let rows = [m.row(f), m.row(f + 1), m.row(f + 2), m.row(f + 3)];
+            proposal::forward_x4(&p.skel, &flat, &mut x4, rows, [q0, q1, q2, q3]);
+            for q in &quad {
+                out.push(units_com(&p, q, &mut pts4_m));
+                contacts.push(contact_points(&p, &pts4_m));
+            }
+            f += 4;
+        }
+        for f in f..n {
+            fk::forward(&p.skel, &mut ws4, m.row(f), &mut pts4);
+            out.push(units_com(&p, &pts4, &mut pts4_m));
+            contacts.push(contact_points(&p, &pts4_m));
+        }
+    };
+    let (mut out2, mut contacts2) = (Vec::new(), Vec::new());
+    fk_com_x4(&mut out2, &mut contacts2);
+    fk_com_all(&p, &mut ws, &mut pts, &mut pts_m, &mut out, &mut contacts);
+    let flat_pts = |o: &[[f64; 3]], c: &[[[f64; 3]; 4]]| -> Vec<f64> {
+        o.iter()
+            .flatten()
+            .chain(c.iter().flatten().flatten())
+            .copied()
+            .collect()
+    };
+    let (a, b) = (flat_pts(&out, &contacts), flat_pts(&out2, &contacts2));
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "fk_com: full_proposal_4_four_frames_per_lane vs fk::forward: \
+         largest COM or contact point difference {worst:.1e} m"
+    );
+    assert!(
+        a.len() == b.len() && worst < 1e-9,
+        "variant 4 disagrees with fk::forward by {worst}"
+    );
+    g.bench_function(
+        BenchmarkId::new("full_proposal_4_four_frames_per_lane", &label),
+        |b| {
+            b.iter(|| {
+                fk_com_x4(&mut out2, &mut contacts2);
+                black_box((&out2, &contacts2));
+            })
+        },
+    );
     let rot_idx: Vec<usize> = p
         .skel
         .channels
@@ -606,22 +686,15 @@ mod proposal {
         }
     }
 
-    /// `a · b` for column-stored matrices.
-    #[inline(always)]
-    fn mul_mat(a: &Mat3, b: &Mat3) -> Mat3 {
-        [mul_vec(a, &b[0]), mul_vec(a, &b[1]), mul_vec(a, &b[2])]
-    }
-
-    /// Same output as `fk::forward` (to rounding). Changes, each switchable:
-    /// - always: constant column indices in the per-channel rotation (`rotate_right_sc`);
+    /// Same output as `fk::forward` (to rounding). Changes:
+    /// - constant column indices in the per-channel rotation (`rotate_right_sc`);
     /// - `BATCH`: one batched sin/cos pass over the frame's rotation channels
-    ///   (`sincos_all`) instead of one libm `sin_cos` call per channel;
-    /// - `LOCAL`: the local rotation is built from its channels alone, which does not wait
-    ///   for the parent, and the world rotation is one `parent · local` product, so the
-    ///   parent-to-child dependency chain is one 3×3 product per joint instead of one
-    ///   column mix per channel; a joint whose angles are all 0 in this frame takes its
-    ///   parent's rotation without a product.
-    pub fn forward<const BATCH: bool, const LOCAL: bool>(
+    ///   (`sincos_all`) instead of one libm `sin_cos` call per channel.
+    ///
+    /// (Also tried and dropped: building each joint's local rotation first, off the
+    /// parent-to-child dependency chain, then one `parent · local` product. It was 15–20 %
+    /// slower than mixing the parent's columns in place: 27 multiply-adds instead of 18.)
+    pub fn forward<const BATCH: bool>(
         skel: &Skeleton,
         w: &mut FlatFk,
         row: &[f64],
@@ -660,23 +733,10 @@ mod proposal {
                     (rp, [pp[0] + d[0], pp[1] + d[1], pp[2] + d[2]])
                 }
             };
-            let r = if LOCAL {
-                if w.angles[k0..k1].iter().all(|&a| a == 0.0) {
-                    rp
-                } else {
-                    let mut local = IDENTITY;
-                    for k in k0..k1 {
-                        rotate_right_sc(&mut local, w.rot_axis[k], w.sin[k], w.cos[k]);
-                    }
-                    mul_mat(&rp, &local)
-                }
-            } else {
-                let mut r = rp;
-                for k in k0..k1 {
-                    rotate_right_sc(&mut r, w.rot_axis[k], w.sin[k], w.cos[k]);
-                }
-                r
-            };
+            let mut r = rp;
+            for k in k0..k1 {
+                rotate_right_sc(&mut r, w.rot_axis[k], w.sin[k], w.cos[k]);
+            }
             w.rot[j] = r;
             points[j] = p;
         }
@@ -686,6 +746,295 @@ mod proposal {
             let p = points[*j];
             points[nj + e] = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
         }
+    }
+    /// A column padded to 4 lanes (one AVX register).
+    type Col = [f64; 4];
+    /// A rotation as three padded columns.
+    type M4 = [Col; 3];
+    const I4: M4 = [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+    ];
+
+    #[inline(always)]
+    fn lin2(a: f64, x: &Col, b: f64, y: &Col) -> Col {
+        std::array::from_fn(|r| a * x[r] + b * y[r])
+    }
+
+    #[inline(always)]
+    fn mul_vec4(m: &M4, v: &Col) -> Col {
+        std::array::from_fn(|r| m[0][r] * v[0] + m[1][r] * v[1] + m[2][r] * v[2])
+    }
+
+    #[inline(always)]
+    fn rotate4(m: &mut M4, axis: u8, s: f64, c: f64) {
+        #[inline(always)]
+        fn mix<const A: usize, const B: usize>(m: &mut M4, s: f64, c: f64) {
+            let (ca, cb) = (m[A], m[B]);
+            m[A] = lin2(c, &ca, s, &cb);
+            m[B] = lin2(-s, &ca, c, &cb);
+        }
+        match axis {
+            0 => mix::<1, 2>(m, s, c),
+            1 => mix::<2, 0>(m, s, c),
+            _ => mix::<0, 1>(m, s, c),
+        }
+    }
+
+    /// Scratch of [`forward_padded`]: world rotation and position per joint, padded.
+    pub struct Padded {
+        rot: Vec<M4>,
+        pos: Vec<Col>,
+    }
+
+    impl Padded {
+        pub fn new(skel: &Skeleton) -> Padded {
+            Padded {
+                rot: vec![I4; skel.n_joints()],
+                pos: vec![[0.0; 4]; skel.n_joints()],
+            }
+        }
+    }
+
+    #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // `j` indexes seven parallel arrays
+    fn forward_padded_body(
+        skel: &Skeleton,
+        w: &mut FlatFk,
+        pd: &mut Padded,
+        row: &[f64],
+        points: &mut [[f64; 3]],
+    ) {
+        for (a, &i) in w.angles.iter_mut().zip(&w.rot_idx) {
+            *a = row[i];
+        }
+        sincos_all_body(&w.angles, &mut w.sin, &mut w.cos);
+        for j in 0..skel.n_joints() {
+            let ch = &skel.channels[j];
+            let off = skel.offsets[j];
+            let t: Col = match ch.mode {
+                TranslationMode::Offset => [off[0], off[1], off[2], 0.0],
+                TranslationMode::Replace => std::array::from_fn(|a| {
+                    if a < 3 {
+                        ch.translations[a].map_or(off[a], |i| row[i])
+                    } else {
+                        0.0
+                    }
+                }),
+                TranslationMode::Delta => std::array::from_fn(|a| {
+                    if a < 3 {
+                        off[a] + ch.translations[a].map_or(0.0, |i| row[i])
+                    } else {
+                        0.0
+                    }
+                }),
+            };
+            let (k0, k1) = w.joint_rot[j];
+            let (rp, p) = match skel.parents[j] {
+                None => (I4, t),
+                Some(pj) => {
+                    let rp = pd.rot[pj];
+                    let d = mul_vec4(&rp, &t);
+                    let pp = pd.pos[pj];
+                    (rp, std::array::from_fn(|r| pp[r] + d[r]))
+                }
+            };
+            let mut r = rp;
+            for k in k0..k1 {
+                rotate4(&mut r, w.rot_axis[k], w.sin[k], w.cos[k]);
+            }
+            pd.rot[j] = r;
+            pd.pos[j] = p;
+            points[j] = [p[0], p[1], p[2]];
+        }
+        let nj = skel.n_joints();
+        for (e, (j, off)) in skel.end_sites.iter().enumerate() {
+            let d = mul_vec4(&pd.rot[*j], &[off[0], off[1], off[2], 0.0]);
+            let p = pd.pos[*j];
+            points[nj + e] = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn forward_padded_avx2(
+        skel: &Skeleton,
+        w: &mut FlatFk,
+        pd: &mut Padded,
+        row: &[f64],
+        points: &mut [[f64; 3]],
+    ) {
+        forward_padded_body(skel, w, pd, row, points)
+    }
+
+    /// Variant 3: batched trig, and the whole FK compiled for AVX2 + FMA (runtime check)
+    /// with rotations and positions kept as 4-lane padded columns, so that every column
+    /// is one register, loaded and stored whole (no split stores that a child's load
+    /// cannot forward from).
+    pub fn forward_padded(
+        skel: &Skeleton,
+        w: &mut FlatFk,
+        pd: &mut Padded,
+        row: &[f64],
+        points: &mut [[f64; 3]],
+    ) {
+        assert!(row.len() >= skel.n_channels && points.len() >= skel.n_points());
+        #[cfg(target_arch = "x86_64")]
+        if w.avx2 {
+            // SAFETY: `avx2` is true only when the CPU reports AVX2 and FMA (`FlatFk::new`).
+            return unsafe { forward_padded_avx2(skel, w, pd, row, points) };
+        }
+        forward_padded_body(skel, w, pd, row, points)
+    }
+    /// One value for each of 4 frames (one AVX register).
+    type Lanes = [f64; 4];
+
+    #[inline(always)]
+    fn lanes(f: impl FnMut(usize) -> f64) -> Lanes {
+        std::array::from_fn(f)
+    }
+
+    /// Scratch of [`forward_x4`]: per joint, world rotation (`rot[j][col][row]`) and
+    /// position (`pos[j][axis]`) of 4 frames at once; sines and cosines per channel.
+    pub struct X4 {
+        rot: Vec<[[Lanes; 3]; 3]>,
+        pos: Vec<[Lanes; 3]>,
+        sin: Vec<Lanes>,
+        cos: Vec<Lanes>,
+    }
+
+    impl X4 {
+        pub fn new(skel: &Skeleton, w: &FlatFk) -> X4 {
+            let nj = skel.n_joints();
+            let nr = w.rot_idx.len();
+            X4 {
+                rot: vec![[[[0.0; 4]; 3]; 3]; nj],
+                pos: vec![[[0.0; 4]; 3]; nj],
+                sin: vec![[0.0; 4]; nr],
+                cos: vec![[0.0; 4]; nr],
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn mul_vec_x4(m: &[[Lanes; 3]; 3], v: &[Lanes; 3]) -> [Lanes; 3] {
+        std::array::from_fn(|r| {
+            lanes(|l| m[0][r][l] * v[0][l] + m[1][r][l] * v[1][l] + m[2][r][l] * v[2][l])
+        })
+    }
+
+    #[inline(always)]
+    fn rotate_x4(m: &mut [[Lanes; 3]; 3], axis: u8, s: &Lanes, c: &Lanes) {
+        #[inline(always)]
+        fn mix<const A: usize, const B: usize>(m: &mut [[Lanes; 3]; 3], s: &Lanes, c: &Lanes) {
+            let (ca, cb) = (m[A], m[B]);
+            m[A] = std::array::from_fn(|r| lanes(|l| c[l] * ca[r][l] + s[l] * cb[r][l]));
+            m[B] = std::array::from_fn(|r| lanes(|l| c[l] * cb[r][l] - s[l] * ca[r][l]));
+        }
+        match axis {
+            0 => mix::<1, 2>(m, s, c),
+            1 => mix::<2, 0>(m, s, c),
+            _ => mix::<0, 1>(m, s, c),
+        }
+    }
+
+    #[inline(always)]
+    fn forward_x4_body(
+        skel: &Skeleton,
+        w: &FlatFk,
+        x: &mut X4,
+        rows: [&[f64]; 4],
+        points: [&mut [[f64; 3]]; 4],
+    ) {
+        for (k, &i) in w.rot_idx.iter().enumerate() {
+            let a = lanes(|l| rows[l][i]);
+            let sc: [(f64, f64); 4] = std::array::from_fn(|l| sincos_deg(a[l]));
+            x.sin[k] = lanes(|l| sc[l].0);
+            x.cos[k] = lanes(|l| sc[l].1);
+        }
+        let one = [1.0; 4];
+        let zero = [0.0; 4];
+        let ident = [[one, zero, zero], [zero, one, zero], [zero, zero, one]];
+        for j in 0..skel.n_joints() {
+            let ch = &skel.channels[j];
+            let off = skel.offsets[j];
+            let t: [Lanes; 3] = match ch.mode {
+                TranslationMode::Offset => off.map(|v| [v; 4]),
+                TranslationMode::Replace => std::array::from_fn(|a| match ch.translations[a] {
+                    Some(i) => lanes(|l| rows[l][i]),
+                    None => [off[a]; 4],
+                }),
+                TranslationMode::Delta => std::array::from_fn(|a| match ch.translations[a] {
+                    Some(i) => lanes(|l| off[a] + rows[l][i]),
+                    None => [off[a]; 4],
+                }),
+            };
+            let (mut r, p) = match skel.parents[j] {
+                None => (ident, t),
+                Some(pj) => {
+                    let rp = x.rot[pj];
+                    let d = mul_vec_x4(&rp, &t);
+                    let pp = x.pos[pj];
+                    (rp, std::array::from_fn(|a| lanes(|l| pp[a][l] + d[a][l])))
+                }
+            };
+            let (k0, k1) = w.joint_rot[j];
+            for k in k0..k1 {
+                rotate_x4(&mut r, w.rot_axis[k], &x.sin[k], &x.cos[k]);
+            }
+            x.rot[j] = r;
+            x.pos[j] = p;
+        }
+        let nj = skel.n_joints();
+        let [p0, p1, p2, p3] = points;
+        let mut outs = [p0, p1, p2, p3];
+        for j in 0..nj {
+            let p = x.pos[j];
+            for (l, o) in outs.iter_mut().enumerate() {
+                o[j] = [p[0][l], p[1][l], p[2][l]];
+            }
+        }
+        for (e, (j, off)) in skel.end_sites.iter().enumerate() {
+            let d = mul_vec_x4(&x.rot[*j], &off.map(|v| [v; 4]));
+            let p = x.pos[*j];
+            for (l, o) in outs.iter_mut().enumerate() {
+                o[nj + e] = [p[0][l] + d[0][l], p[1][l] + d[1][l], p[2][l] + d[2][l]];
+            }
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn forward_x4_avx2(
+        skel: &Skeleton,
+        w: &FlatFk,
+        x: &mut X4,
+        rows: [&[f64]; 4],
+        points: [&mut [[f64; 3]]; 4],
+    ) {
+        forward_x4_body(skel, w, x, rows, points)
+    }
+
+    /// Variant 4: four frames at once, one frame per SIMD lane (AVX2 + FMA when the CPU
+    /// has them): every scalar of `fk::forward` becomes 4 lanes, so trig, column mixes
+    /// and products all run 4-wide with no shuffles, and the parent-to-child latency is
+    /// shared by 4 frames.
+    pub fn forward_x4(
+        skel: &Skeleton,
+        w: &FlatFk,
+        x: &mut X4,
+        rows: [&[f64]; 4],
+        points: [&mut [[f64; 3]]; 4],
+    ) {
+        assert!(rows.iter().all(|r| r.len() >= skel.n_channels));
+        assert!(points.iter().all(|p| p.len() >= skel.n_points()));
+        #[cfg(target_arch = "x86_64")]
+        if w.avx2 {
+            // SAFETY: `avx2` is true only when the CPU reports AVX2 and FMA (`FlatFk::new`).
+            return unsafe { forward_x4_avx2(skel, w, x, rows, points) };
+        }
+        forward_x4_body(skel, w, x, rows, points)
     }
 }
 
