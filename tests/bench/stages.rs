@@ -44,6 +44,17 @@
 //!                                         1.57 ms   1.76 M frames/s   goal met
 //! ingest/ingest                           5.91 ms    466 k frames/s   whole clip, every stage
 //! ```
+//!
+//! After `fk::rotate_right` took proposal 1 (constant column indices), same machine:
+//!
+//! ```text
+//! fk_com/full                             3.23 ms    852 k frames/s   +14 %
+//! fk_com/fk_only                          2.97 ms    925 k frames/s
+//! ingest/ingest                           5.48 ms    502 k frames/s
+//! parse/parse_reader                      4.96 ms    398 MiB/s  (baseline 504 MiB/s: 1.27×)
+//! ```
+//! Proposals 2 and 4 (AVX2 batched sin/cos, four frames per lane) reach the 1.5 M goal but
+//! add a runtime-dispatched SIMD path; not adopted yet.
 //! `perf` of `full`: 52 % in `fk::forward` itself, 39 % in glibc `__sincos_fma`, 3 % in
 //! `com::com`. Inside `fk::forward` the hot spots are the reloads of the rotation matrix
 //! that `rotate_right` keeps on the stack: it indexes columns with the runtime pair
