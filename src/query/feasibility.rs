@@ -1,0 +1,424 @@
+//! Feasibility of a scaled stance: the O(1) filters, the exact sampled check and the
+//! closed-form contact point (spec stance-model §7.1–7.5, §8.2–8.3).
+//!
+//! # Model
+//!
+//! A query scales the stance's applied force per axis, `f̃_a(τ) = β_a f_a(τ)`. On the grid
+//! `τ_k` of §4.3 the exact check ([`exact`]) computes
+//!
+//! ```text
+//! F_peak  = max_k √(Σ_a β_a² f_a(τ_k)²)                                           (N)
+//! μ_req   = max_{T_act} √(β_h² f_h² + β_p² f_p²) / (β_v f_v)                      (–)
+//! T_act   = {τ_k : f_v(τ_k) ≥ λ_act · max_k f_v},  λ_act = 0.05 (β_v > 0 scales both sides)
+//! ext(τ)  = |U(τ) + β∘S(τ)|,  ext_min = min_k ext,  ext_max = max_k ext            (m)
+//! U_h = vs Δt τ − cp_h,  U_p = vps Δt τ − cp_p,  U_v = −g t_TD Δt τ − ½ g Δt² τ² + z_TD
+//! ```
+//!
+//! and a candidate is feasible iff (every comparison `≤`, so the identity query at its own
+//! extremes is feasible):
+//!
+//! ```text
+//! (5) β_a ≥ 0   (6) F_peak ≤ F_max   (7) μ_req ≤ μ and f_v ≥ −0.05 max f_v on all of [0, 1]
+//! (8) χ_min ≤ ext_min,  ext_max ≤ χ_max
+//! ```
+//!
+//! The fast filter ([`approx`]) is eq 10 and eq 12 on the stored `A^F`, `A^μ`; it never
+//! accepts what eq 6 and eq 7 reject (a max of sums is at most the sum of maxes).
+//!
+//! The contact point ([`contact_point`]) minimises `|H(u) − H_des|` with `H(u) = A u + b`
+//! affine in `u = (cp_h, cp_p)` (§8.2), `W = I`:
+//!
+//! ```text
+//! I    = m β∘J                                           (N·s)
+//! R_ab = ∫₀¹ r_a(β, τ) f_b(τ) dτ = ℓ1_a T1_b + ℓ2_a T2_b + β_a Q_ab                 (m·N)
+//! H_0  = Δt (β_v R_pv − β_p R_vp,  β_h R_vh − β_v R_hv,  β_p R_hp − β_h R_ph)        (N·m·s)
+//! b    = (0, 0, −z_TD) × I − H_0,   A = [[0, I_v], [−I_v, 0], [I_p, −I_h]]
+//! u*   = (AᵀA)⁻¹ Aᵀ (H_des − b)                                                      (m)
+//! ℓ1 = (vs Δt, vps Δt, −g t_TD Δt),  ℓ2 = (0, 0, −½ g Δt²),  T1_b = ∫τ f_b,  T2_b = ∫τ² f_b,
+//! Q_ab = ∫ S_a f_b
+//! ```
+//!
+//! `Q`, `T1`, `T2` and `m J` depend on the stance only ([`ImpulseMoments`], built once), so
+//! a query's `u*` costs O(1) and no trigonometry.
+//!
+//! # Frames and units
+//!
+//! Stance frame (h, p, v), origin at the COM at touchdown; SI units (m, s, kg, N); β and μ
+//! dimensionless.
+//!
+//! # References
+//!
+//! Pollard & Behmaram-Mosavat 2000, eq 5–12; spec stance-model §7.1–7.5 (active set,
+//! unilateral test, limits), §8.2–8.3 (contact point), CORRECTIONS Issue 4 items 6–7.
+//!
+//! # Examples
+//!
+//! ```
+//! use stancelib::constraints::{precompute, SampledTables, StanceContext};
+//! use stancelib::force_model::{AxisModel, ForceModel, GRAVITY};
+//! use stancelib::query::feasibility::{approx, exact, relative_limits};
+//!
+//! let bell = 2.0 * 70.0 * GRAVITY;
+//! let v = AxisModel { c0: bell, harmonics: vec![1], amps: vec![bell],
+//!                     phases: vec![std::f64::consts::PI], fit_rms: 0.0 };
+//! let h = AxisModel { c0: 0.0, harmonics: vec![1], amps: vec![200.0], phases: vec![0.0],
+//!                     fit_rms: 0.0 };
+//! let model = ForceModel { mass_kg: 70.0, dt_s: 0.25, axes: [h, AxisModel::constant(0.0), v] };
+//! let ctx = StanceContext { vs: 3.0, vps: 0.0, t_td: 0.1, z_td: 0.9, cp: [0.2, 0.0] };
+//! let coef = precompute(&model, &ctx);
+//! let lim = relative_limits(&coef);
+//! // The identity query is feasible under the stance's own relative limits.
+//! let verdict = exact(&SampledTables::new(&model), &model, &ctx, [1.0; 3], &lim);
+//! assert!(verdict.feasible && approx(coef.a_f, coef.a_mu, [1.0; 3], &lim));
+//! ```
+
+use crate::constraints::extension::unscaled_offset;
+use crate::constraints::impulse::moment_integral;
+use crate::constraints::tables::{dc_term, harmonic_terms};
+use crate::constraints::{
+    contact_point_matrix, force_filter_accepts, friction_filter_accepts, linear_impulse,
+    Coefficients, SampledTables, StanceContext, ACTIVE_FRACTION, RELATIVE_MARGIN,
+};
+use crate::force_model::{ForceModel, GRAVITY, UNILATERAL_FRACTION};
+use std::f64::consts::TAU;
+
+/// Absolute friction coefficient `μ` of `query run` (§7.5).
+pub const DEFAULT_MU: f64 = 0.7;
+/// [`contact_point`] gives `None` when `det(AᵀA) ≤ SINGULAR_REL · tr(AᵀA)²`, i.e. when
+/// `I_v² ≤ SINGULAR_REL · |I|²` roughly (no vertical impulse: `u*` is not determined).
+pub const SINGULAR_REL: f64 = 1e-12;
+
+/// The limits of eq 6–8 for one query (§7.5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Friction coefficient `μ`, dimensionless.
+    pub mu: f64,
+    /// Largest contact force magnitude `F_max`, N.
+    pub f_max: f64,
+    /// Shortest leg extension `χ_min`, m.
+    pub chi_min: f64,
+    /// Longest leg extension `χ_max`, m.
+    pub chi_max: f64,
+}
+
+/// The query's context: scaled stance start state and contact point, stance frame
+/// (§5, §7.3); the same fields as the stance's own [`StanceContext`].
+pub type QueryContext = StanceContext;
+
+/// The first constraint a candidate violates, in the order checked by [`exact`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Violation {
+    /// Eq 5: some `β_a < 0` (or NaN).
+    Beta,
+    /// Eq 6: `F_peak > F_max`.
+    Force,
+    /// Eq 7: `μ_req > μ` on the active set.
+    Friction,
+    /// §4.3: `f_v < −0.05 · max f_v` somewhere (independent of β).
+    Unilateral,
+    /// Eq 8: `ext_min < χ_min`.
+    ExtensionMin,
+    /// Eq 8: `ext_max > χ_max`.
+    ExtensionMax,
+}
+
+/// Result of the exact check (§7.4) with the scaled stance's extremes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Verdict {
+    /// Every sample satisfies eq 5–8 and the unilateral test.
+    pub feasible: bool,
+    /// The first violated constraint (order of [`Violation`]); `None` iff feasible.
+    pub violated: Option<Violation>,
+    /// `max_k |f̃(τ_k)|`, N.
+    pub f_peak: f64,
+    /// `max over T_act of |f̃_t|/f̃_v`; `+∞` when the stance carries no load.
+    pub mu_req: f64,
+    /// `min_k |r(τ_k) − x_cp|`, m.
+    pub ext_min: f64,
+    /// `max_k |r(τ_k) − x_cp|`, m.
+    pub ext_max: f64,
+}
+
+/// O(1) filters (eq 10, eq 12) from the stance's stored `A^F`, `A^μ`: conservative.
+///
+/// Also checks eq 5 (`β ≥ 0`) and rejects negative or NaN `F_max`, `μ`. It never accepts a
+/// candidate whose eq 6 or eq 7 fails in [`exact`]; it may reject feasible ones. The
+/// unilateral test does not depend on β: read it from the stance's `unilateral_ok`.
+pub fn approx(a_f: [f64; 3], a_mu: [f64; 2], beta: [f64; 3], lim: &Limits) -> bool {
+    beta.iter().all(|&b| b >= 0.0)
+        && lim.f_max >= 0.0
+        && lim.mu >= 0.0
+        && force_filter_accepts(&a_f, beta, lim.f_max)
+        && friction_filter_accepts(&a_mu, beta, lim.mu)
+}
+
+/// `max` that propagates NaN (`f64::max` drops it).
+fn max_nan(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// `min` that propagates NaN.
+fn min_nan(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+/// Exact sampled check (§7.4) on precomputed tables (no trig per query): eq 5–8 and the
+/// unilateral test.
+///
+/// `tables` must be those of `model` ([`SampledTables::new`]); `ctx.cp` is the contact
+/// point to test (the re-solved `u*` of [`contact_point`] for a query, CORRECTIONS Issue 4
+/// item 7). At β = 1 with the stance's own context it reproduces `constraints::precompute`'s
+/// `F_peak`, `μ_req`, `ext_min`, `ext_max`. Never panics: NaN inputs give an infeasible
+/// verdict; an empty grid gives zeros and `μ_req = +∞` (friction violated).
+pub fn exact(
+    tables: &SampledTables,
+    model: &ForceModel,
+    ctx: &QueryContext,
+    beta: [f64; 3],
+    lim: &Limits,
+) -> Verdict {
+    let [fh, fp, fv] = &tables.f;
+    let [sh, sp, sv] = &tables.s;
+    let [bh, bp, bv] = beta;
+
+    let mut max_fv = f64::NEG_INFINITY;
+    for &v in fv {
+        max_fv = max_nan(max_fv, v);
+    }
+    if fv.is_empty() {
+        max_fv = 0.0;
+    }
+    let floor = -UNILATERAL_FRACTION * max_fv;
+    let unilateral_ok = fv.iter().all(|&v| v >= floor);
+    let loaded = max_fv > 0.0;
+    let threshold = ACTIVE_FRACTION * max_fv;
+
+    let mut f2_peak = 0.0f64;
+    let mut mu_req = if loaded { 0.0 } else { f64::INFINITY };
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    let forces = fh.iter().zip(fp).zip(fv);
+    let disp = sh.iter().zip(sp).zip(sv);
+    for ((&t, ((&h, &p), &v)), ((&s_h, &s_p), &s_v)) in tables.tau.iter().zip(forces).zip(disp) {
+        let (gh, gp, gv) = (bh * h, bp * p, bv * v);
+        f2_peak = max_nan(f2_peak, gh * gh + gp * gp + gv * gv);
+        if loaded && v >= threshold {
+            let tangential = gh.hypot(gp);
+            let ratio = if tangential == 0.0 {
+                0.0
+            } else if gv > 0.0 {
+                tangential / gv
+            } else if tangential.is_nan() || gv.is_nan() {
+                f64::NAN
+            } else {
+                f64::INFINITY
+            };
+            mu_req = max_nan(mu_req, ratio);
+        }
+        let u = unscaled_offset(model, ctx, t);
+        let d2 = (u[0] + bh * s_h).powi(2) + (u[1] + bp * s_p).powi(2) + (u[2] + bv * s_v).powi(2);
+        lo = min_nan(lo, d2);
+        hi = max_nan(hi, d2);
+    }
+    if tables.is_empty() {
+        (lo, hi) = (0.0, 0.0);
+    }
+    let (f_peak, ext_min, ext_max) = (f2_peak.sqrt(), lo.sqrt(), hi.sqrt());
+
+    let checks = [
+        (beta.iter().all(|&b| b >= 0.0), Violation::Beta),
+        (f_peak <= lim.f_max, Violation::Force),
+        (mu_req <= lim.mu, Violation::Friction),
+        (unilateral_ok, Violation::Unilateral),
+        (lim.chi_min <= ext_min, Violation::ExtensionMin),
+        (ext_max <= lim.chi_max, Violation::ExtensionMax),
+    ];
+    let violated = checks.iter().find(|(ok, _)| !ok).map(|&(_, v)| v);
+    Verdict {
+        feasible: violated.is_none(),
+        violated,
+        f_peak,
+        mu_req,
+        ext_min,
+        ext_max,
+    }
+}
+
+/// The exact check at the re-solved contact point (CORRECTIONS Issue 4 item 7, §8.3).
+///
+/// `u* = contact_point_with(moments, β, ctx, h_des)`, then [`exact`] with
+/// `x_cp = (u*, −z_TD)`. Returns the verdict and `u*` (m); when `u*` is undetermined
+/// (`I_v` ~ 0, see [`SINGULAR_REL`]) the check runs at `ctx.cp` and `u*` is `None`.
+pub fn exact_at_contact_point(
+    tables: &SampledTables,
+    model: &ForceModel,
+    moments: &ImpulseMoments,
+    ctx: &QueryContext,
+    beta: [f64; 3],
+    h_des: [f64; 3],
+    lim: &Limits,
+) -> (Verdict, Option<[f64; 2]>) {
+    let u = contact_point_with(moments, beta, ctx, h_des);
+    let at = QueryContext {
+        cp: u.unwrap_or(ctx.cp),
+        ..*ctx
+    };
+    (exact(tables, model, &at, beta, lim), u)
+}
+
+/// `(∫₀¹ τ f_b dτ, ∫₀¹ τ² f_b dτ)` for integer harmonics, N.
+fn tau_moments(model: &ForceModel, axis: usize) -> (f64, f64) {
+    let d = dc_term(model, axis);
+    let (mut t1, mut t2) = (d / 2.0, d / 3.0);
+    for (j, c, phi) in harmonic_terms(model, axis) {
+        let omega = TAU * f64::from(j);
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let m1 = sin_phi / omega;
+        t1 += c * m1;
+        t2 += c * (m1 + 2.0 * cos_phi / (omega * omega));
+    }
+    (t1, t2)
+}
+
+/// Per-stance, context-free moments behind the contact point (§8.2–8.3).
+///
+/// ```text
+/// Q_ab = ∫₀¹ S_a f_b dτ (m·N),  T1_b = ∫₀¹ τ f_b dτ,  T2_b = ∫₀¹ τ² f_b dτ (N),  I¹ = m J (N·s)
+/// ```
+///
+/// Built once per stance (a few `sin_cos` per harmonic); [`contact_point_with`] then solves
+/// each query in O(1) without trigonometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImpulseMoments {
+    /// `Q_ab = ∫ S_a f_b dτ`, rows `a`, columns `b` (h, p, v), m·N.
+    pub q: [[f64; 3]; 3],
+    /// `T1_b = ∫ τ f_b dτ`, N.
+    pub t1: [f64; 3],
+    /// `T2_b = ∫ τ² f_b dτ`, N.
+    pub t2: [f64; 3],
+    /// Linear impulse at β = 1, `m (J_h, J_p, J_v)`, N·s.
+    pub impulse: [f64; 3],
+    /// Stance duration `Δt`, s.
+    pub dt_s: f64,
+}
+
+impl ImpulseMoments {
+    /// The moments of `model` (closed form, exact for integer harmonics).
+    pub fn new(model: &ForceModel) -> Self {
+        let dt = model.dt_s;
+        let moments = [0, 1, 2].map(|b| tau_moments(model, b));
+        let (t1, t2) = (moments.map(|m| m.0), moments.map(|m| m.1));
+        // With vs = vps = t_TD = 0 the free motion is ℓ2_a τ² only.
+        let still = StanceContext::default();
+        let l2 = [0.0, 0.0, -0.5 * GRAVITY * dt * dt];
+        let q = [0, 1, 2]
+            .map(|a| [0, 1, 2].map(|b| moment_integral(model, &still, a, b) - l2[a] * t2[b]));
+        Self {
+            q,
+            t1,
+            t2,
+            impulse: linear_impulse(model),
+            dt_s: dt,
+        }
+    }
+}
+
+/// `H(u) = A u + b` of the scaled stance (§8.2): `(A, b)`, rows (h, p, v), N·s and N·m·s.
+///
+/// `ctx.cp` is ignored (`u` is the unknown). O(1), no trigonometry.
+pub fn impulse_affine(
+    moments: &ImpulseMoments,
+    beta: [f64; 3],
+    ctx: &QueryContext,
+) -> ([[f64; 2]; 3], [f64; 3]) {
+    let dt = moments.dt_s;
+    let l1 = [ctx.vs * dt, ctx.vps * dt, -GRAVITY * ctx.t_td * dt];
+    let l2 = [0.0, 0.0, -0.5 * GRAVITY * dt * dt];
+    let r = |a: usize, b: usize| {
+        l1[a] * moments.t1[b] + l2[a] * moments.t2[b] + beta[a] * moments.q[a][b]
+    };
+    let [bh, bp, bv] = beta;
+    let h0 = [
+        dt * (bv * r(1, 2) - bp * r(2, 1)),
+        dt * (bh * r(2, 0) - bv * r(0, 2)),
+        dt * (bp * r(0, 1) - bh * r(1, 0)),
+    ];
+    let imp = [0, 1, 2].map(|a| beta[a] * moments.impulse[a]);
+    // (0, 0, −z_TD) × I = (z_TD I_p, −z_TD I_h, 0).
+    let moment = [ctx.z_td * imp[1], -ctx.z_td * imp[0], 0.0];
+    let b = [0, 1, 2].map(|a| moment[a] - h0[a]);
+    (contact_point_matrix(imp), b)
+}
+
+/// Closed-form contact point for the scaled stance (§8.3), `W = I`, m.
+///
+/// ```text
+/// u* = (AᵀA)⁻¹ Aᵀ (H_des − b)      det(AᵀA) = I_v² |I|²
+/// ```
+///
+/// `ctx.cp` is ignored; builds the stance's [`ImpulseMoments`] (reuse them across queries
+/// with [`contact_point_with`]). The default `h_des` is the stance's original `H`
+/// (`Coefficients::ang_impulse`, N·m·s). `None` when `I_v` is ~0 relative to `|I|`
+/// ([`SINGULAR_REL`]) or any input is non-finite.
+pub fn contact_point(
+    model: &ForceModel,
+    beta: [f64; 3],
+    ctx: &QueryContext,
+    h_des: [f64; 3],
+) -> Option<[f64; 2]> {
+    contact_point_with(&ImpulseMoments::new(model), beta, ctx, h_des)
+}
+
+/// [`contact_point`] from the stance's precomputed [`ImpulseMoments`]: O(1), no trig, m.
+pub fn contact_point_with(
+    moments: &ImpulseMoments,
+    beta: [f64; 3],
+    ctx: &QueryContext,
+    h_des: [f64; 3],
+) -> Option<[f64; 2]> {
+    let (a, b) = impulse_affine(moments, beta, ctx);
+    let rhs = [0, 1, 2].map(|k| h_des[k] - b[k]);
+    let (mut n, mut g) = ([[0.0f64; 2]; 2], [0.0f64; 2]);
+    for (row, &y) in a.iter().zip(&rhs) {
+        for i in 0..2 {
+            g[i] += row[i] * y;
+            for j in 0..2 {
+                n[i][j] += row[i] * row[j];
+            }
+        }
+    }
+    let det = n[0][0] * n[1][1] - n[0][1] * n[1][0];
+    let trace = n[0][0] + n[1][1];
+    if !(det.is_finite() && det > SINGULAR_REL * trace * trace) {
+        return None;
+    }
+    let u = [
+        (n[1][1] * g[0] - n[0][1] * g[1]) / det,
+        (n[0][0] * g[1] - n[1][0] * g[0]) / det,
+    ];
+    u.iter().all(|x| x.is_finite()).then_some(u)
+}
+
+/// §7.5 relative limits from a stance's original extremes (`≤` comparisons, 1.05 margins).
+///
+/// ```text
+/// μ = 1.05 μ_req,  F_max = 1.05 F_peak,  χ_max = 1.05 ext_max,  χ_min = ext_min / 1.05
+/// ```
+pub fn relative_limits(coef: &Coefficients) -> Limits {
+    Limits {
+        mu: RELATIVE_MARGIN * coef.mu_req,
+        f_max: RELATIVE_MARGIN * coef.f_peak,
+        chi_min: coef.ext_min / RELATIVE_MARGIN,
+        chi_max: RELATIVE_MARGIN * coef.ext_max,
+    }
+}
+
+#[cfg(test)]
+mod tests;
