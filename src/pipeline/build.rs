@@ -28,6 +28,7 @@ use crate::library::schema::{
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, write_atomic};
 use crate::library::{ClipRecord, Status};
+use crate::stances::build::StanceNote;
 use crate::stances::limits::{limits, ClipFacts, Limits, StanceFacts};
 use crate::stances::{build_clip, Stance, StanceOptions};
 
@@ -70,7 +71,7 @@ pub fn build(files: &[PathBuf], opts: &BuildOptions) -> BuildReport {
 fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport {
     let mut records = ingest_named(named, &opts.ingest);
     let bar = progress(records.len(), "clips segmented and fitted");
-    let per_clip: Vec<(Vec<Stance>, Vec<String>)> = records
+    let per_clip: Vec<(Vec<Stance>, Vec<StanceNote>)> = records
         .par_iter()
         .map(|r| {
             let out = match (&r.frames, r.status) {
@@ -99,13 +100,13 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport 
         // failed fits are also errors.
         r.summary
             .warnings
-            .extend(warnings.iter().map(|w| format!("stances: {w}")));
-        for w in warnings.iter().filter(|w| w.contains("failed")) {
+            .extend(warnings.iter().map(|w| format!("stances: {}", w.message)));
+        for w in warnings.iter().filter(|w| w.failed) {
             errors.push(ErrorRow {
                 path: r.path.clone(),
                 clip: Some(r.clip.clone()),
                 stage: "stances".into(),
-                message: w.clone(),
+                message: w.message.clone(),
             });
         }
     }

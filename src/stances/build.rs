@@ -220,14 +220,33 @@ impl StageB<'_> {
     }
 }
 
-/// Build every stance of a clip. Returns the stances and clip-level warnings.
+/// A clip-level message of the stance stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceNote {
+    /// What happened (frame and reason).
+    pub message: String,
+    /// A stance was lost to a failure (an `errors.parquet` row), not just reported.
+    pub failed: bool,
+}
+
+impl From<String> for StanceNote {
+    /// An advisory note (not a failure).
+    fn from(message: String) -> Self {
+        StanceNote {
+            message,
+            failed: false,
+        }
+    }
+}
+
+/// Build every stance of a clip. Returns the stances and clip-level notes.
 pub fn build_clip(
     clip: &str,
     fr: &ClipFrames,
     summary: &ClipSummary,
     mass_kg: f64,
     opts: &StanceOptions,
-) -> (Vec<Stance>, Vec<String>) {
+) -> (Vec<Stance>, Vec<StanceNote>) {
     let n = fr.frame.len();
     let dt = summary.frame_time_s;
     let mut warnings = Vec::new();
@@ -250,7 +269,9 @@ pub fn build_clip(
         Splines::new(&fr.time_s, &fr.com_v),
         Splines::new(&fr.time_s, &fr.com_a),
     ) else {
-        warnings.push("cannot build splines of the COM (too few frames)".into());
+        warnings.push(StanceNote::from(
+            "cannot build splines of the COM (too few frames)".to_string(),
+        ));
         return (Vec::new(), warnings);
     };
     let speed: Vec<f64> = fr
@@ -272,7 +293,7 @@ pub fn build_clip(
         ballistic: &ballistic,
         dt,
     });
-    warnings.extend(w);
+    warnings.extend(w.into_iter().map(StanceNote::from));
     let mut ws = FitWorkspace::new(opts.fit.samples);
     let mut previous: Option<V3> = None;
     let mut out = Vec::with_capacity(segments.len());
@@ -308,10 +329,13 @@ pub fn build_clip(
         ) {
             Ok(m) => m,
             Err(e) => {
-                warnings.push(format!(
-                    "stance at frame {}: force fit failed: {e}",
-                    fr.frame[seg.i0]
-                ));
+                warnings.push(StanceNote {
+                    message: format!(
+                        "stance at frame {}: force fit failed: {e}",
+                        fr.frame[seg.i0]
+                    ),
+                    failed: true,
+                });
                 continue;
             }
         };
