@@ -12,8 +12,8 @@ fn python_has(modules: &str) -> bool {
 
 #[test]
 fn pyarrow_and_duckdb_read_the_library() {
-    if !python_has("pyarrow, duckdb") {
-        eprintln!("SKIPPED pyarrow_and_duckdb_read_the_library: python3 with pyarrow and duckdb not found (.ci/run installs them)");
+    if !python_has("pyarrow, duckdb, pandas") {
+        eprintln!("SKIPPED pyarrow_and_duckdb_read_the_library: python3 with pyarrow, pandas and duckdb not found (.ci/run installs them)");
         return;
     }
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -58,6 +58,12 @@ clips = duckdb.sql(f"select count(*) from '{{lib}}/clips.parquet' where status =
 assert clips == 3, clips
 frames = duckdb.sql(f"select count(*) from '{{lib}}/frames.parquet'").fetchall()[0][0]
 assert frames == {frames}, frames
+# pandas, through pyarrow: list<string> columns must not come back as string_view lists.
+import pandas as pd
+for name in ["stances", "clips", "frames", "contacts", "errors"]:
+    df = pd.read_parquet(f"{{lib}}/{{name}}.parquet")
+s = pd.read_parquet(lib + "/stances.parquet")
+assert len(s) == {n_stances} and isinstance(s["effectors"].iloc[0][0], str), s["effectors"].iloc[0]
 print("ok", n, frames)
 "#,
         lib = lib.display().to_string(),

@@ -5,6 +5,7 @@
 //! # References
 //! spec com-from-bvh §8 (column tables); STYLE.md §5.6 (deterministic files).
 
+mod columns;
 pub mod read;
 pub mod schema;
 pub mod stances;

@@ -8,6 +8,8 @@ use std::path::Path;
 
 use polars::prelude::*;
 
+use super::columns::col;
+
 use super::schema::*;
 use super::ClipRecord;
 use crate::contacts::EFFECTORS;
@@ -15,14 +17,6 @@ use crate::error::{Error, Result};
 
 /// Rows per Parquet row group.
 pub const ROW_GROUP_ROWS: usize = 65_536;
-
-fn col<T, P>(name: &str, v: T) -> Column
-where
-    Series: NamedFrom<T, P>,
-    P: ?Sized,
-{
-    Column::new(name.into(), v)
-}
 
 fn polars_err(path: &Path, e: PolarsError) -> Error {
     Error::io(path, "cannot build table", e)
@@ -348,9 +342,9 @@ pub fn write_atomic(
             .with_statistics(StatisticsOptions::full())
             .with_row_group_size(Some(ROW_GROUP_ROWS))
             .set_parallel(false)
-            .with_key_value_metadata(
-                (!kv.is_empty()).then(|| KeyValueMetadata::from_static(kv.to_vec())),
-            )
+            .with_key_value_metadata(Some(KeyValueMetadata::from_static(with_portable_schema(
+                df, kv,
+            ))))
             .finish(df)
             .map_err(|e| Error::io(&tmp, "cannot write parquet", e))?;
         std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, "cannot rename into place", e))
@@ -359,6 +353,23 @@ pub fn write_atomic(
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// `kv` preceded by an `ARROW:schema` entry of the oldest Arrow compatibility level
+/// (`large_string`, not `string_view`).
+///
+/// polars stores its newest Arrow types in the Parquet footer; pyarrow 26 then reads list
+/// columns as `list<string_view>`, which `to_pandas` (and `pandas.read_parquet`) cannot
+/// convert. The Parquet data pages are the same either way; only the type hint differs.
+fn with_portable_schema(df: &DataFrame, kv: &[(String, String)]) -> Vec<(String, String)> {
+    let schema = df.schema().to_arrow(CompatLevel::oldest());
+    let key = polars_parquet::write::schema_to_metadata_key(&schema);
+    let mut out = Vec::with_capacity(kv.len() + 1);
+    if let Some(v) = key.value {
+        out.push((key.key, v));
+    }
+    out.extend(kv.iter().cloned());
+    out
 }
 
 /// Build and write every table of a `frames` run into `dir`.
