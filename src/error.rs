@@ -56,6 +56,19 @@ pub enum ErrorKind {
         /// Size found.
         found: usize,
     },
+    /// A library table lacks a column, has it with the wrong type, or holds a null or
+    /// invalid value where the schema forbids one.
+    #[error("{}: column '{column}'{}: {msg}", path.display(), row.map(|r| format!(", row {r}")).unwrap_or_default())]
+    Column {
+        /// The table file.
+        path: PathBuf,
+        /// The column.
+        column: String,
+        /// 0-based row, when one value is at fault.
+        row: Option<usize>,
+        /// What is wrong.
+        msg: String,
+    },
     /// A columnar (Parquet) file could not be written or read.
     #[error("{}: {msg}", path.display())]
     Io {
@@ -105,6 +118,22 @@ impl Error {
             path: path.into(),
             msg: msg.into(),
             source: Some(Box::new(source)),
+        }
+        .into()
+    }
+
+    /// A column error in a library table.
+    pub fn column(
+        path: impl Into<PathBuf>,
+        column: &str,
+        row: Option<usize>,
+        msg: impl Into<String>,
+    ) -> Self {
+        ErrorKind::Column {
+            path: path.into(),
+            column: column.to_string(),
+            row,
+            msg: msg.into(),
         }
         .into()
     }

@@ -90,7 +90,7 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
                 let (qh, qp) = ((h / v) * (h / v), (p / v) * (p / v));
                 rh = rh.max(qh);
                 rp = rp.max(qp);
-                rt = rt.max(h.hypot(p) / v);
+                rt = rt.max((h * h + p * p).sqrt() / v); // as query::feasibility::exact
             }
         }
         (a_mu, mu_req) = ([rh, rp], rt);

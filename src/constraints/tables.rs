@@ -27,7 +27,7 @@
 //!
 //! Stance frame (h, p, v); forces in N, `S_a` in m, `τ` dimensionless.
 
-use crate::force_model::ForceModel;
+use crate::force_model::{ForceModel, UNILATERAL_FRACTION};
 use std::f64::consts::TAU;
 
 /// `f_a(τ_k)` and `S_a(τ_k)` of one stance on its grid; reusable across stances.
@@ -39,6 +39,10 @@ pub struct SampledTables {
     pub f: [Vec<f64>; 3],
     /// `S_a(τ_k) = (Δt²/m) F2_a(τ_k)` per axis (h, p, v), m.
     pub s: [Vec<f64>; 3],
+    /// `max_k f_v(τ_k)`, N (0 for an empty grid, NaN if any `f_v` is NaN).
+    pub max_f_v: f64,
+    /// `f_v(τ_k) ≥ −0.05 · max f_v` at every grid point (§4.3); false if any is NaN.
+    pub unilateral_ok: bool,
     /// `(cos, sin)` of `2π m/(N_s − 1)`, `m = 0 … N_s − 2`, for the last grid size.
     unit_circle: Vec<(f64, f64)>,
 }
@@ -110,6 +114,23 @@ impl SampledTables {
                 }
             }
         }
+        self.summarise_vertical();
+    }
+
+    /// `max f_v` and the unilateral test of the current `f_v` row (end of [`Self::rebuild`]).
+    fn summarise_vertical(&mut self) {
+        let fv = &self.f[2];
+        let nan = fv.iter().any(|v| v.is_nan());
+        let max = fv.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        self.max_f_v = if nan {
+            f64::NAN
+        } else if fv.is_empty() {
+            0.0
+        } else {
+            max
+        };
+        let floor = -UNILATERAL_FRACTION * self.max_f_v;
+        self.unilateral_ok = !nan && fv.iter().all(|&v| v >= floor);
     }
 
     /// Number of grid points `N_s`.

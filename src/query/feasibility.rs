@@ -72,14 +72,13 @@
 //! assert!(verdict.feasible && approx(coef.a_f, coef.a_mu, [1.0; 3], &lim));
 //! ```
 
-use crate::constraints::extension::unscaled_offset;
 use crate::constraints::impulse::moment_integral;
 use crate::constraints::tables::{dc_term, harmonic_terms};
 use crate::constraints::{
     contact_point_matrix, force_filter_accepts, friction_filter_accepts, linear_impulse,
     Coefficients, SampledTables, StanceContext, ACTIVE_FRACTION, RELATIVE_MARGIN,
 };
-use crate::force_model::{ForceModel, GRAVITY, UNILATERAL_FRACTION};
+use crate::force_model::{ForceModel, GRAVITY};
 use std::f64::consts::TAU;
 
 /// Absolute friction coefficient `μ` of `query run` (§7.5).
@@ -152,21 +151,158 @@ pub fn approx(a_f: [f64; 3], a_mu: [f64; 2], beta: [f64; 3], lim: &Limits) -> bo
         && friction_filter_accepts(&a_mu, beta, lim.mu)
 }
 
-/// `max` that propagates NaN (`f64::max` drops it).
-fn max_nan(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
+/// `√x ≤ lim` decided exactly, with the square root only near the boundary.
+///
+/// `√` is correctly rounded and monotone, so comparing `√x` with a limit set from another
+/// `√` (a stance's own extreme) is exact; `x ≤ lim²` alone is not (`lim²` rounds). Outside a
+/// relative band of `±8ε` around `lim²` the squared comparison decides.
+#[derive(Debug, Clone, Copy)]
+struct SqrtLe {
+    lim: f64,
+    below: f64,
+    above: f64,
+}
+
+impl SqrtLe {
+    fn new(lim: f64) -> Self {
+        let l2 = lim * lim;
+        SqrtLe {
+            lim,
+            below: l2 * (1.0 - 8.0 * f64::EPSILON),
+            above: l2 * (1.0 + 8.0 * f64::EPSILON),
+        }
+    }
+
+    /// `√x ≤ lim` (false for NaN; `lim < 0` is never met).
+    #[inline(always)]
+    fn holds(&self, x: f64) -> bool {
+        if x <= self.below {
+            self.lim >= 0.0
+        } else if x > self.above {
+            false
+        } else {
+            x.sqrt() <= self.lim
+        }
+    }
+
+    /// `lim ≤ √x` (false for NaN).
+    #[inline(always)]
+    fn holds_above(&self, x: f64) -> bool {
+        if x >= self.above {
+            true
+        } else if x < self.below {
+            self.lim <= 0.0 && x >= 0.0
+        } else {
+            self.lim <= x.sqrt()
+        }
     }
 }
 
-/// `min` that propagates NaN.
-fn min_nan(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.min(b)
+/// What the exact check needs per query, precomputed once (O(1)): β, the limits, the
+/// active-set threshold and the β-independent offset `U(τ)` of §7.4, in the operation
+/// order of `constraints::extension::unscaled_offset` (so β = 1 reproduces the stored
+/// extremes bit for bit).
+struct Setup {
+    beta: [f64; 3],
+    force: SqrtLe,
+    chi_min: SqrtLe,
+    chi_max: SqrtLe,
+    mu: f64,
+    mu2_below: f64,
+    /// `λ_act · max f_v`; the active set is `f_v ≥ threshold` (only when loaded).
+    threshold: f64,
+    loaded: bool,
+    unilateral_ok: bool,
+    /// `(vs Δt, vps Δt, −g t_TD Δt)`, `½ g Δt²`, `(−cp_h, −cp_p, z_TD)`.
+    lin: [f64; 3],
+    quad: f64,
+    cp: [f64; 2],
+    z_td: f64,
+}
+
+/// One grid sample of the scaled stance: `|f̃|²`, `|f̃_t|²`, `f̃_v`, `|r − x_cp|²`, active.
+struct Sample {
+    f2: f64,
+    t2: f64,
+    gv: f64,
+    d2: f64,
+    active: bool,
+}
+
+impl Setup {
+    fn new(
+        tables: &SampledTables,
+        model: &ForceModel,
+        ctx: &QueryContext,
+        beta: [f64; 3],
+        lim: &Limits,
+    ) -> Self {
+        let (max_fv, unilateral_ok) = (tables.max_f_v, tables.unilateral_ok);
+        let nan = max_fv.is_nan();
+        let dt = model.dt_s;
+        Setup {
+            beta,
+            force: SqrtLe::new(lim.f_max),
+            chi_min: SqrtLe::new(lim.chi_min),
+            chi_max: SqrtLe::new(lim.chi_max),
+            mu: lim.mu,
+            mu2_below: lim.mu * lim.mu * (1.0 - 8.0 * f64::EPSILON),
+            threshold: ACTIVE_FRACTION * max_fv,
+            loaded: !nan && max_fv > 0.0,
+            unilateral_ok,
+            lin: [ctx.vs * dt, ctx.vps * dt, -GRAVITY * ctx.t_td * dt],
+            quad: 0.5 * GRAVITY * dt * dt,
+            cp: ctx.cp,
+            z_td: ctx.z_td,
+        }
+    }
+
+    /// Sample `k` of the tables (`k < tables.len()`).
+    #[inline(always)]
+    fn sample(&self, t: &SampledTables, k: usize) -> Sample {
+        let [bh, bp, bv] = self.beta;
+        let tau = t.tau[k];
+        let (gh, gp, gv) = (bh * t.f[0][k], bp * t.f[1][k], bv * t.f[2][k]);
+        let uh = self.lin[0] * tau - self.cp[0];
+        let up = self.lin[1] * tau - self.cp[1];
+        let uv = self.lin[2] * tau - self.quad * tau * tau + self.z_td;
+        let (rh, rp, rv) = (
+            uh + bh * t.s[0][k],
+            up + bp * t.s[1][k],
+            uv + bv * t.s[2][k],
+        );
+        let t2 = gh * gh + gp * gp;
+        Sample {
+            f2: t2 + gv * gv,
+            t2,
+            gv,
+            d2: rh * rh + rp * rp + rv * rv,
+            active: self.loaded && t.f[2][k] >= self.threshold,
+        }
+    }
+
+    /// The friction ratio `|f̃_t|/f̃_v` of an active sample (`+∞` without a positive normal
+    /// force, 0 without a tangential one).
+    #[inline(always)]
+    fn ratio(x: &Sample) -> f64 {
+        if x.t2 == 0.0 {
+            0.0
+        } else if x.gv > 0.0 {
+            x.t2.sqrt() / x.gv
+        } else if x.t2.is_nan() || x.gv.is_nan() {
+            f64::NAN
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Eq 7 at one active sample, `|f̃_t|/f̃_v ≤ μ`; the squared form decides clear cases.
+    #[inline(always)]
+    fn friction_ok(&self, x: &Sample) -> bool {
+        if x.gv > 0.0 && x.t2 <= self.mu2_below * x.gv * x.gv {
+            return self.mu >= 0.0;
+        }
+        Self::ratio(x) <= self.mu
     }
 }
 
@@ -176,7 +312,9 @@ fn min_nan(a: f64, b: f64) -> f64 {
 /// `tables` must be those of `model` ([`SampledTables::new`]); `ctx.cp` is the contact
 /// point to test (the re-solved `u*` of [`contact_point`] for a query, CORRECTIONS Issue 4
 /// item 7). At β = 1 with the stance's own context it reproduces `constraints::precompute`'s
-/// `F_peak`, `μ_req`, `ext_min`, `ext_max`. Never panics: NaN inputs give an infeasible
+/// `F_peak`, `μ_req`, `ext_min`, `ext_max`, and limits equal to them are met (every test is
+/// `≤`). Each constraint is decided per sample by the same predicates as
+/// [`exact_feasible`], so both always agree. Never panics: NaN inputs give an infeasible
 /// verdict; an empty grid gives zeros and `μ_req = +∞` (friction violated).
 pub fn exact(
     tables: &SampledTables,
@@ -185,70 +323,74 @@ pub fn exact(
     beta: [f64; 3],
     lim: &Limits,
 ) -> Verdict {
-    let [fh, fp, fv] = &tables.f;
-    let [sh, sp, sv] = &tables.s;
-    let [bh, bp, bv] = beta;
-
-    let mut max_fv = f64::NEG_INFINITY;
-    for &v in fv {
-        max_fv = max_nan(max_fv, v);
-    }
-    if fv.is_empty() {
-        max_fv = 0.0;
-    }
-    let floor = -UNILATERAL_FRACTION * max_fv;
-    let unilateral_ok = fv.iter().all(|&v| v >= floor);
-    let loaded = max_fv > 0.0;
-    let threshold = ACTIVE_FRACTION * max_fv;
-
-    let mut f2_peak = 0.0f64;
-    let mut mu_req = if loaded { 0.0 } else { f64::INFINITY };
+    let s = Setup::new(tables, model, ctx, beta, lim);
+    let (mut force_ok, mut friction_ok) = (true, s.loaded);
+    let (mut ext_lo_ok, mut ext_hi_ok) = (true, true);
+    let (mut f2_peak, mut mu_req) = (0.0f64, 0.0f64);
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    let forces = fh.iter().zip(fp).zip(fv);
-    let disp = sh.iter().zip(sp).zip(sv);
-    for ((&t, ((&h, &p), &v)), ((&s_h, &s_p), &s_v)) in tables.tau.iter().zip(forces).zip(disp) {
-        let (gh, gp, gv) = (bh * h, bp * p, bv * v);
-        f2_peak = max_nan(f2_peak, gh * gh + gp * gp + gv * gv);
-        if loaded && v >= threshold {
-            let tangential = gh.hypot(gp);
-            let ratio = if tangential == 0.0 {
-                0.0
-            } else if gv > 0.0 {
-                tangential / gv
-            } else if tangential.is_nan() || gv.is_nan() {
-                f64::NAN
-            } else {
-                f64::INFINITY
-            };
-            mu_req = max_nan(mu_req, ratio);
+    let mut nan = false;
+    for k in 0..tables.len() {
+        let x = s.sample(tables, k);
+        nan |= x.f2.is_nan() || x.d2.is_nan();
+        force_ok &= s.force.holds(x.f2);
+        f2_peak = f2_peak.max(x.f2);
+        if x.active {
+            friction_ok &= s.friction_ok(&x);
+            let r = Setup::ratio(&x);
+            nan |= r.is_nan();
+            mu_req = mu_req.max(r);
         }
-        let u = unscaled_offset(model, ctx, t);
-        let d2 = (u[0] + bh * s_h).powi(2) + (u[1] + bp * s_p).powi(2) + (u[2] + bv * s_v).powi(2);
-        lo = min_nan(lo, d2);
-        hi = max_nan(hi, d2);
+        ext_lo_ok &= s.chi_min.holds_above(x.d2);
+        ext_hi_ok &= s.chi_max.holds(x.d2);
+        lo = lo.min(x.d2);
+        hi = hi.max(x.d2);
     }
     if tables.is_empty() {
         (lo, hi) = (0.0, 0.0);
     }
-    let (f_peak, ext_min, ext_max) = (f2_peak.sqrt(), lo.sqrt(), hi.sqrt());
-
+    let out = |v: f64| if nan { f64::NAN } else { v };
     let checks = [
         (beta.iter().all(|&b| b >= 0.0), Violation::Beta),
-        (f_peak <= lim.f_max, Violation::Force),
-        (mu_req <= lim.mu, Violation::Friction),
-        (unilateral_ok, Violation::Unilateral),
-        (lim.chi_min <= ext_min, Violation::ExtensionMin),
-        (ext_max <= lim.chi_max, Violation::ExtensionMax),
+        (force_ok && !nan, Violation::Force),
+        (friction_ok && !nan, Violation::Friction),
+        (s.unilateral_ok, Violation::Unilateral),
+        (ext_lo_ok && !nan, Violation::ExtensionMin),
+        (ext_hi_ok && !nan, Violation::ExtensionMax),
     ];
     let violated = checks.iter().find(|(ok, _)| !ok).map(|&(_, v)| v);
     Verdict {
         feasible: violated.is_none(),
         violated,
-        f_peak,
-        mu_req,
-        ext_min,
-        ext_max,
+        f_peak: out(f2_peak.sqrt()),
+        mu_req: if s.loaded { out(mu_req) } else { f64::INFINITY },
+        ext_min: out(lo.sqrt()),
+        ext_max: out(hi.sqrt()),
     }
+}
+
+/// The verdict of [`exact`] alone, stopping at the first violating sample (the map's
+/// inner loop). Same per-sample predicates, so `exact_feasible(..) == exact(..).feasible`.
+pub fn exact_feasible(
+    tables: &SampledTables,
+    model: &ForceModel,
+    ctx: &QueryContext,
+    beta: [f64; 3],
+    lim: &Limits,
+) -> bool {
+    if !beta.iter().all(|&b| b >= 0.0) {
+        return false;
+    }
+    let s = Setup::new(tables, model, ctx, beta, lim);
+    if !(s.unilateral_ok && s.loaded) {
+        return false;
+    }
+    (0..tables.len()).all(|k| {
+        let x = s.sample(tables, k);
+        s.force.holds(x.f2)
+            && (!x.active || s.friction_ok(&x))
+            && s.chi_min.holds_above(x.d2)
+            && s.chi_max.holds(x.d2)
+    })
 }
 
 /// The exact check at the re-solved contact point (CORRECTIONS Issue 4 item 7, §8.3).

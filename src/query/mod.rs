@@ -1,12 +1,17 @@
-//! Queries on the stance library: closed-form stance scaling and its feasibility.
+//! Queries on the stance library: closed-form stance scaling, its feasibility, and the
+//! run, jump and map queries built on them.
 //!
-//! Modules: [`solve`] (spec stance-model §6.1–§6.5: β and event times from six stance
-//! parameters, degenerate branches, admissibility and root choice) and [`feasibility`]
-//! (§7.3 fast filters, §7.4 exact sampled check, §8.3 closed-form contact point, §7.5
-//! relative limits). The `query` and `map` commands that use them are not built yet.
+//! Data flow: `library::read::open_library` → [`pool::PoolStance`] (one library row) →
+//! [`pool::Prepared`] (tables built once) → [`solve`] (spec stance-model §6.1–§6.5) →
+//! [`feasibility`] (§7.3 filters, §7.4 exact check, §8.3 contact point, §7.5 limits) →
+//! [`run`] (§6.8 run at speed v, §9 new characters).
 //!
 //! # Frames and units
 //! Stance frame (h, p, v), SI units; heights above the contact height `z_c`.
 
 pub mod feasibility;
+pub mod pool;
 pub mod solve;
+
+#[cfg(test)]
+pub(crate) mod testkit;

@@ -55,6 +55,7 @@
 //! ```
 
 use crate::force_model::{ForceModel, GRAVITY};
+use crate::stances::params::StanceParams;
 use crate::stances::segment::Boundary;
 use crate::stances::Stance;
 
@@ -178,13 +179,20 @@ impl StanceShape {
     /// The shape of a library stance: boundaries from its kinds, `(u, w)` from its
     /// model-consistent `t_TD` and `t_E`.
     pub fn from_stance(s: &Stance) -> Self {
-        let mut shape = Self::from_model(
-            &s.model,
-            s.boundary_start == Boundary::Flight,
-            s.boundary_end == Boundary::Flight,
-            None,
-        );
-        shape.ref_signs = shape.centroid_split(s.params.t_td, s.params.t_e);
+        Self::from_boundaries(&s.model, s.boundary_start, s.boundary_end, &s.params)
+    }
+
+    /// The shape of a model with the given boundary kinds and reference parameters
+    /// (`(u, w)` from their `t_TD` and `t_E`).
+    pub fn from_boundaries(
+        m: &ForceModel,
+        start: Boundary,
+        end: Boundary,
+        reference: &StanceParams,
+    ) -> Self {
+        let mut shape =
+            Self::from_model(m, start == Boundary::Flight, end == Boundary::Flight, None);
+        shape.ref_signs = shape.centroid_split(reference.t_td, reference.t_e);
         shape
     }
 
@@ -271,6 +279,48 @@ pub struct Candidate {
     pub w: f64,
 }
 
+/// Up to two candidates (the roots of the master quadratic), stored inline so a query
+/// allocates nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Roots {
+    len: usize,
+    items: [Candidate; 2],
+}
+
+impl Roots {
+    const EMPTY: Candidate = Candidate {
+        beta: [0.0; 3],
+        t_td: 0.0,
+        t_e: 0.0,
+        u: 0.0,
+        w: 0.0,
+    };
+
+    fn one(c: Candidate) -> Self {
+        Roots {
+            len: 1,
+            items: [c, Self::EMPTY],
+        }
+    }
+
+    fn two(a: Candidate, b: Candidate) -> Self {
+        Roots {
+            len: 2,
+            items: [a, b],
+        }
+    }
+
+    /// The candidates, in root order.
+    pub fn as_slice(&self) -> &[Candidate] {
+        &self.items[..self.len]
+    }
+
+    /// Iterates over the candidates.
+    pub fn iter(&self) -> std::slice::Iter<'_, Candidate> {
+        self.as_slice().iter()
+    }
+}
+
 /// An admissible solution.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Solution {
@@ -315,14 +365,19 @@ pub fn solve_with(
 ) -> Result<Solution, Infeasible> {
     let (cands, branch) = candidates(shape, req, refs, opts)?;
     let mut worst = Infeasible::SignRule;
-    let mut ok: Vec<Candidate> = Vec::with_capacity(2);
-    for c in cands {
-        match admissible(shape, &c, opts.admissible_tol) {
-            Ok(()) => ok.push(c),
+    let mut ok = [Roots::EMPTY; 2];
+    let mut n_ok = 0;
+    for c in cands.iter() {
+        match admissible(shape, c, opts.admissible_tol) {
+            Ok(()) => {
+                ok[n_ok] = *c;
+                n_ok += 1;
+            }
             Err(e) => worst = later(worst, e),
         }
     }
-    choose(&mut ok, t_orig);
+    let ok = &mut ok[..n_ok];
+    choose(ok, t_orig);
     let Some(best) = ok.first() else {
         return Err(worst);
     };
@@ -351,7 +406,15 @@ pub fn solve_with(
 /// pair when `t_orig` is `None`) to the smaller `T` (§6.5).
 fn choose(ok: &mut [Candidate], t_orig: Option<f64>) {
     let key = |c: &Candidate| t_orig.map_or(0.0, |t| (c.t_e - t).abs());
-    ok.sort_by(|a, b| key(a).total_cmp(&key(b)).then(a.t_e.total_cmp(&b.t_e)));
+    if let [a, b] = ok {
+        if key(b)
+            .total_cmp(&key(a))
+            .then(b.t_e.total_cmp(&a.t_e))
+            .is_lt()
+        {
+            std::mem::swap(a, b);
+        }
+    }
 }
 
 /// The later of two rule failures (rule 1 < rule 2 < rule 3).
@@ -383,7 +446,7 @@ pub fn candidates(
     req: &Request,
     refs: &Refs,
     opts: &SolveOptions,
-) -> Result<(Vec<Candidate>, Branch), Infeasible> {
+) -> Result<(Roots, Branch), Infeasible> {
     let inputs = [
         req.zs,
         req.vs,
@@ -445,7 +508,7 @@ pub fn candidates(
         }
         let t = refs.beta_v * jv / g;
         if t <= 0.0 {
-            return Ok((vec![sign_fail(t, beta_p)], Branch::NoNetHorizontal));
+            return Ok((Roots::one(sign_fail(t, beta_p)), Branch::NoNetHorizontal));
         }
         let mut c = make(t, 0.0);
         let moment_scale = shape.dt * shape.j_scale[0];
@@ -458,18 +521,18 @@ pub fn candidates(
         } else {
             (rest - req.x) / kh
         };
-        return Ok((vec![c], Branch::NoNetHorizontal));
+        return Ok((Roots::one(c), Branch::NoNetHorizontal));
     }
     let beta_h = d / jh;
     let sh = kh / jh;
     let a = (req.vs + req.ve) / 2.0;
     let b = -(req.x + d * (sh - sv));
     let c = d * dz / g;
-    let free = |t: f64| {
-        if t <= 0.0 {
-            vec![sign_fail(t, beta_p)]
+    let at = |t: f64| {
+        if t > 0.0 && t.is_finite() {
+            make(t, beta_h)
         } else {
-            vec![make(t, beta_h)]
+            sign_fail(t, beta_p)
         }
     };
     if a == 0.0 {
@@ -478,15 +541,12 @@ pub fn candidates(
         let c_tol = opts.match_tol * 1f64.max(d.abs()).max(dz.abs());
         if b.abs() > b_tol {
             let t = -c / b;
-            return Ok((
-                roots_to_candidates(&[t], beta_p, &make, beta_h),
-                Branch::Linear,
-            ));
+            return Ok((Roots::one(at(t)), Branch::Linear));
         }
         if c.abs() > c_tol {
             return Err(Infeasible::NoRoot);
         }
-        return Ok((free(refs.beta_v * jv / g), Branch::FreePeriod));
+        return Ok((Roots::one(at(refs.beta_v * jv / g)), Branch::FreePeriod));
     }
     let mut disc = b * b - 4.0 * a * c;
     if disc < 0.0 {
@@ -500,17 +560,14 @@ pub fn candidates(
         return Err(Infeasible::NonFinite);
     }
     let q = -0.5 * (b + b.signum() * disc.sqrt());
-    let roots: Vec<f64> = if q == 0.0 {
-        vec![0.0] // b = 0 and disc = 0 ⇒ c = 0: the double root T = 0
+    let roots = if q == 0.0 {
+        Roots::one(at(0.0)) // b = 0 and disc = 0 ⇒ c = 0: the double root T = 0
     } else if disc == 0.0 {
-        vec![q / a]
+        Roots::one(at(q / a))
     } else {
-        vec![q / a, c / q]
+        Roots::two(at(q / a), at(c / q))
     };
-    Ok((
-        roots_to_candidates(&roots, beta_p, &make, beta_h),
-        Branch::Quadratic,
-    ))
+    Ok((roots, Branch::Quadratic))
 }
 
 /// A placeholder candidate for `T ≤ 0` (no `t_TD` exists); it fails rule 1.
@@ -522,24 +579,6 @@ fn sign_fail(t: f64, beta_p: f64) -> Candidate {
         u: 0.0,
         w: 0.0,
     }
-}
-
-fn roots_to_candidates(
-    roots: &[f64],
-    beta_p: f64,
-    make: &dyn Fn(f64, f64) -> Candidate,
-    beta_h: f64,
-) -> Vec<Candidate> {
-    roots
-        .iter()
-        .map(|&t| {
-            if t > 0.0 && t.is_finite() {
-                make(t, beta_h)
-            } else {
-                sign_fail(t, beta_p)
-            }
-        })
-        .collect()
 }
 
 /// §6.5 rules 1–3 for one candidate, with slack `tol`.

@@ -58,6 +58,19 @@ impl Boundary {
             Boundary::Unsupported => "unsupported",
         }
     }
+
+    /// The kind named `s` in `stances.parquet` (inverse of [`Boundary::as_str`]).
+    pub fn parse(s: &str) -> Option<Self> {
+        [
+            Boundary::Flight,
+            Boundary::NoFlight,
+            Boundary::Rest,
+            Boundary::ClipEdge,
+            Boundary::Unsupported,
+        ]
+        .into_iter()
+        .find(|b| b.as_str() == s)
+    }
 }
 
 /// One stance's frames and boundary kinds.

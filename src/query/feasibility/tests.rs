@@ -4,78 +4,22 @@
 use super::*;
 use crate::constraints::{com_offset, precompute};
 use crate::force_model::AxisModel;
+use crate::query::testkit::{bell_model as random_model, Lcg};
 use std::f64::consts::PI;
-
-/// A 64-bit LCG (Knuth's MMIX constants) for seeded test data.
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> u64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        self.0 >> 11
-    }
-
-    /// Uniform in `[lo, hi)`.
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next() as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform integer in `1..=hi`.
-    fn harmonic(&mut self, hi: u64) -> u32 {
-        (1 + self.next() % hi) as u32
-    }
-}
-
-/// DC `c0` plus 1–3 harmonics `j ∈ 1..=6` of amplitude up to `amp`, N.
-fn random_axis(rng: &mut Lcg, c0: f64, amp: f64) -> AxisModel {
-    let n = 1 + (rng.next() % 3) as usize;
-    AxisModel {
-        c0,
-        harmonics: (0..n).map(|_| rng.harmonic(6)).collect(),
-        amps: (0..n).map(|_| rng.uniform(0.0, amp)).collect(),
-        phases: (0..n).map(|_| rng.uniform(-PI, PI)).collect(),
-        fit_rms: 0.0,
-    }
-}
-
-/// A stance-like model: vertical bell `A(1 − cos 2πτ)` plus small ringing, random
-/// horizontal forces.
-fn random_model(rng: &mut Lcg) -> ForceModel {
-    let mass_kg = rng.uniform(40.0, 100.0);
-    let weight = mass_kg * GRAVITY;
-    let bell = rng.uniform(1.0, 3.0) * weight;
-    let mut v = random_axis(rng, bell, 0.04 * weight);
-    v.harmonics.push(1);
-    v.amps.push(bell);
-    v.phases.push(PI);
-    let (h_dc, p_dc) = (rng.uniform(-0.3, 0.3), rng.uniform(-0.1, 0.1));
-    ForceModel {
-        mass_kg,
-        dt_s: rng.uniform(0.15, 0.5),
-        axes: [
-            random_axis(rng, h_dc * weight, 0.5 * weight),
-            random_axis(rng, p_dc * weight, 0.2 * weight),
-            v,
-        ],
-    }
-}
 
 /// A running-like context.
 fn random_context(rng: &mut Lcg) -> QueryContext {
     QueryContext {
-        vs: rng.uniform(0.0, 6.0),
-        vps: rng.uniform(-0.5, 0.5),
-        t_td: rng.uniform(0.05, 0.4),
-        z_td: rng.uniform(0.8, 1.1),
-        cp: [rng.uniform(-0.3, 0.5), rng.uniform(-0.2, 0.2)],
+        vs: rng.range(0.0, 6.0),
+        vps: rng.range(-0.5, 0.5),
+        t_td: rng.range(0.05, 0.4),
+        z_td: rng.range(0.8, 1.1),
+        cp: [rng.range(-0.3, 0.5), rng.range(-0.2, 0.2)],
     }
 }
 
 fn beta_in(rng: &mut Lcg, lo: f64, hi: f64) -> [f64; 3] {
-    [0; 3].map(|_| rng.uniform(lo, hi))
+    [0; 3].map(|_| rng.range(lo, hi))
 }
 
 /// `|x − y| ≤ tol · max(1, |y|)`.
@@ -95,8 +39,8 @@ fn approx_never_accepts_what_exact_rejects() {
         let base = relative_limits(&coef);
         for _ in 0..100 {
             let lim = Limits {
-                mu: base.mu * rng.uniform(0.5, 2.0),
-                f_max: base.f_max * rng.uniform(0.5, 3.0),
+                mu: base.mu * rng.range(0.5, 2.0),
+                f_max: base.f_max * rng.range(0.5, 3.0),
                 ..base
             };
             let beta = beta_in(&mut rng, 0.0, 3.0);
@@ -389,7 +333,7 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
         let ctx = random_context(&mut rng);
         let coef = precompute(&model, &ctx);
         let base = relative_limits(&coef);
-        let (l, m) = (rng.uniform(0.5, 2.0), rng.uniform(0.3, 4.0));
+        let (l, m) = (rng.range(0.5, 2.0), rng.range(0.3, 4.0));
         let (sl, s_model) = (l.sqrt(), scale_model(&model, l, m));
         let s_ctx = QueryContext {
             vs: ctx.vs * sl,
@@ -404,10 +348,10 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
         for _ in 0..25 {
             let beta = beta_in(&mut rng, 0.5, 1.6);
             let lim = Limits {
-                mu: base.mu * rng.uniform(0.8, 1.5),
-                f_max: base.f_max * rng.uniform(0.8, 1.5),
-                chi_min: base.chi_min * rng.uniform(0.7, 1.2),
-                chi_max: base.chi_max * rng.uniform(0.9, 1.2),
+                mu: base.mu * rng.range(0.8, 1.5),
+                f_max: base.f_max * rng.range(0.8, 1.5),
+                chi_min: base.chi_min * rng.range(0.7, 1.2),
+                chi_max: base.chi_max * rng.range(0.9, 1.2),
             };
             let s_lim = Limits {
                 mu: lim.mu,

@@ -1,0 +1,145 @@
+//! The stances a query draws from: one library row with the per-stance tables every query
+//! reuses, and the new-character map of dynamic similarity (spec stance-model §9).
+//!
+//! # Model
+//! ```text
+//! length, position, zs, ze, x, z_c, cp, χ, ext      × L        mass, force, c0, c_i, F      × M
+//! time, Δt, t_TD, t_LO, T                            × √L       velocity vs, ve, vp, vps     × √L
+//! A^F (force²)                                       × M²       A^μ, μ, β, j, φ              × 1
+//! angular impulse H, H_0                             × M L^{3/2}
+//! ```
+//! `L = L_leg,target / L_leg,source`, `M = m_target / m_source`, `g` unchanged (Froude
+//! scaling: base factors mass `M`, length `L`, time `√L`).
+//!
+//! # References
+//! spec stance-model §9 (table), §7.2 (what is stored per stance), §11 (columns).
+
+use crate::constraints::{Coefficients, SampledTables, StanceContext};
+use crate::force_model::ForceModel;
+use crate::stances::params::StanceParams;
+use crate::stances::segment::Boundary;
+
+use super::feasibility::ImpulseMoments;
+use super::solve::StanceShape;
+
+/// One stance of the library as the queries use it (a `stances.parquet` row).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoolStance {
+    /// `<clip>:<label>:<first frame>`.
+    pub stance_id: String,
+    /// Clip name.
+    pub clip: String,
+    /// Character id (§11).
+    pub character_id: String,
+    /// `L`, `R`, `LR`, …
+    pub label: String,
+    /// First stance frame (file row).
+    pub first_frame: i64,
+    /// What precedes the stance.
+    pub boundary_start: Boundary,
+    /// What follows the stance.
+    pub boundary_end: Boundary,
+    /// Contact height `z_c`, m.
+    pub z_c: f64,
+    /// Model-consistent parameters (§3).
+    pub params: StanceParams,
+    /// The force model (stance axes).
+    pub model: ForceModel,
+    /// Data contact point `(cp_h, cp_p)`, m.
+    pub cp: [f64; 2],
+    /// Stored coefficients and original extremes (§7.2).
+    pub coef: Coefficients,
+}
+
+impl PoolStance {
+    /// The stance's own context `(vs, vps, t_TD, z_TD, cp)` (§7.3).
+    pub fn context(&self) -> StanceContext {
+        StanceContext {
+            vs: self.params.vs,
+            vps: self.params.vps,
+            t_td: self.params.t_td,
+            z_td: self.params.z_td,
+            cp: self.cp,
+        }
+    }
+
+    /// The same stance performed by a character `L` times as long and `M` times as heavy
+    /// (§9); `L = M = 1` returns an identical copy.
+    pub fn scaled(&self, length: f64, mass: f64) -> PoolStance {
+        let (l, m, t) = (length, mass, length.sqrt());
+        let p = &self.params;
+        let params = StanceParams {
+            zs: p.zs * l,
+            vs: p.vs * t,
+            ze: p.ze * l,
+            ve: p.ve * t,
+            vp: p.vp * t,
+            vps: p.vps * t,
+            x: p.x * l,
+            z_td: p.z_td * l,
+            z_lo: p.z_lo * l,
+            t_td: p.t_td * t,
+            t_lo: p.t_lo * t,
+            t_e: p.t_e * t,
+        };
+        let mut model = self.model.clone();
+        model.mass_kg *= m;
+        model.dt_s *= t;
+        for axis in &mut model.axes {
+            axis.c0 *= m;
+            axis.amps.iter_mut().for_each(|c| *c *= m);
+            axis.fit_rms *= m;
+        }
+        let c = &self.coef;
+        let ang = m * l * t;
+        let coef = Coefficients {
+            a_f: c.a_f.map(|v| v * m * m),
+            min_f_v: c.min_f_v * m,
+            f_peak: c.f_peak * m,
+            ext_min: c.ext_min * l,
+            ext_max: c.ext_max * l,
+            ang_impulse: c.ang_impulse.map(|v| v * ang),
+            ang_impulse_h0: c.ang_impulse_h0.map(|v| v * ang),
+            ..*c
+        };
+        PoolStance {
+            z_c: self.z_c * l,
+            params,
+            model,
+            cp: self.cp.map(|v| v * l),
+            coef,
+            ..self.clone()
+        }
+    }
+}
+
+/// A stance with the tables every query of it reuses (built once, O(N_s)).
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The library row.
+    pub stance: PoolStance,
+    /// Solver view: `J`, `K`, `Δt`, boundary rules, reference centroid signs.
+    pub shape: StanceShape,
+    /// `f_a(τ_k)`, `S_a(τ_k)` on the stance's grid (§7.4).
+    pub tables: SampledTables,
+    /// Context-free moments of the contact point (§8.3).
+    pub moments: ImpulseMoments,
+}
+
+impl Prepared {
+    /// Builds the tables of `stance`.
+    pub fn new(stance: PoolStance) -> Self {
+        let shape = StanceShape::from_boundaries(
+            &stance.model,
+            stance.boundary_start,
+            stance.boundary_end,
+            &stance.params,
+        );
+        Prepared {
+            tables: SampledTables::new(&stance.model),
+            moments: ImpulseMoments::new(&stance.model),
+            shape,
+            stance,
+        }
+    }
+}
