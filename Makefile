@@ -17,10 +17,12 @@ lint:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets -- -D warnings
 
-## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances (library).
+## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances
+## (library); candidate evaluations and the 200 × 200 jump map (queries).
 bench:
 	$(CARGO) bench --bench stages
 	$(CARGO) bench --bench library
+	$(CARGO) bench --bench queries
 
 ## The nightly job over ../shared/data (pipelines/nightly.toml).
 nightly:

@@ -31,6 +31,7 @@ pub mod ingest;
 pub mod library;
 pub mod math;
 pub mod pipeline;
+pub mod plot;
 pub mod query;
 pub mod skeleton;
 pub mod stances;

@@ -23,6 +23,7 @@ mod forceplate;
 mod forceplate_stances;
 mod multicontact;
 mod props;
+mod queries;
 mod readers;
 mod real_data;
 mod regression;

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::pipeline::spec::Overrides;
+use crate::query::map::Axis;
 use crate::skeleton::units::{parse_unit, UpAxis};
 
 /// stancelib: physically grounded stance libraries from motion-capture clips.
@@ -27,6 +28,144 @@ pub enum Command {
     Build(BuildArgs),
     /// Write a generated clip with known ground truth (fixtures).
     Synth(SynthArgs),
+    /// Scaled runs and jumps from a stance library.
+    #[command(subcommand)]
+    Query(QueryCommand),
+    /// Feasibility maps over a stance library.
+    #[command(subcommand)]
+    Map(MapCommand),
+}
+
+/// `stancelib query …`.
+#[derive(Debug, Subcommand)]
+pub enum QueryCommand {
+    /// Steady run cycles at a speed, by scaling recorded running stances (§6.8).
+    Run(RunQueryArgs),
+    /// Jumps of a height and distance from a liftoff and a landing stance (§6.9).
+    Jump(JumpArgs),
+}
+
+/// `stancelib map …`.
+#[derive(Debug, Subcommand)]
+pub enum MapCommand {
+    /// Jump feasibility over (u_apex, height) for every liftoff/landing pair (§6.10).
+    Jumps(MapJumpsArgs),
+}
+
+/// Parses `start:stop:step` (inclusive) into an axis.
+///
+/// # Errors
+/// Not three numbers, a step ≤ 0 or stop < start.
+pub fn parse_range(flag: &str, s: &str) -> anyhow::Result<Axis> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let nums: Option<Vec<f64>> = parts.iter().map(|p| p.trim().parse().ok()).collect();
+    match nums.as_deref() {
+        Some(&[start, stop, step])
+            if [start, stop, step].iter().all(|v| v.is_finite()) && step > 0.0 && stop >= start =>
+        {
+            Ok(Axis { start, stop, step })
+        }
+        _ => anyhow::bail!(
+            "{flag}: expected start:stop:step with step > 0 and stop ≥ start, found '{s}'"
+        ),
+    }
+}
+
+/// `stancelib query run`.
+#[derive(Debug, Args)]
+pub struct RunQueryArgs {
+    /// Library folder (from `build` or `run`).
+    #[arg(long)]
+    pub lib: PathBuf,
+    /// Target speed, m/s.
+    #[arg(long, conflicts_with = "speeds")]
+    pub speed: Option<f64>,
+    /// A sweep of target speeds `start:stop:step` in m/s (e.g. 0:6:0.5 for Table 1).
+    #[arg(long)]
+    pub speeds: Option<String>,
+    /// Leg-length ratio target/recorded character (dynamic similarity, §9).
+    #[arg(long = "length-scale", default_value_t = 1.0)]
+    pub length_scale: f64,
+    /// Body-mass ratio target/recorded character.
+    #[arg(long = "mass-scale", default_value_t = 1.0)]
+    pub mass_scale: f64,
+    /// Output Parquet file.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+impl RunQueryArgs {
+    /// The requested speeds.
+    ///
+    /// # Errors
+    /// Neither option, a bad range, or a negative or non-finite speed.
+    pub fn speeds(&self) -> anyhow::Result<Vec<f64>> {
+        let v = match (&self.speeds, self.speed) {
+            (Some(r), _) => parse_range("--speeds", r)?.values(),
+            (None, Some(v)) => vec![v],
+            (None, None) => anyhow::bail!("give --speed V or --speeds start:stop:step"),
+        };
+        if let Some(bad) = v.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            anyhow::bail!("speeds must be finite and ≥ 0 m/s, found {bad}");
+        }
+        Ok(v)
+    }
+}
+
+/// `stancelib query jump`.
+#[derive(Debug, Args)]
+pub struct JumpArgs {
+    /// Library folder.
+    #[arg(long)]
+    pub lib: PathBuf,
+    /// Flight apex height above the liftoff contact, m.
+    #[arg(long, allow_hyphen_values = true)]
+    pub height: f64,
+    /// Jump distance (liftoff start apex to landing end apex, along the heading), m;
+    /// negative is backwards.
+    #[arg(long, allow_hyphen_values = true)]
+    pub distance: f64,
+    /// Rows printed (the file has every pair).
+    #[arg(long, default_value_t = 10)]
+    pub top: usize,
+    /// Output Parquet file.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `stancelib map jumps`.
+#[derive(Debug, Args)]
+pub struct MapJumpsArgs {
+    /// Library folder.
+    #[arg(long)]
+    pub lib: PathBuf,
+    /// Rows: apex heights `start:stop:step`, m.
+    #[arg(long, default_value = "0.6:1.6:0.02")]
+    pub heights: String,
+    /// Columns: horizontal apex speeds `start:stop:step`, m/s.
+    #[arg(long, default_value = "0:5:0.05")]
+    pub speeds: String,
+    /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+impl MapJumpsArgs {
+    /// The height axis.
+    ///
+    /// # Errors
+    /// A bad range.
+    pub fn heights(&self) -> anyhow::Result<Axis> {
+        parse_range("--heights", &self.heights)
+    }
+
+    /// The speed axis.
+    ///
+    /// # Errors
+    /// A bad range.
+    pub fn speeds(&self) -> anyhow::Result<Axis> {
+        parse_range("--speeds", &self.speeds)
+    }
 }
 
 /// Options shared by `frames` and `run` (each wins over the pipeline and body files).

@@ -3,7 +3,7 @@
 pub mod args;
 pub mod cmd;
 
-use args::{Cli, Command};
+use args::{Cli, Command, MapCommand, QueryCommand};
 
 /// How a command finished (fatal errors are `Err`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -26,5 +26,8 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Run(a) => cmd::run::run(a),
         Command::Build(a) => cmd::build::run(a),
         Command::Synth(a) => cmd::synth::run(a),
+        Command::Query(QueryCommand::Run(a)) => cmd::query::run(a),
+        Command::Query(QueryCommand::Jump(a)) => cmd::query::run_jump(a),
+        Command::Map(MapCommand::Jumps(a)) => cmd::map::run(a),
     }
 }

@@ -10,7 +10,10 @@
 //! Stance frame (h, p, v), SI units; heights above the contact height `z_c`.
 
 pub mod feasibility;
+pub mod jump;
+pub mod map;
 pub mod pool;
+pub mod run;
 pub mod solve;
 
 #[cfg(test)]

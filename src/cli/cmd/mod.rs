@@ -2,5 +2,7 @@
 
 pub mod build;
 pub mod frames;
+pub mod map;
+pub mod query;
 pub mod run;
 pub mod synth;

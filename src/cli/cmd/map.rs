@@ -1,0 +1,90 @@
+//! `stancelib map jumps`: the jump feasibility map of a library (spec stance-model §6.10)
+//! as `jump_map.parquet`, `jump_map_pairs.parquet`, `jump_map.json` and `jump_map.png`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Context;
+
+use super::super::args::MapJumpsArgs;
+use super::super::Outcome;
+use super::query::{load_pool, query_kv};
+use crate::library::queries::{jump_map_table, jump_pairs_table};
+use crate::library::write::write_atomic;
+use crate::plot::jump_map_png;
+use crate::query::map::jump_map;
+
+/// Draws the PNG under a temporary name, then renames it into place.
+fn write_png(dir: &Path, map: &crate::query::map::JumpMap) -> anyhow::Result<()> {
+    let path = dir.join("jump_map.png");
+    let tmp = dir.join(format!(".jump_map.png.tmp-{}.png", std::process::id()));
+    let drawn = jump_map_png(&tmp, map)
+        .map_err(anyhow::Error::from)
+        .and_then(|()| std::fs::rename(&tmp, &path).context("cannot rename jump_map.png"));
+    if drawn.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    drawn
+}
+
+/// Run `map jumps`.
+///
+/// # Errors
+/// Bad grid options, an unreadable library, an unwritable output folder.
+pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
+    let (heights, speeds) = (a.heights()?.values(), a.speeds()?.values());
+    anyhow::ensure!(
+        !heights.is_empty() && !speeds.is_empty(),
+        "the grid is empty: check --heights and --speeds"
+    );
+    let (_, pool) = load_pool(&a.lib)?;
+    let t0 = Instant::now();
+    let map = jump_map(&pool, &heights, &speeds);
+    let elapsed = t0.elapsed().as_secs_f64();
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("cannot create {}", a.out.display()))?;
+    let iou = map.agreement.iou();
+    let summary = serde_json::json!({
+        "heights_m": {"start": heights[0], "stop": heights[heights.len() - 1], "n": heights.len()},
+        "u_apex_mps": {"start": speeds[0], "stop": speeds[speeds.len() - 1], "n": speeds.len()},
+        "liftoffs": map.liftoffs.len(), "landings": map.landings.len(), "pairs": map.pairs.len(),
+        "cells_approx": map.agreement.approx, "cells_exact": map.agreement.exact,
+        "cells_both": map.agreement.both, "iou": iou,
+        "limits": "relative per stance (stance-model §7.5)",
+    });
+    let kv = query_kv(summary.clone());
+    write_atomic(
+        &a.out,
+        "jump_map.parquet",
+        &mut jump_map_table(&map, &pool)?,
+        &kv,
+    )?;
+    write_atomic(
+        &a.out,
+        "jump_map_pairs.parquet",
+        &mut jump_pairs_table(&map, &pool)?,
+        &kv,
+    )?;
+    let json_tmp = a
+        .out
+        .join(format!(".jump_map.json.tmp-{}", std::process::id()));
+    std::fs::write(&json_tmp, serde_json::to_string_pretty(&summary)? + "\n")
+        .with_context(|| format!("cannot write {}", json_tmp.display()))?;
+    std::fs::rename(&json_tmp, a.out.join("jump_map.json"))
+        .context("cannot write jump_map.json")?;
+    write_png(&a.out, &map)?;
+    println!(
+        "map jumps: {} liftoff(s) × {} landing(s) → {} pair(s) of one character, {} × {} cells",
+        map.liftoffs.len(),
+        map.landings.len(),
+        map.pairs.len(),
+        heights.len(),
+        speeds.len()
+    );
+    println!(
+        "  cells feasible: approx {}, exact {}, both {}; IoU = {iou:.4}; computed in {elapsed:.3} s",
+        map.agreement.approx, map.agreement.exact, map.agreement.both
+    );
+    println!("  → {}", a.out.display());
+    Ok(Outcome::Clean)
+}

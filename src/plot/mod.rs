@@ -1,0 +1,225 @@
+//! Plots (PNG) of query results, drawn with plotters and an embedded font, so they render
+//! on a machine without fontconfig or system fonts.
+//!
+//! The font is DejaVu Sans (Bitstream Vera licence, see `DejaVuSans-LICENSE.txt`).
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+use crate::query::map::JumpMap;
+
+/// DejaVu Sans, registered as the `sans-serif` family on first use.
+static FONT: &[u8] = include_bytes!("DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+fn register_font() {
+    REGISTER.call_once(|| {
+        // The bytes are a valid TTF (checked by the plot test); a failure leaves plotters
+        // without a font and its text calls return an error, not a panic.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// Errors of the plot writers.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: cannot draw plot: {msg}")]
+pub struct PlotError {
+    /// The output file.
+    pub path: String,
+    /// What failed.
+    pub msg: String,
+}
+
+fn err(path: &Path, e: impl std::fmt::Display) -> PlotError {
+    PlotError {
+        path: path.display().to_string(),
+        msg: e.to_string(),
+    }
+}
+
+/// Per (distance bin, height row): pairs feasible by both, approx only, exact only.
+struct Binned {
+    d0: f64,
+    width: f64,
+    n_d: usize,
+    cells: Vec<[u32; 3]>,
+    max_exact: u32,
+}
+
+fn bin(map: &JumpMap, width: f64) -> Option<Binned> {
+    let n_u = map.speeds.len();
+    let mut range = (f64::INFINITY, f64::NEG_INFINITY);
+    let each = |f: &mut dyn FnMut(usize, f64, bool, bool)| {
+        for p in &map.pairs {
+            for (r, row) in p.rows.iter().enumerate() {
+                let Some((d, c, _)) = row else { continue };
+                for (q, &u) in map.speeds.iter().enumerate() {
+                    let (a, e) = (p.approx[r * n_u + q], p.exact[r * n_u + q]);
+                    if a || e {
+                        f(r, u * d + c, a, e);
+                    }
+                }
+            }
+        }
+    };
+    each(&mut |_, d, _, _| range = (range.0.min(d), range.1.max(d)));
+    if !range.0.is_finite() {
+        return None;
+    }
+    let d0 = (range.0 / width).floor() * width;
+    let n_d = ((range.1 - d0) / width).floor() as usize + 1;
+    let mut cells = vec![[0u32; 3]; n_d * map.heights.len()];
+    each(&mut |r, d, a, e| {
+        let k = (((d - d0) / width) as usize).min(n_d - 1);
+        let kind = match (a, e) {
+            (true, true) => 0,
+            (true, false) => 1,
+            _ => 2,
+        };
+        cells[r * n_d + k][kind] += 1;
+    });
+    let max_exact = cells.iter().map(|c| c[0] + c[2]).max().unwrap_or(0);
+    Some(Binned {
+        d0,
+        width,
+        n_d,
+        cells,
+        max_exact,
+    })
+}
+
+type Chart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// One panel: distance (m) against apex height (m), with a mesh and axis names.
+fn panel<'a, 'b>(
+    area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
+    path: &Path,
+    caption: &str,
+    (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
+) -> Result<Chart<'a, 'b>, PlotError> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x, y)
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("jump distance d_jump (m)")
+        .y_desc("apex height above the liftoff contact (m)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| err(path, e))?;
+    Ok(chart)
+}
+
+/// `jump_map.png`: left, how many liftoff/landing pairs can make each (distance, height)
+/// by the exact check (Figure 4 over the whole pool); right, where the fast filters and
+/// the exact check agree (Figure 5).
+///
+/// # Errors
+/// The file cannot be written or the font cannot be used.
+pub fn jump_map_png(path: &Path, map: &JumpMap) -> Result<(), PlotError> {
+    register_font();
+    let root = BitMapBackend::new(path, (1500, 650)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let title = format!(
+        "Jump feasibility map: {} liftoff × landing pairs, library IoU(approx, exact) = {:.3}",
+        map.pairs.len(),
+        map.agreement.iou()
+    );
+    let root = root
+        .titled(&title, ("sans-serif", 22))
+        .map_err(|e| err(path, e))?;
+    let (left, right) = root.split_horizontally(750);
+    let (h0, h1) = (
+        map.heights.first().copied().unwrap_or(0.0),
+        map.heights.last().copied().unwrap_or(1.0),
+    );
+    let dh = map.heights.get(1).map_or(0.02, |h| h - h0);
+    let b = bin(map, 0.05);
+    let (x0, x1) = b
+        .as_ref()
+        .map_or((0.0, 1.0), |b| (b.d0, b.d0 + b.n_d as f64 * b.width));
+    let ranges = (x0..x1, (h0 - dh / 2.0)..(h1 + dh / 2.0));
+    let mut l = panel(
+        &left,
+        path,
+        "Exact check: feasible pairs per cell",
+        ranges.clone(),
+    )?;
+    let mut r = panel(
+        &right,
+        path,
+        "Fast filters (eq 10, 12) vs exact check (§7.4)",
+        ranges,
+    )?;
+    let rect = |b: &Binned, k: usize, row: usize| {
+        let x = b.d0 + k as f64 * b.width;
+        let y = h0 + row as f64 * dh;
+        [(x, y - dh / 2.0), (x + b.width, y + dh / 2.0)]
+    };
+    let colours = [
+        RGBColor(46, 139, 87),
+        RGBColor(255, 140, 0),
+        RGBColor(65, 105, 225),
+    ];
+    if let Some(b) = &b {
+        let mut exact = Vec::new();
+        let mut agree = Vec::new();
+        for row in 0..map.heights.len() {
+            for k in 0..b.n_d {
+                let c = b.cells[row * b.n_d + k];
+                let n_exact = c[0] + c[2];
+                if n_exact > 0 {
+                    let shade = 0.15 + 0.85 * f64::from(n_exact) / f64::from(b.max_exact.max(1));
+                    exact.push(Rectangle::new(rect(b, k, row), BLUE.mix(shade).filled()));
+                }
+                let kind = (0..3).max_by_key(|&i| (c[i], 3 - i)).unwrap_or(0);
+                if c.iter().any(|&n| n > 0) {
+                    agree.push((kind, rect(b, k, row)));
+                }
+            }
+        }
+        l.draw_series(exact)
+            .map_err(|e| err(path, e))?
+            .label(format!(
+                "darker = more feasible (pair, cell)s, max {}",
+                b.max_exact
+            ))
+            .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], BLUE.filled()));
+        let names = ["both feasible", "approx only", "exact only"];
+        for (kind, name) in names.iter().enumerate() {
+            let rects = agree
+                .iter()
+                .filter(|(k, _)| *k == kind)
+                .map(|(_, c)| Rectangle::new(*c, colours[kind].filled()));
+            let colour = colours[kind];
+            r.draw_series(rects)
+                .map_err(|e| err(path, e))?
+                .label(*name)
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled())
+                });
+        }
+    }
+    for chart in [&mut l, &mut r] {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| err(path, e))?;
+    }
+    root.present().map_err(|e| err(path, e))?;
+    Ok(())
+}

@@ -1,0 +1,303 @@
+//! The jump feasibility map over a stance pool (spec stance-model §6.10, Figures 3–5).
+//!
+//! # Model
+//! ```text
+//! grid: rows h_r (apex height above the liftoff contact, m), columns u_q (u_apex, m/s)
+//! per stance and row (once): T(h_r), β_v, β_p; per column: β_h affine in u_q,
+//!     approx bit = eq 5 ∧ eq 10 ∧ eq 12 ∧ unilateral_ok ∧ §6.5 rules
+//!     exact bit  = the §7.4 check at the re-solved contact point ∧ §6.5 rules
+//! per pair (S1 liftoff, S2 landing, same character_id) and cell:
+//!     feasible_approx = A1 ∧ A2,   feasible_exact = E1 ∧ E2
+//!     d_jump = u_q·D(h_r) + C(h_r),  flight_time = (T1 − τ1 − Δt1) + t_TD2
+//! IoU = |A ∩ E| / |A ∪ E|   (1 when both are empty)
+//! ```
+//! Cost: `O((n1 + n2)·n_h·n_u·N_s)` for the per-stance work, `O(n1·n2·n_h·n_u)` bit
+//! operations for the pairs. Limits are relative per stance (§7.5) unless given.
+//!
+//! # References
+//! spec stance-model §6.9–§6.10, §7.3–§7.5; CORRECTIONS Issue 4 items 1, 3, 6.
+
+use rayon::prelude::*;
+
+use super::feasibility::{relative_limits, Limits};
+use super::jump::Side;
+use super::jump::{
+    distance_map, is_landing, is_liftoff, landing_side, liftoff_side, side_solution,
+};
+use super::pool::Prepared;
+use super::run::verdicts;
+
+/// An inclusive grid `start, start + step, …, ≤ stop` (with a 1e-9·step slack on `stop`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Axis {
+    /// First value.
+    pub start: f64,
+    /// Last value (inclusive when on the grid).
+    pub stop: f64,
+    /// Step (> 0).
+    pub step: f64,
+}
+
+impl Axis {
+    /// The values of the axis.
+    pub fn values(&self) -> Vec<f64> {
+        if !(self.step > 0.0 && self.start.is_finite() && self.stop.is_finite()) {
+            return Vec::new();
+        }
+        let n = ((self.stop - self.start) / self.step + 1e-9).floor();
+        if n < 0.0 {
+            return Vec::new();
+        }
+        (0..=n as usize)
+            .map(|i| self.start + i as f64 * self.step)
+            .collect()
+    }
+}
+
+/// Default rows: apex height 0.60 to 1.60 m in 0.02 m steps (§6.10).
+pub const DEFAULT_HEIGHTS: Axis = Axis {
+    start: 0.60,
+    stop: 1.60,
+    step: 0.02,
+};
+/// Default columns: `u_apex` 0 to 5 m/s in 0.05 m/s steps (§6.10).
+pub const DEFAULT_SPEEDS: Axis = Axis {
+    start: 0.0,
+    stop: 5.0,
+    step: 0.05,
+};
+
+/// One stance's verdicts over the grid (row-major, `n_h × n_u`) and its per-row side.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceGrid {
+    /// Per row: the `u_apex`-independent side, or `None` when the row has no solution.
+    pub sides: Vec<Option<Side>>,
+    /// Approximate verdict per cell.
+    pub approx: Vec<bool>,
+    /// Exact verdict per cell.
+    pub exact: Vec<bool>,
+}
+
+/// The verdicts of one stance over the grid (§6.10 steps 1–2).
+///
+/// `liftoff` selects pin_start (rows are `h_r`) or pin_end (rows are `h_r + z_c1 − z_c2`
+/// with `dz = z_c1 − z_c2` of the pair: pass `dz = 0` for a pool on level ground; a pair with
+/// another `dz` needs its own grid).
+pub fn stance_grid(
+    p: &Prepared,
+    liftoff: bool,
+    heights: &[f64],
+    speeds: &[f64],
+    dz: f64,
+    lim: &Limits,
+) -> StanceGrid {
+    let n = heights.len() * speeds.len();
+    let mut out = StanceGrid {
+        sides: Vec::with_capacity(heights.len()),
+        approx: vec![false; n],
+        exact: vec![false; n],
+    };
+    for (r, &h) in heights.iter().enumerate() {
+        let side = if liftoff {
+            liftoff_side(p, h)
+        } else {
+            landing_side(p, h + dz)
+        }
+        .ok();
+        out.sides.push(side);
+        let Some(side) = side else { continue };
+        for (q, &u) in speeds.iter().enumerate() {
+            let Ok((req, sol)) = side_solution(p, &side, liftoff, u) else {
+                continue;
+            };
+            let (a, e) = verdicts(p, &req, &sol, lim);
+            out.approx[r * speeds.len() + q] = a;
+            out.exact[r * speeds.len() + q] = e;
+        }
+    }
+    out
+}
+
+/// Counts of one pair's cells: approximate, exact, both, either.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Agreement {
+    /// Cells feasible by the approximate verdict.
+    pub approx: usize,
+    /// Cells feasible by the exact verdict.
+    pub exact: usize,
+    /// Cells feasible by both.
+    pub both: usize,
+    /// Cells feasible by either.
+    pub either: usize,
+}
+
+impl Agreement {
+    /// `|A ∩ E| / |A ∪ E|`, 1 when both are empty.
+    pub fn iou(&self) -> f64 {
+        if self.either == 0 {
+            1.0
+        } else {
+            self.both as f64 / self.either as f64
+        }
+    }
+
+    fn add(&mut self, o: &Agreement) {
+        self.approx += o.approx;
+        self.exact += o.exact;
+        self.both += o.both;
+        self.either += o.either;
+    }
+}
+
+/// One liftoff/landing pair of the map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairMap {
+    /// Index of the liftoff stance in the pool.
+    pub liftoff: usize,
+    /// Index of the landing stance in the pool.
+    pub landing: usize,
+    /// Per row: `(D, C, flight_time)`, `None` when either side has no solution.
+    pub rows: Vec<Option<(f64, f64, f64)>>,
+    /// Approximate verdict per cell (row-major).
+    pub approx: Vec<bool>,
+    /// Exact verdict per cell.
+    pub exact: Vec<bool>,
+    /// The pair's agreement counts.
+    pub agreement: Agreement,
+}
+
+/// The whole map: the grid, the per-stance grids and the pairs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JumpMap {
+    /// Row values `h_r`, m.
+    pub heights: Vec<f64>,
+    /// Column values `u_q`, m/s.
+    pub speeds: Vec<f64>,
+    /// Pool indices of the liftoff stances.
+    pub liftoffs: Vec<usize>,
+    /// Pool indices of the landing stances.
+    pub landings: Vec<usize>,
+    /// Every pair of one character.
+    pub pairs: Vec<PairMap>,
+    /// Library-wide counts over all pairs and cells.
+    pub agreement: Agreement,
+}
+
+/// Combines two stance grids into a pair's verdicts (§6.10 step 3).
+fn pair_map(
+    (i1, p1, g1): (usize, &Prepared, &StanceGrid),
+    (i2, p2, g2): (usize, &Prepared, &StanceGrid),
+    n_u: usize,
+) -> PairMap {
+    let rows: Vec<Option<(f64, f64, f64)>> = g1
+        .sides
+        .iter()
+        .zip(&g2.sides)
+        .map(|(a, b)| {
+            let (a, b) = (a.as_ref()?, b.as_ref()?);
+            let (d, c) = distance_map(p1, a, p2, b);
+            Some((d, c, a.flight_part + b.flight_part))
+        })
+        .collect();
+    let mut approx = vec![false; g1.approx.len()];
+    let mut exact = vec![false; g1.exact.len()];
+    let mut agreement = Agreement::default();
+    for (r, row) in rows.iter().enumerate() {
+        if row.is_none_or(|(d, _, _)| d.is_nan() || d <= 0.0) {
+            continue; // no distance for this row: its cells stay infeasible
+        }
+        for k in r * n_u..(r + 1) * n_u {
+            let a = g1.approx[k] && g2.approx[k];
+            let e = g1.exact[k] && g2.exact[k];
+            approx[k] = a;
+            exact[k] = e;
+            agreement.add(&Agreement {
+                approx: usize::from(a),
+                exact: usize::from(e),
+                both: usize::from(a && e),
+                either: usize::from(a || e),
+            });
+        }
+    }
+    PairMap {
+        liftoff: i1,
+        landing: i2,
+        rows,
+        approx,
+        exact,
+        agreement,
+    }
+}
+
+/// The jump map of a pool (§6.10): every liftoff paired with every landing of the same
+/// `character_id`, relative limits per stance. Parallel over stances and pairs.
+///
+/// Landings whose contact height differs from their liftoff's get their own grid per
+/// distinct height offset (level ground, the common case, shares one grid per stance).
+pub fn jump_map(pool: &[Prepared], heights: &[f64], speeds: &[f64]) -> JumpMap {
+    let liftoffs: Vec<usize> = (0..pool.len())
+        .filter(|&i| is_liftoff(&pool[i].stance))
+        .collect();
+    let landings: Vec<usize> = (0..pool.len())
+        .filter(|&i| is_landing(&pool[i].stance))
+        .collect();
+    let lim = |i: usize| relative_limits(&pool[i].stance.coef);
+    let up: Vec<StanceGrid> = liftoffs
+        .par_iter()
+        .map(|&i| stance_grid(&pool[i], true, heights, speeds, 0.0, &lim(i)))
+        .collect();
+    let pair_list: Vec<(usize, usize)> = (0..liftoffs.len())
+        .flat_map(|a| (0..landings.len()).map(move |b| (a, b)))
+        .filter(|&(a, b)| {
+            pool[liftoffs[a]].stance.character_id == pool[landings[b]].stance.character_id
+        })
+        .collect();
+    // Landing grids per (landing, contact-height offset to its liftoff), level ground → 0.
+    let dz = |a: usize, b: usize| pool[liftoffs[a]].stance.z_c - pool[landings[b]].stance.z_c;
+    let mut keys: Vec<(usize, u64)> = pair_list
+        .iter()
+        .map(|&(a, b)| (b, dz(a, b).to_bits()))
+        .collect();
+    keys.sort_unstable();
+    keys.dedup();
+    let down: Vec<StanceGrid> = keys
+        .par_iter()
+        .map(|&(b, bits)| {
+            let i = landings[b];
+            stance_grid(
+                &pool[i],
+                false,
+                heights,
+                speeds,
+                f64::from_bits(bits),
+                &lim(i),
+            )
+        })
+        .collect();
+    let n_u = speeds.len();
+    let pairs: Vec<PairMap> = pair_list
+        .par_iter()
+        .map(|&(a, b)| {
+            let k = keys
+                .binary_search(&(b, dz(a, b).to_bits()))
+                .unwrap_or_default();
+            let (i1, i2) = (liftoffs[a], landings[b]);
+            pair_map((i1, &pool[i1], &up[a]), (i2, &pool[i2], &down[k]), n_u)
+        })
+        .collect();
+    let mut agreement = Agreement::default();
+    for p in &pairs {
+        agreement.add(&p.agreement);
+    }
+    JumpMap {
+        heights: heights.to_vec(),
+        speeds: speeds.to_vec(),
+        liftoffs,
+        landings,
+        pairs,
+        agreement,
+    }
+}
+
+#[cfg(test)]
+mod tests;

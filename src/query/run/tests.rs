@@ -1,0 +1,175 @@
+//! Tests of the run-at-speed policy: the outcome checked by an independent forward
+//! simulation, the cycle rules, and the invariance of the verdicts under dynamic
+//! similarity (spec stance-model §6.8, §9).
+
+use super::*;
+use crate::query::feasibility::relative_limits;
+use crate::query::solve::Solution;
+use crate::query::testkit::{bell_model, pool_stance, simulate, Lcg};
+
+/// A runner-like stance: touchdown at 3–5 m/s descending, liftoff rising (a flight on
+/// both sides, so §6.5 rule 3 holds for the recorded stance itself).
+fn running_stance(rng: &mut Lcg, id: &str, label: &str) -> Prepared {
+    loop {
+        let m = bell_model(rng);
+        let v_td = [rng.range(3.0, 5.0), 0.0, -rng.range(0.3, 1.0)];
+        let s = pool_stance(
+            id,
+            m,
+            v_td,
+            rng.range(0.85, 1.0),
+            (Boundary::Flight, Boundary::Flight),
+            label,
+            [rng.range(-0.1, 0.2), rng.range(-0.1, 0.1)],
+        );
+        if s.params.t_e >= s.params.t_lo {
+            return Prepared::new(s);
+        }
+    }
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * 1f64.max(a.abs()).max(b.abs())
+}
+
+#[test]
+fn policy_keeps_vertical_solution_and_scales_horizontal_forces() {
+    let mut rng = Lcg(0x5eed_0401);
+    let mut solved = 0;
+    for i in 0..100 {
+        let p = running_stance(&mut rng, "s", "L");
+        let q = p.stance.params;
+        for k in [0.0, 0.3, 1.0, 1.4] {
+            let req = policy_request(&p.stance, k);
+            let sol = match solve(&p.shape, &req, &Refs::default(), Some(q.t_e)) {
+                Ok(s) => s,
+                Err(e) => {
+                    // Only k = 0 may lose the centroid rule (in-place bounce); never NaN.
+                    assert!(k == 0.0, "stance {i}, k = {k}: {e}");
+                    continue;
+                }
+            };
+            solved += 1;
+            assert!(close(sol.beta[0], k, 1e-9), "β_h {} ≠ k {k}", sol.beta[0]);
+            assert!(close(sol.beta[1], 1.0, 1e-9) && close(sol.beta[2], 1.0, 1e-9));
+            for (a, b) in [(sol.t_td, q.t_td), (sol.t_lo, q.t_lo), (sol.t_e, q.t_e)] {
+                assert!((a - b).abs() < 1e-9, "times changed: {a} vs {b}");
+            }
+            // Independent check: RK4 on the scaled model force, start apex → end apex.
+            let end = simulate(&p.stance.model, &req, &sol);
+            assert!((end[0] - req.x).abs() < 1e-6, "x {} vs {}", end[0], req.x);
+            assert!(
+                (end[2] - req.ze).abs() < 1e-6,
+                "ze {} vs {}",
+                end[2],
+                req.ze
+            );
+            assert!(
+                (end[3] - req.ve).abs() < 1e-6,
+                "ve {} vs {}",
+                end[3],
+                req.ve
+            );
+            assert!((end[4] - req.vp).abs() < 1e-6 && end[5].abs() < 1e-6);
+        }
+    }
+    assert!(solved >= 300, "only {solved} solved");
+}
+
+fn with(p: &Prepared, f: impl Fn(&mut PoolStance)) -> PoolStance {
+    let mut s = p.stance.clone();
+    f(&mut s);
+    s
+}
+
+#[test]
+fn cycles_need_opposite_feet_flights_and_chaining() {
+    let mut rng = Lcg(0x5eed_0402);
+    let a = running_stance(&mut rng, "a", "L");
+    // b starts where a's flight ends: same speed and apex height.
+    let b = with(&running_stance(&mut rng, "b", "R"), |s| {
+        s.params.vs = a.stance.params.ve;
+        s.params.zs = a.stance.params.ze;
+    });
+    let v = cycle_of(&a.stance, &b).expect("a chained L→R pair is a cycle");
+    let (pa, pb) = (&a.stance.params, &b.params);
+    assert!(close(v, (pa.x + pb.x) / (pa.t_e + pb.t_e), 1e-12));
+    let same_foot = with(&a, |s| s.label = "L".into());
+    assert_eq!(cycle_of(&a.stance, &same_foot), Err(NotACycle::Feet));
+    let walk = with(&a, |s| {
+        s.label = "R".into();
+        s.boundary_end = Boundary::NoFlight;
+    });
+    assert_eq!(cycle_of(&a.stance, &walk), Err(NotACycle::Boundaries));
+    let faster = with(&a, |s| {
+        s.label = "R".into();
+        s.params.vs = pa.ve + 0.06 * v;
+        s.params.zs = pa.ze;
+    });
+    assert_eq!(cycle_of(&a.stance, &faster), Err(NotACycle::Chaining));
+    let higher = with(&a, |s| {
+        s.label = "R".into();
+        s.params.vs = pa.ve;
+        s.params.zs = pa.ze + 0.021;
+    });
+    assert_eq!(cycle_of(&a.stance, &higher), Err(NotACycle::Chaining));
+    // run_cycles pairs consecutive stances of one clip only.
+    let pool = vec![
+        a.stance.clone(),
+        b.clone(),
+        with(&a, |s| s.clip = "other".into()),
+    ];
+    let cycles = run_cycles(&pool);
+    assert_eq!(cycles.len(), 1);
+    assert_eq!(cycles[0].stances, [0, 1]);
+}
+
+fn solved(c: &RunCandidate) -> [&ScaledStance; 2] {
+    c.stances.each_ref().map(|s| s.as_ref().expect("solved"))
+}
+
+#[test]
+fn verdicts_are_invariant_under_dynamic_similarity() {
+    let mut rng = Lcg(0x5eed_0403);
+    let (l, m) = (0.67, 3.62);
+    let mut outcomes = [0usize; 2];
+    for _ in 0..40 {
+        let pair = [
+            running_stance(&mut rng, "a", "L"),
+            running_stance(&mut rng, "b", "R"),
+        ];
+        let lim = relative_limits(&pair[0].stance.coef);
+        let v_orig = 4.0;
+        let big = pair
+            .each_ref()
+            .map(|p| Prepared::new(p.stance.scaled(l, m)));
+        let big_lim = scale_limits(&lim, l, m);
+        for v in [1.0, 3.0, 5.0] {
+            let a = run_at_speed([&pair[0], &pair[1]], v_orig, v, &lim);
+            let b = run_at_speed(
+                [&big[0], &big[1]],
+                v_orig * l.sqrt(),
+                v * l.sqrt(),
+                &big_lim,
+            );
+            assert_eq!(a.feasible(), b.feasible());
+            assert_eq!(a.feasible_approx(), b.feasible_approx());
+            outcomes[usize::from(a.feasible())] += 1;
+            for (x, y) in solved(&a).iter().zip(solved(&b)) {
+                let (sx, sy): (&Solution, &Solution) = (&x.solution, &y.solution);
+                for k in 0..3 {
+                    assert!(close(sx.beta[k], sy.beta[k], 1e-9), "β changed");
+                }
+                assert!(close(sx.t_e * l.sqrt(), sy.t_e, 1e-9));
+                assert_eq!(x.verdict.violated, y.verdict.violated);
+                assert!(close(x.verdict.f_peak * m, y.verdict.f_peak, 1e-9));
+                assert!(close(x.verdict.ext_max * l, y.verdict.ext_max, 1e-9));
+                assert!(close(x.verdict.ext_min * l, y.verdict.ext_min, 1e-9));
+                assert!(close(x.verdict.mu_req, y.verdict.mu_req, 1e-9));
+                assert!(close(x.cp[0] * l, y.cp[0], 1e-9) && close(x.cp[1] * l, y.cp[1], 1e-9));
+            }
+        }
+    }
+    // Both verdicts occur, so the invariance is not vacuous.
+    assert!(outcomes[0] > 10 && outcomes[1] > 10, "{outcomes:?}");
+}

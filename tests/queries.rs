@@ -1,0 +1,244 @@
+//! The queries on the library built from the shared clips (`../shared/data/bvh`): the
+//! run-at-speed sweep (Table 1's pattern), recorded jumps found feasible at their own
+//! height and distance with β ≈ 1, and the jump map. Skipped with a printed reason where
+//! `../shared` is absent.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use stancelib::library::read::Table;
+use stancelib::pipeline::batch::discover;
+use stancelib::pipeline::build::{build_and_write, BuildOptions};
+use stancelib::query::jump::{is_landing, is_liftoff, recorded_jump};
+
+use crate::util::shared_or_skip;
+
+/// The shared library, built once per test binary into a folder that lives as long.
+fn shared_library() -> Option<&'static Path> {
+    static LIB: OnceLock<Option<(tempfile::TempDir, PathBuf)>> = OnceLock::new();
+    LIB.get_or_init(|| {
+        let data = shared_or_skip("queries on the shared library")?;
+        let dir = tempfile::tempdir().unwrap();
+        let lib = dir.path().join("lib");
+        let files = discover(&[data.join("bvh")]).unwrap();
+        build_and_write(&files, &lib, &BuildOptions::default(), false).unwrap();
+        Some((dir, lib))
+    })
+    .as_ref()
+    .map(|(_, p)| p.as_path())
+}
+
+fn stancelib(args: &[&str]) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_stancelib"))
+        .args(args)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "stancelib {args:?} failed:\n{out}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    out
+}
+
+fn list_f64(t: &Table, name: &str) -> Vec<Vec<f64>> {
+    t.f64_lists(name, Some(2)).unwrap()
+}
+
+#[test]
+fn run_sweep_reproduces_table_one_pattern() {
+    let Some(lib) = shared_library() else { return };
+    let out = lib.parent().unwrap().join("runs.parquet");
+    let printed = stancelib(&[
+        "query",
+        "run",
+        "--lib",
+        &lib.display().to_string(),
+        "--speeds",
+        "0:6:0.5",
+        "--out",
+        &out.display().to_string(),
+    ]);
+    let t = Table::open(&out).unwrap();
+    assert!(
+        t.height() > 0,
+        "no run cycle in the shared library:\n{printed}"
+    );
+    let (speed, v_orig) = (t.f64s("speed_mps").unwrap(), t.f64s("v_orig_mps").unwrap());
+    let (bh, bv, bp) = (
+        list_f64(&t, "beta_h"),
+        list_f64(&t, "beta_v"),
+        list_f64(&t, "beta_p"),
+    );
+    let ids = t.strings("clip").unwrap();
+    let mu = t.opt_f64("mu_min").unwrap();
+    let feasible = t.bools("feasible").unwrap();
+    let n_speeds = 13;
+    let n_cycles = t.height() / n_speeds;
+    assert_eq!(n_cycles * n_speeds, t.height());
+    // β_h = v / v_orig exactly (linear in speed), β_v = β_p = 1 (Table 1's pattern).
+    for i in 0..t.height() {
+        for k in 0..2 {
+            let want = speed[i] / v_orig[i];
+            assert!(
+                (bh[i][k] - want).abs() < 1e-9,
+                "row {i}: β_h {} vs {want}",
+                bh[i][k]
+            );
+            assert!((bv[i][k] - 1.0).abs() < 1e-9 && (bp[i][k] - 1.0).abs() < 1e-9);
+        }
+    }
+    // μ_min non-decreasing with speed, per cycle (rows are speed-major).
+    for c in 0..n_cycles {
+        let series: Vec<f64> = (0..n_speeds)
+            .map(|s| mu[s * n_cycles + c].unwrap())
+            .collect();
+        for w in series.windows(2) {
+            assert!(
+                w[1] >= w[0] - 1e-12,
+                "cycle {c} ({}): μ_min {series:?}",
+                ids[c]
+            );
+        }
+    }
+    // The slow end is feasible; the recorded stances' own friction need (μ_req up to 1.4
+    // on cmu_09_01's R:40, from the model's edge ringing) exceeds μ = 0.7 near 4 m/s.
+    assert!(feasible[0], "the 0 m/s bounce is infeasible:\n{printed}");
+    eprintln!("query run on the shared library: {n_cycles} cycles\n{printed}");
+}
+
+/// The identity jump (stance-model §6.9, CORRECTIONS Issue 4 item 2) of every recorded
+/// jump: a liftoff followed, after one flight, by a landing in the same clip.
+///
+/// Each stance's model gives its own end of the flight, so `ve1` and `vs2` differ by the
+/// models' error (Stage A on these clips: up to 0.2 m/s, the COM's horizontal speed is not
+/// constant in flight), and `β_h` departs from 1 by `|u_apex − ve1|/|J_h1|` (a vertical
+/// jump, with small `J_h`, amplifies it). The test checks β_v within 5 % (the two models
+/// agree on the apex height), and feasibility wherever every β is within 5 % of 1.
+#[test]
+fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
+    let Some(lib) = shared_library() else { return };
+    let stances = stancelib::library::read::read_stances(&lib.join("stances.parquet")).unwrap();
+    let clips = stancelib::library::read::read_clip_info(&lib.join("clips.parquet")).unwrap();
+    let recorded: Vec<(usize, usize)> = (1..stances.len())
+        .filter(|&i| stances[i - 1].clip == stances[i].clip)
+        .filter(|&i| is_liftoff(&stances[i - 1]) && is_landing(&stances[i]))
+        .map(|i| (i - 1, i))
+        .collect();
+    assert!(
+        !recorded.is_empty(),
+        "no recorded jump in the shared library"
+    );
+    let mut identities = 0;
+    for (n, &(a, b)) in recorded.iter().enumerate() {
+        let (s1, s2) = (&stances[a], &stances[b]);
+        let (ve1, vs2) = (s1.params.ve, s2.params.vs);
+        let s_eff = clips[&s1.clip].s_eff.unwrap_or(1.0);
+        // A liftoff from rest takes its heading from the hips (§8.1): when the body turned
+        // during that stance, its frame points against the jump (ve1 and vs2 of opposite
+        // signs) and the straight-jump model cannot compose the pair. Clips with a wrong
+        // time base (s_eff outside [0.9, 1.1]) set no limits and are left out as in runs.
+        if ve1 * vs2 < 0.0 || !(0.9..=1.1).contains(&s_eff) {
+            eprintln!(
+                "identity jump {} → {} left out: ve1 {ve1:.3}, vs2 {vs2:.3} m/s, s_eff {s_eff:.2}",
+                s1.stance_id, s2.stance_id
+            );
+            continue;
+        }
+        let (h, d) = recorded_jump(s1, s2);
+        let out = lib.parent().unwrap().join(format!("jump{n}.parquet"));
+        stancelib(&[
+            "query",
+            "jump",
+            "--lib",
+            &lib.display().to_string(),
+            "--height",
+            &h.to_string(),
+            &format!("--distance={d}"),
+            "--out",
+            &out.display().to_string(),
+        ]);
+        let t = Table::open(&out).unwrap();
+        let (up, down) = (
+            t.strings("liftoff_stance_id").unwrap(),
+            t.strings("landing_stance_id").unwrap(),
+        );
+        let row = (0..t.height())
+            .find(|&i| up[i] == s1.stance_id && down[i] == s2.stance_id)
+            .expect("the recorded pair is a candidate");
+        let feasible = t.bools("feasible").unwrap()[row];
+        let why =
+            t.df.column("violated")
+                .unwrap()
+                .str()
+                .unwrap()
+                .get(row)
+                .map(str::to_string);
+        let get =
+            |c: &str| t.opt_f64(c).unwrap()[row].unwrap_or_else(|| panic!("{c} null: {why:?}"));
+        let [bh1, bv1, bh2, bv2] = ["beta_h1", "beta_v1", "beta_h2", "beta_v2"].map(get);
+        let u = get("u_apex_mps");
+        eprintln!(
+            "identity jump {} → {}: h {h:.3} m, d {d:.3} m, ve1 {ve1:.3}, vs2 {vs2:.3}, u_apex {u:.3} m/s, β [{bh1:.4}, {bv1:.4}, {bh2:.4}, {bv2:.4}], feasible {feasible} {why:?}",
+            s1.stance_id, s2.stance_id
+        );
+        assert!(
+            (bv1 - 1.0).abs() <= 0.05 && (bv2 - 1.0).abs() <= 0.05,
+            "β_v {bv1}, {bv2}"
+        );
+        if [bh1, bv1, bh2, bv2].iter().all(|b| (b - 1.0).abs() <= 0.05) {
+            assert!(
+                feasible,
+                "{} → {}: β within 5 % but {why:?}",
+                s1.stance_id, s2.stance_id
+            );
+            identities += 1;
+        }
+    }
+    assert!(
+        identities >= 2,
+        "only {identities} identity jumps within 5 %"
+    );
+}
+
+#[test]
+fn jump_map_has_a_feasible_region_and_reports_agreement() {
+    let Some(lib) = shared_library() else { return };
+    let out = lib.parent().unwrap().join("map");
+    let printed = stancelib(&[
+        "map",
+        "jumps",
+        "--lib",
+        &lib.display().to_string(),
+        "--out",
+        &out.display().to_string(),
+    ]);
+    let t = Table::open(&out.join("jump_map.parquet")).unwrap();
+    let pairs = Table::open(&out.join("jump_map_pairs.parquet")).unwrap();
+    assert!(pairs.height() > 0, "no liftoff/landing pair:\n{printed}");
+    assert_eq!(
+        t.height(),
+        pairs.height() * 51 * 101,
+        "one row per pair and cell"
+    );
+    let (ap, ex) = (
+        t.bools("feasible_approx").unwrap(),
+        t.bools("feasible_exact").unwrap(),
+    );
+    let n_exact = ex.iter().filter(|&&e| e).count();
+    assert!(n_exact > 0, "empty jump region:\n{printed}");
+    let both = ap.iter().zip(&ex).filter(|(a, e)| **a && **e).count();
+    let either = ap.iter().zip(&ex).filter(|(a, e)| **a || **e).count();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("jump_map.json")).unwrap()).unwrap();
+    let iou = summary["iou"].as_f64().unwrap();
+    assert!(
+        (iou - both as f64 / either as f64).abs() < 1e-12,
+        "IoU {iou}"
+    );
+    let png = std::fs::read(out.join("jump_map.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    eprintln!("map jumps on the shared library:\n{printed}");
+}
