@@ -14,6 +14,7 @@ mod equilibrium;
 mod hull;
 mod region;
 mod simplex;
+mod timing;
 mod trajectory;
 mod transition;
 
