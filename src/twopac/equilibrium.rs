@@ -57,7 +57,8 @@ pub enum Status {
     ForceClosure,
     /// `G V β = w` has no solution with `β ≥ 0` at any margin.
     Infeasible,
-    /// The LP solver stopped without an answer (reported, never hidden).
+    /// The LP solver stopped without an answer, or the COM state is not finite
+    /// (reported, never hidden).
     SolverFailed,
 }
 
@@ -253,6 +254,9 @@ impl EqualityForm {
             margin_n: None,
             b0_n: None,
         };
+        if !com.iter().chain(&acc).all(|v| v.is_finite()) {
+            return none(Status::SolverFailed, false);
+        }
         if self.force_closure() {
             return none(Status::ForceClosure, true);
         }

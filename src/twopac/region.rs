@@ -44,8 +44,11 @@ pub const DEFAULT_BOX_HALF_M: f64 = 1e3;
 pub const DEFAULT_TOL_M: f64 = 1e-9;
 /// Number of initial support directions (evenly spaced).
 pub const DEFAULT_INITIAL_DIRECTIONS: usize = 8;
-/// Refinement depth cap per initial sector (never reached by convex input).
+/// Refinement depth cap per chord (never reached by convex input).
 pub const MAX_DEPTH: usize = 48;
+/// Cap on the number of support LPs of one region (a polygon has at most this many
+/// vertices here; reached only on non-finite input).
+pub const MAX_LPS: usize = 4096;
 
 /// Options of [`static_region`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -174,7 +177,8 @@ impl SupportLp {
 /// # Errors
 ///
 /// [`TwopacError::Solver`] if an LP hits its pivot cap or turns out unbounded inside the
-/// clipping square (numerical trouble; never seen on valid input).
+/// clipping square, or more than [`MAX_LPS`] LPs are needed (numerical trouble or
+/// non-finite points; never seen on valid input).
 pub fn static_region(
     points: &[ContactPoint],
     opts: &RegionOptions,
@@ -225,7 +229,14 @@ pub fn static_region(
             let n = [e[1] / len, -e[0] / len];
             let (h, c) = lp.support(n).map_err(|e| fail("support", e))?;
             let chord = n[0] * a[0] + n[1] * a[1];
-            if h - chord <= opts.tol_m || depth >= MAX_DEPTH {
+            if lp.n_lps > MAX_LPS {
+                return Err(TwopacError::Solver {
+                    what: format!("static region: more than {MAX_LPS} support LPs"),
+                });
+            }
+            // A NaN gap also ends the refinement.
+            let gap = h - chord;
+            if gap.is_nan() || gap <= opts.tol_m || depth >= MAX_DEPTH {
                 facets.push((n, h.max(chord)));
             } else {
                 found.push(c);

@@ -9,6 +9,7 @@
 //! - `hull`: convex hull H-rep of point clouds.
 //! - `simplex`: the private LP solver on small closed-form LPs.
 
+mod contact;
 mod curve;
 mod equilibrium;
 mod hull;

@@ -225,3 +225,23 @@ fn force_closure_region_has_no_rows_and_no_support_is_empty() {
     assert_eq!(region.status, RegionStatus::Empty);
     assert!(!region.contains([0.0, 0.0, 1.0], 1.0));
 }
+
+#[test]
+fn non_finite_points_end_quickly() {
+    // Regression: a NaN gap once split chords down to the depth cap (2^48 LPs).
+    use crate::twopac::contact::ContactPoint;
+    let mut pts = contact_points(&[flat_foot("f", [0.0; 3], 0.2, 0.1, 0.5)]);
+    pts.push(ContactPoint {
+        pos: [f64::NAN, 0.0, 0.0],
+        normal: [0.0, 0.0, 1.0],
+        mu: 0.5,
+    });
+    let t = std::time::Instant::now();
+    let _ = static_region(&pts, &RegionOptions::default());
+    assert!(t.elapsed().as_secs_f64() < 5.0);
+    let form = EqualityForm::new(&[flat_foot("f", [0.0; 3], 0.2, 0.1, 0.5)], 70.0).unwrap();
+    assert_eq!(
+        form.verdict([f64::NAN, 0.0, 1.0], [0.0; 3]).status,
+        Status::SolverFailed
+    );
+}
