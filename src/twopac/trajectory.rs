@@ -434,6 +434,28 @@ pub fn plan(
     })
 }
 
+/// Per-phase diagnostics of §8: statics at the phase state and the kinematic margin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhaseDiagnostic {
+    /// The phase state `c^(j)` is statically feasible (its QP slack and wrench residual
+    /// are at most `1e-6`).
+    pub static_feasible: bool,
+    /// `min(k − K c^(j))` over the phase polytope, m (`+∞` without rows; `< 0` outside).
+    pub kinematic_margin_m: f64,
+}
+
+/// §8 per-phase diagnostics of a plan made from `phases`.
+pub fn phase_diagnostics(plan: &Plan, phases: &[Phase]) -> Vec<PhaseDiagnostic> {
+    plan.phase_states
+        .iter()
+        .zip(phases)
+        .map(|(s, p)| PhaseDiagnostic {
+            static_feasible: s.is_static(1e-6),
+            kinematic_margin_m: -p.polytope().max_violation(s.com),
+        })
+        .collect()
+}
+
 /// The quasi-static polyline baseline `c^(1) → c^(1,2) → c^(2) → …` (§6), each segment
 /// rest to rest by the quintic smoothstep `σ(τ) = 10τ³ − 15τ⁴ + 6τ⁵`.
 #[derive(Debug, Clone, PartialEq)]

@@ -4,7 +4,9 @@ use super::{flat_foot, r3_box};
 use crate::twopac::bezier::{check_control_points, Bezier, ComState};
 use crate::twopac::contact::Contact;
 use crate::twopac::equilibrium::EqualityForm;
-use crate::twopac::trajectory::{plan, ComTrajectory, Phase, PlanOptions, QuasiStatic};
+use crate::twopac::trajectory::{
+    phase_diagnostics, plan, ComTrajectory, Phase, PlanOptions, QuasiStatic,
+};
 use crate::twopac::transition::QpForm;
 use crate::twopac::validate::{sample_times, summarise, validate, DEFAULT_STEP_S};
 use crate::twopac::TwopacError;
@@ -262,4 +264,25 @@ fn walk_validation_reports_every_sample() {
         assert!(close(s.pos, pos, 1e-12) && close(s.vel, [0.0; 3], 1e-12));
     }
     let _ = validate(&q, &p.forms, DEFAULT_STEP_S);
+}
+
+#[test]
+fn phase_diagnostics_report_statics_and_kinematic_margin() {
+    // Phase 1's data COM (0.15, 0, 0.8) is outside the right foot's polygon: its state is
+    // projected onto the polygon's corner (0.1086, −0.031) (§1), 0.1 m below the z ≤ 0.9 row.
+    let mut phases = walk(0.3, 0.6);
+    phases[1].com = Some([0.15, 0.0, 0.8]);
+    let p = plan(&phases, M, &ComState::default(), &PlanOptions::default()).unwrap();
+    let d = phase_diagnostics(&p, &phases);
+    assert_eq!(d.len(), 7);
+    assert!(d.iter().all(|x| x.static_feasible));
+    assert!(
+        (p.phase_states[1].com[1] + 0.031).abs() < 1e-6,
+        "{:?}",
+        p.phase_states[1]
+    );
+    for (x, s) in d.iter().zip(&p.phase_states) {
+        assert!(x.kinematic_margin_m >= -1e-9);
+        assert!(x.kinematic_margin_m <= 0.9 - s.com[2] + 1e-9);
+    }
 }
