@@ -36,5 +36,6 @@ pub mod query;
 pub mod skeleton;
 pub mod stances;
 pub mod synth;
+pub mod twopac;
 
 pub use error::{Error, ErrorKind, Result};
