@@ -151,9 +151,40 @@ pub struct StanceShape {
     pub after_flight: bool,
     /// `(u, w)` of the original stance (only their signs are used, rule 2).
     pub ref_signs: Option<(f64, f64)>,
+    /// Values derived once from `j`, `k`, `dt` (build shapes with [`Self::from_model`];
+    /// after changing those fields by hand, call [`Self::refresh`]).
+    derived: Derived,
+}
+
+/// Per-stance constants of the solver: `1/J_a`, `s̄_h`, `s̄_v`, and whether `J`, `K`, the
+/// ε_J scales and `Δt > 0` are all finite.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Derived {
+    inv_j: [f64; 3],
+    s_bar_h: f64,
+    s_bar_v: f64,
+    valid: bool,
+}
+
+impl Derived {
+    fn of(j: &[f64; 3], k: &[f64; 3], j_scale: &[f64; 3], dt: f64) -> Self {
+        Derived {
+            inv_j: j.map(|v| 1.0 / v),
+            s_bar_h: k[0] / j[0],
+            s_bar_v: k[2] / j[2],
+            valid: j.iter().chain(k).chain(j_scale).all(|v| v.is_finite())
+                && dt.is_finite()
+                && dt > 0.0,
+        }
+    }
 }
 
 impl StanceShape {
+    /// Recomputes the derived constants after `j`, `k`, `j_scale` or `dt` changed.
+    pub fn refresh(&mut self) {
+        self.derived = Derived::of(&self.j, &self.k, &self.j_scale, self.dt);
+    }
+
     /// The shape of a force model, with its boundary rules and reference `(u, w)`.
     pub fn from_model(
         m: &ForceModel,
@@ -165,9 +196,11 @@ impl StanceShape {
             let sum: f64 = a.c0.abs() + a.terms().map(|(_, c, _)| c.abs()).sum::<f64>();
             m.dt_s / m.mass_kg * sum
         });
+        let (j, k) = (m.j(), m.k());
         StanceShape {
-            j: m.j(),
-            k: m.k(),
+            derived: Derived::of(&j, &k, &j_scale, m.dt_s),
+            j,
+            k,
             dt: m.dt_s,
             j_scale,
             before_flight,
@@ -356,6 +389,7 @@ pub fn solve(
 ///
 /// # Errors
 /// An [`Infeasible`] reason; never a NaN.
+#[inline]
 pub fn solve_with(
     shape: &StanceShape,
     req: &Request,
@@ -391,10 +425,8 @@ pub fn solve_with(
         branch,
         other_t_e: ok.get(1).map(|c| c.t_e),
     };
-    let finite = sol.beta.iter().all(|b| b.is_finite())
-        && [sol.t_td, sol.t_lo, sol.t_e, sol.y]
-            .iter()
-            .all(|v| v.is_finite());
+    let finite = (sol.beta[0] + sol.beta[1] + sol.beta[2] + sol.t_td + sol.t_lo + sol.t_e + sol.y)
+        .is_finite();
     if finite {
         Ok(sol)
     } else {
@@ -441,6 +473,7 @@ fn matches(a: f64, b: f64, tol: f64) -> bool {
 /// # Errors
 /// [`Infeasible::InvalidInput`], the §6.4 reasons, [`Infeasible::NegativeDiscriminant`]
 /// or [`Infeasible::NoRoot`].
+#[inline]
 pub fn candidates(
     shape: &StanceShape,
     req: &Request,
@@ -458,26 +491,20 @@ pub fn candidates(
         refs.beta_h,
         refs.beta_p,
         refs.beta_v,
-        shape.dt,
     ];
-    let shape_ok = shape
-        .j
-        .iter()
-        .chain(&shape.k)
-        .chain(&shape.j_scale)
-        .all(|v| v.is_finite());
-    if !inputs.iter().all(|v| v.is_finite()) || !shape_ok || shape.dt <= 0.0 {
+    if !(shape.derived.valid && inputs.iter().all(|v| v.is_finite())) {
         return Err(Infeasible::InvalidInput);
     }
     let g = GRAVITY;
-    let [jh, jp, jv] = shape.j;
-    let [kh, _, kv] = shape.k;
+    let jv = shape.j[2];
+    let kh = shape.k[0];
+    let [inv_jh, inv_jp, inv_jv] = shape.derived.inv_j;
     let near_zero = |a: usize| shape.j[a].abs() <= opts.eps_j * shape.j_scale[a];
     // (i) support.
     if jv <= 0.0 || near_zero(2) {
         return Err(Infeasible::NoSupport);
     }
-    let sv = kv / jv;
+    let sv = shape.derived.s_bar_v;
     let d = req.ve - req.vs;
     let dz = req.ze - req.zs;
     // (iii) perpendicular.
@@ -487,14 +514,14 @@ pub fn candidates(
         }
         refs.beta_p
     } else {
-        (req.vp - req.vps) / jp
+        (req.vp - req.vps) * inv_jp
     };
     // t_TD, u, w and the candidate for one T > 0.
     let make = |t: f64, beta_h: f64| {
         let t_td = t / 2.0 - sv - dz / (g * t);
         let u = t_td + sv;
         Candidate {
-            beta: [beta_h, beta_p, g * t / jv],
+            beta: [beta_h, beta_p, g * t * inv_jv],
             t_td,
             t_e: t,
             u,
@@ -523,8 +550,8 @@ pub fn candidates(
         };
         return Ok((Roots::one(c), Branch::NoNetHorizontal));
     }
-    let beta_h = d / jh;
-    let sh = kh / jh;
+    let beta_h = d * inv_jh;
+    let sh = shape.derived.s_bar_h;
     let a = (req.vs + req.ve) / 2.0;
     let b = -(req.x + d * (sh - sv));
     let c = d * dz / g;
@@ -586,9 +613,11 @@ fn sign_fail(t: f64, beta_p: f64) -> Candidate {
 /// # Errors
 /// The first rule broken: [`Infeasible::SignRule`], [`Infeasible::CentroidRule`] or
 /// [`Infeasible::FlightRule`].
+#[inline]
 pub fn admissible(shape: &StanceShape, c: &Candidate, tol: f64) -> Result<(), Infeasible> {
-    let finite = c.beta.iter().all(|b| b.is_finite())
-        && [c.t_td, c.t_e, c.u, c.w].iter().all(|v| v.is_finite());
+    // One test for all seven: a sum is finite iff every term is (a NaN or ±∞ term
+    // propagates; finite terms this large do not occur in a stance).
+    let finite = (c.beta[0] + c.beta[1] + c.beta[2] + c.t_td + c.t_e + c.u + c.w).is_finite();
     // T > 0 strictly: t_TD = T/2 − s̄_v − Δz/(gT) needs it; then β_v = gT/J_v > 0.
     let signs = c.t_e > 0.0 && c.beta[0] >= -tol && c.beta[1] >= -tol && c.beta[2] > 0.0;
     if !finite || !signs {

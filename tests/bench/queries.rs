@@ -69,9 +69,14 @@ fn requests(pool: &[Prepared]) -> Vec<(usize, Request)> {
 }
 
 fn candidate_evals(c: &mut Criterion) {
-    let Some((_dir, pool)) = shared_pool() else { return };
+    let Some((_dir, pool)) = shared_pool() else {
+        return;
+    };
     let reqs = requests(&pool);
-    let limits: Vec<_> = pool.iter().map(|p| relative_limits(&p.stance.coef)).collect();
+    let limits: Vec<_> = pool
+        .iter()
+        .map(|p| relative_limits(&p.stance.coef))
+        .collect();
     let refs = Refs::default();
     let mut g = c.benchmark_group("candidate_evals");
     g.sample_size(20).measurement_time(Duration::from_secs(10));
@@ -93,7 +98,9 @@ fn candidate_evals(c: &mut Criterion) {
 }
 
 fn jump_map_200(c: &mut Criterion) {
-    let Some((_dir, pool)) = shared_pool() else { return };
+    let Some((_dir, pool)) = shared_pool() else {
+        return;
+    };
     let heights = Axis {
         start: 0.6,
         stop: 1.6,
