@@ -88,6 +88,25 @@ pub struct ConstraintsTable {
     pub limits: Option<String>,
 }
 
+/// `[queries]` of a pipeline file: query stages run on the library after the build; their
+/// outputs go to `<out>/queries/`.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct QueriesTable {
+    /// `query run` speeds, `start:stop:step` in m/s (→ `queries/runs.parquet`).
+    pub run_speeds: Option<String>,
+    /// Leg-length ratio of the run's target character (default 1).
+    pub length_scale: Option<f64>,
+    /// Body-mass ratio of the run's target character (default 1).
+    pub mass_scale: Option<f64>,
+    /// Run `map jumps` (→ `queries/jump_map/`).
+    pub jump_map: Option<bool>,
+    /// Map rows, `start:stop:step` in m (default 0.6:1.6:0.02).
+    pub map_heights: Option<String>,
+    /// Map columns, `start:stop:step` in m/s (default 0:5:0.05).
+    pub map_speeds: Option<String>,
+}
+
 /// A pipeline file.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -112,6 +131,8 @@ pub struct PipelineFile {
     pub fit: Option<FitTable>,
     /// Constraint options.
     pub constraints: Option<ConstraintsTable>,
+    /// Query stages run after the build.
+    pub queries: Option<QueriesTable>,
 }
 
 /// 1-based line of a byte offset.

@@ -1,9 +1,15 @@
 //! `stancelib run <pipeline.toml>`: a declarative library build (inputs, body, options,
-//! output folder).
+//! output folder), then the `[queries]` stages on the new library.
 
-use super::super::args::RunArgs;
+use std::path::Path;
+
+use anyhow::Context;
+
+use super::super::args::{MapJumpsArgs, RunArgs, RunQueryArgs};
 use super::super::Outcome;
-use crate::pipeline::spec::{expand_inputs, load_body, load_pipeline, relative_to, resolve};
+use crate::pipeline::spec::{
+    expand_inputs, load_body, load_pipeline, relative_to, resolve, QueriesTable,
+};
 
 /// Run a pipeline file.
 ///
@@ -29,11 +35,37 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
         ingest: opts,
         stances: crate::pipeline::spec::resolve_fit(Some(&pipe), a.body.stage_b),
     };
-    super::build::execute(
-        &files,
-        &relative_to(&a.pipeline, &pipe.out),
-        &opts,
-        threads,
-        a.incremental,
-    )
+    let lib = relative_to(&a.pipeline, &pipe.out);
+    let outcome = super::build::execute(&files, &lib, &opts, threads, a.incremental)?;
+    if let Some(q) = &pipe.queries {
+        run_queries(q, &lib).with_context(|| format!("{}: [queries]", a.pipeline.display()))?;
+    }
+    Ok(outcome)
+}
+
+/// The `[queries]` stages on the library just built, into `<lib>/queries/`.
+fn run_queries(q: &QueriesTable, lib: &Path) -> anyhow::Result<()> {
+    let dir = lib.join("queries");
+    if let Some(speeds) = &q.run_speeds {
+        super::query::run(RunQueryArgs {
+            lib: lib.to_path_buf(),
+            speed: None,
+            speeds: Some(speeds.clone()),
+            length_scale: q.length_scale.unwrap_or(1.0),
+            mass_scale: q.mass_scale.unwrap_or(1.0),
+            out: dir.join("runs.parquet"),
+        })?;
+    }
+    if q.jump_map == Some(true) {
+        super::map::run(MapJumpsArgs {
+            lib: lib.to_path_buf(),
+            heights: q
+                .map_heights
+                .clone()
+                .unwrap_or_else(|| "0.6:1.6:0.02".into()),
+            speeds: q.map_speeds.clone().unwrap_or_else(|| "0:5:0.05".into()),
+            out: dir.join("jump_map"),
+        })?;
+    }
+    Ok(())
 }
