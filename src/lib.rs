@@ -28,6 +28,7 @@ pub mod contacts;
 pub mod error;
 pub mod force_model;
 pub mod ingest;
+pub mod kinematics;
 pub mod library;
 pub mod math;
 pub mod pipeline;

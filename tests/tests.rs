@@ -21,6 +21,7 @@ mod cli;
 mod fixtures;
 mod forceplate;
 mod forceplate_stances;
+mod kinematics;
 mod multicontact;
 mod props;
 mod queries;

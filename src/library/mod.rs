@@ -6,6 +6,7 @@
 //! spec com-from-bvh §8 (column tables); STYLE.md §5.6 (deterministic files).
 
 mod columns;
+pub mod kinematics;
 pub mod queries;
 pub mod read;
 pub mod schema;

@@ -25,9 +25,11 @@ pub const ERRORS_FILE: &str = "errors.parquet";
 /// Reserved in the library layout for the kinematic polytopes of the multi-contact stage
 /// (spec two-pac §3; not written yet).
 pub const KINEMATICS_FILE: &str = "kinematics.parquet";
+/// Points behind the kinematic polytopes (two-pac §3).
+pub const KINEMATICS_POINTS_FILE: &str = "kinematics_points.parquet";
 
 /// Columns of `clips.parquet`, in order.
-pub const CLIPS_COLUMNS: [&str; 23] = [
+pub const CLIPS_COLUMNS: [&str; 24] = [
     "path",
     "clip",
     "content_sha256",
@@ -43,6 +45,7 @@ pub const CLIPS_COLUMNS: [&str; 23] = [
     "up_axis",
     "handedness_ok",
     "leg_length_m",
+    "character_id",
     "mass_kg",
     "skeleton",
     "toe_tip_rule_left",

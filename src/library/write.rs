@@ -213,6 +213,7 @@ pub fn clips_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
                 .collect::<Vec<_>>(),
         ),
         col("leg_length_m", f(&|r| r.summary.leg_length_m)),
+        col("character_id", s(&|r| r.summary.character_id.clone())),
         col(
             "mass_kg",
             records.iter().map(|r| r.mass_kg).collect::<Vec<_>>(),

@@ -21,9 +21,11 @@ use super::batch::{file_sha256, ingest_named, progress};
 use super::names::clip_names;
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
+use crate::library::kinematics::kinematics_tables;
 use crate::library::read::read_parquet;
 use crate::library::schema::{
-    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, SCHEMA_VERSION, STANCES_FILE,
+    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, KINEMATICS_FILE, KINEMATICS_POINTS_FILE,
+    SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, write_atomic};
@@ -410,6 +412,10 @@ fn write_tables(
     for (name, df) in t.named() {
         write_atomic(dir, name, df, &kv)?;
     }
+    let (mut facets, mut points) =
+        kinematics_tables(&t.frames, &t.contacts, &t.clips).map_err(|e| pe(KINEMATICS_FILE, e))?;
+    write_atomic(dir, KINEMATICS_FILE, &mut facets, &kv)?;
+    write_atomic(dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
     let manifest = serde_json::json!({
         "schema_version": SCHEMA_VERSION,
         "tool_version": env!("CARGO_PKG_VERSION"),

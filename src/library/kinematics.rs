@@ -1,0 +1,252 @@
+//! `kinematics.parquet` and `kinematics_points.parquet` (spec two-pac §3): the kinematic
+//! polytopes of each character's effectors, built from the library's own frames and
+//! contact runs, and read back as [`Polytope`]s.
+//!
+//! `kinematics.parquet`: one row per facet, `character_id`, `effector`, `nx`, `ny`, `nz`,
+//! `d` (`n·ʳc ≤ d`, unit outward `n`, metres, contact frame), sorted by (`character_id`,
+//! `effector`, `nx`, `ny`, `nz`, `d`). `kinematics_points.parquet`: the points after the
+//! outlier rules, `character_id`, `effector`, `clip`, `frame`, `x`, `y`, `z`, sorted by
+//! (`character_id`, `effector`, `clip`, `frame`).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use polars::prelude::*;
+
+use super::columns::col;
+use super::read::Table;
+use super::schema::KINEMATICS_FILE;
+use crate::error::{Error, Result};
+use crate::kinematics::{com_in_contact_frame, inliers, polytope};
+use crate::twopac::polytope::Polytope;
+
+/// One kinematic sample: the COM in an effector's contact frame at one frame.
+#[derive(Debug, Clone, PartialEq)]
+struct Sample {
+    clip: String,
+    frame: i64,
+    rc: [f64; 3],
+}
+
+type Groups = BTreeMap<(String, String), Vec<Sample>>;
+/// One facet row: character, effector, unit outward normal, offset (m).
+type Facet = (String, String, [f64; 3], f64);
+
+fn strs(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<String>>> {
+    Ok(df
+        .column(name)?
+        .str()?
+        .iter()
+        .map(|v| v.map(str::to_string))
+        .collect())
+}
+
+fn f64s(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<f64>>> {
+    Ok(df.column(name)?.f64()?.iter().collect())
+}
+
+fn i64s(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<i64>>> {
+    Ok(df.column(name)?.i64()?.iter().collect())
+}
+
+/// Per clip: `frame → COM` (world, m).
+fn com_by_frame(frames: &DataFrame) -> PolarsResult<BTreeMap<String, BTreeMap<i64, [f64; 3]>>> {
+    let (clip, frame) = (strs(frames, "clip")?, i64s(frames, "frame")?);
+    let xyz = [
+        f64s(frames, "com_x")?,
+        f64s(frames, "com_y")?,
+        f64s(frames, "com_z")?,
+    ];
+    let mut out: BTreeMap<String, BTreeMap<i64, [f64; 3]>> = BTreeMap::new();
+    for i in 0..frames.height() {
+        let (Some(c), Some(f)) = (&clip[i], frame[i]) else {
+            continue;
+        };
+        let (Some(x), Some(y), Some(z)) = (xyz[0][i], xyz[1][i], xyz[2][i]) else {
+            continue;
+        };
+        out.entry(c.clone()).or_default().insert(f, [x, y, z]);
+    }
+    Ok(out)
+}
+
+/// Samples grouped by (character, effector), in (clip, frame) order, with each
+/// character's leg length.
+fn samples(
+    frames: &DataFrame,
+    contacts: &DataFrame,
+    clips: &DataFrame,
+) -> PolarsResult<(Groups, BTreeMap<String, f64>)> {
+    let coms = com_by_frame(frames)?;
+    let (names, chars, legs) = (
+        strs(clips, "clip")?,
+        strs(clips, "character_id")?,
+        f64s(clips, "leg_length_m")?,
+    );
+    let mut character: BTreeMap<String, String> = BTreeMap::new();
+    let mut leg: BTreeMap<String, f64> = BTreeMap::new();
+    for i in 0..clips.height() {
+        if let (Some(n), Some(c), Some(l)) = (&names[i], &chars[i], legs[i]) {
+            character.insert(n.clone(), c.clone());
+            leg.entry(c.clone()).or_insert(l);
+        }
+    }
+    let (clip, eff) = (strs(contacts, "clip")?, strs(contacts, "effector")?);
+    let (first, last) = (
+        i64s(contacts, "first_frame")?,
+        i64s(contacts, "last_frame")?,
+    );
+    let origin = [
+        f64s(contacts, "origin_x")?,
+        f64s(contacts, "origin_y")?,
+        f64s(contacts, "origin_z")?,
+    ];
+    let yaw = f64s(contacts, "yaw_rad")?;
+    let mut groups = Groups::new();
+    for i in 0..contacts.height() {
+        let (Some(c), Some(e), Some(a), Some(b), Some(y)) =
+            (&clip[i], &eff[i], first[i], last[i], yaw[i])
+        else {
+            continue;
+        };
+        let (Some(ox), Some(oy), Some(oz)) = (origin[0][i], origin[1][i], origin[2][i]) else {
+            continue;
+        };
+        let (Some(ch), Some(com)) = (character.get(c), coms.get(c)) else {
+            continue;
+        };
+        let group = groups.entry((ch.clone(), e.clone())).or_default();
+        for (&frame, &p) in com.range(a..=b) {
+            group.push(Sample {
+                clip: c.clone(),
+                frame,
+                rc: com_in_contact_frame(p, [ox, oy, oz], y),
+            });
+        }
+    }
+    for g in groups.values_mut() {
+        g.sort_by(|x, y| (&x.clip, x.frame).cmp(&(&y.clip, y.frame)));
+    }
+    Ok((groups, leg))
+}
+
+/// The two kinematics tables of a library from its `frames`, `contacts` and `clips`
+/// tables: `(facets, points)`. A (character, effector) with fewer than 4 non-coplanar
+/// points after the outlier rules has points but no facets (an error at query time).
+///
+/// # Errors
+/// A table lacks a needed column or has it with another type.
+pub fn kinematics_tables(
+    frames: &DataFrame,
+    contacts: &DataFrame,
+    clips: &DataFrame,
+) -> PolarsResult<(DataFrame, DataFrame)> {
+    let (groups, legs) = samples(frames, contacts, clips)?;
+    let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
+    for (key, g) in &groups {
+        let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
+        let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
+        let keep = inliers(&pts, leg);
+        kept.push((
+            key,
+            g.iter()
+                .zip(keep)
+                .filter(|(_, k)| *k)
+                .map(|(s, _)| s)
+                .collect(),
+        ));
+    }
+    let mut facets: Vec<Facet> = Vec::new();
+    for (key, g) in &kept {
+        let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
+        if let Ok(p) = polytope(&pts) {
+            facets.extend(
+                p.a.iter()
+                    .zip(&p.b)
+                    .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d)),
+            );
+        }
+    }
+    facets.sort_by(|x, y| {
+        (&x.0, &x.1)
+            .cmp(&(&y.0, &y.1))
+            .then(x.2[0].total_cmp(&y.2[0]))
+            .then(x.2[1].total_cmp(&y.2[1]))
+            .then(x.2[2].total_cmp(&y.2[2]))
+            .then(x.3.total_cmp(&y.3))
+    });
+    let f = |g: &dyn Fn(&Facet) -> f64| -> Vec<f64> { facets.iter().map(g).collect() };
+    let facet_df = DataFrame::new_infer_height(vec![
+        col(
+            "character_id",
+            facets.iter().map(|r| r.0.clone()).collect::<Vec<_>>(),
+        ),
+        col(
+            "effector",
+            facets.iter().map(|r| r.1.clone()).collect::<Vec<_>>(),
+        ),
+        col("nx", f(&|r| r.2[0])),
+        col("ny", f(&|r| r.2[1])),
+        col("nz", f(&|r| r.2[2])),
+        col("d", f(&|r| r.3)),
+    ])?;
+    let rows: Vec<(&(String, String), &Sample)> = kept
+        .iter()
+        .flat_map(|(k, g)| g.iter().map(move |s| (*k, *s)))
+        .collect();
+    let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
+    let points_df = DataFrame::new_infer_height(vec![
+        col(
+            "character_id",
+            rows.iter().map(|(k, _)| k.0.clone()).collect::<Vec<_>>(),
+        ),
+        col(
+            "effector",
+            rows.iter().map(|(k, _)| k.1.clone()).collect::<Vec<_>>(),
+        ),
+        col(
+            "clip",
+            rows.iter().map(|(_, s)| s.clip.clone()).collect::<Vec<_>>(),
+        ),
+        col(
+            "frame",
+            rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
+        ),
+        col("x", p(0)),
+        col("y", p(1)),
+        col("z", p(2)),
+    ])?;
+    Ok((facet_df, points_df))
+}
+
+/// The kinematic polytopes of a library by (`character_id`, `effector`), in the contact
+/// frame (metres).
+///
+/// # Errors
+/// `kinematics.parquet` missing or malformed (the error names the file, column and row).
+pub fn read_polytopes(lib_dir: &Path) -> Result<BTreeMap<(String, String), Polytope>> {
+    let t = Table::open(&lib_dir.join(KINEMATICS_FILE))?;
+    let (ch, eff) = (t.strings("character_id")?, t.strings("effector")?);
+    let (nx, ny, nz, d) = (t.f64s("nx")?, t.f64s("ny")?, t.f64s("nz")?, t.f64s("d")?);
+    let mut rows: BTreeMap<(String, String), Polytope> = BTreeMap::new();
+    for i in 0..t.height() {
+        let n = [nx[i], ny[i], nz[i]];
+        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if !((norm - 1.0).abs() <= 1e-6 && d[i].is_finite()) {
+            return Err(Error::column(
+                &t.path,
+                "nx",
+                Some(i),
+                "facet normal is not a unit vector or d is not finite",
+            ));
+        }
+        let p = rows.entry((ch[i].clone(), eff[i].clone())).or_default();
+        p.a.push(n);
+        p.b.push(d[i]);
+    }
+    // Rows are renormalised to exactly unit length (stored values carry rounding).
+    Ok(rows
+        .into_iter()
+        .map(|(k, p)| (k, Polytope::new(p.a, p.b)))
+        .collect())
+}
