@@ -258,7 +258,7 @@ fn twopac_flat_walk_outputs() {
     assert!(trans.bools("static_feasible").unwrap().iter().all(|v| *v));
     assert_eq!(
         trans.strings("change").unwrap(),
-        ["remove", "add", "remove", "add"]
+        ["remove", "add", "remove", "add", "remove", "add", "remove", "add", "remove"]
     );
 
     // The §5.4 guarantee is consistent with the per-control-point violations.

@@ -179,13 +179,46 @@ fn bare(e: &serde_json::Error) -> String {
     }
 }
 
-/// Deserialize one value at `path`.
+/// Deserialize one value at `path`; a type error inside one field of an object is
+/// reported at that field's path.
 fn at<T: DeserializeOwned>(v: &Value, path: &str) -> Result<T, JsonError> {
-    T::deserialize(v).map_err(|e| JsonError {
-        path: path.to_string(),
-        msg: bare(&e),
-        at: None,
+    T::deserialize(v).map_err(|e| {
+        let path = match faulty_field::<T>(v) {
+            Some(k) if path.is_empty() => k,
+            Some(k) => format!("{path}.{k}"),
+            None => path.to_string(),
+        };
+        JsonError {
+            path,
+            msg: bare(&e),
+            at: None,
+        }
     })
+}
+
+/// The key of an object whose value `T` fails on: the object is written compactly on one
+/// line, parsed again, and serde's error column is found among the values' spans.
+fn faulty_field<T: DeserializeOwned>(v: &Value) -> Option<String> {
+    let Value::Object(map) = v else { return None };
+    let mut text = String::from("{");
+    let mut spans = Vec::with_capacity(map.len());
+    for (i, (k, val)) in map.iter().enumerate() {
+        if i > 0 {
+            text.push(',');
+        }
+        text += &serde_json::to_string(k).ok()?;
+        text.push(':');
+        let start = text.len();
+        text += &serde_json::to_string(val).ok()?;
+        spans.push((k, start, text.len()));
+    }
+    text.push('}');
+    let e = serde_json::from_str::<T>(&text).err()?;
+    let col = e.column();
+    (e.line() == 1)
+        .then(|| spans.iter().find(|(_, a, b)| col > *a && col <= *b))
+        .flatten()
+        .map(|(k, _, _)| (*k).clone())
 }
 
 /// Parse `text` as JSON (syntax errors carry line and column).
