@@ -6,6 +6,7 @@
 //! Solve times are measured here, by repeating each solve a fixed number of times
 //! ([`REPEATS_BUILD`], …), and go to `timings.json` only (§8: Parquet stays deterministic).
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::time::Instant;
 
@@ -48,10 +49,56 @@ fn parse_form(s: &str) -> anyhow::Result<QpForm> {
     }
 }
 
+/// The library's kinematic polytopes keyed by `(character_id, effector)`.
+///
+/// The reader is `stancelib::library::kinematics::read_polytopes`, being added to main by
+/// the lead; until it is merged here this says so (see the branch notes).
+fn read_library_polytopes(lib: &Path) -> anyhow::Result<BTreeMap<(String, String), Polytope>> {
+    anyhow::bail!(
+        "{}: reading kinematics.parquet is not available in this build yet; use inline {{\"A\", \"b\"}} polytopes",
+        lib.display()
+    )
+}
+
+/// The polytopes of one character: `character`, or the only one in the library.
+///
+/// # Errors
+/// No polytope at all, an unknown character, or several characters without `--character`.
+pub(crate) fn character_polytopes(
+    all: &BTreeMap<(String, String), Polytope>,
+    character: Option<&str>,
+    lib: &Path,
+) -> anyhow::Result<BTreeMap<String, Polytope>> {
+    let ids: BTreeSet<&str> = all.keys().map(|(c, _)| c.as_str()).collect();
+    let list = || ids.iter().copied().collect::<Vec<_>>().join(", ");
+    let id = match (character, ids.len()) {
+        (_, 0) => anyhow::bail!("{}: kinematics.parquet has no polytope", lib.display()),
+        (Some(c), _) if ids.contains(c) => c,
+        (Some(c), _) => anyhow::bail!(
+            "--character {c}: not in {} (characters: {})",
+            lib.display(),
+            list()
+        ),
+        (None, 1) => ids.iter().next().copied().unwrap_or_default(),
+        (None, _) => anyhow::bail!(
+            "{}: several characters ({}): choose one with --character ID",
+            lib.display(),
+            list()
+        ),
+    };
+    Ok(all
+        .iter()
+        .filter(|((c, _), _)| c == id)
+        .map(|((_, e), p)| (e.clone(), p.clone()))
+        .collect())
+}
+
 /// The core's phases with every kinematic polytope resolved (inline, or from `--lib`).
 fn resolve(file: &PhasesFile, path: &Path, a: &TwopacArgs) -> anyhow::Result<Vec<Phase>> {
     let named = file.named_kinematics();
-    if !named.is_empty() {
+    let library = if named.is_empty() {
+        BTreeMap::new()
+    } else {
         let lib = a.lib.as_ref().with_context(|| {
             format!(
                 "{}: effectors use the library polytopes {}: give --lib LIB (with kinematics.parquet) or inline {{\"A\", \"b\"}} polytopes",
@@ -59,15 +106,10 @@ fn resolve(file: &PhasesFile, path: &Path, a: &TwopacArgs) -> anyhow::Result<Vec
                 named.join(", ")
             )
         })?;
-        anyhow::bail!(
-            "{}: library polytopes ({}) from {}: reading kinematics.parquet is not available in this build yet; use inline {{\"A\", \"b\"}} polytopes",
-            path.display(),
-            named.join(", "),
-            lib.display()
-        );
-    }
-    let none = |_: &str| -> Option<Polytope> { None };
-    file.to_phases(&none)
+        character_polytopes(&read_library_polytopes(lib)?, a.character.as_deref(), lib)?
+    };
+    let lookup = |name: &str| library.get(name).cloned();
+    file.to_phases(&lookup)
         .with_context(|| path.display().to_string())
 }
 
@@ -369,4 +411,39 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
     }
     println!("  → {}", a.out.display());
     Ok(Outcome::Clean)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lib(keys: &[(&str, &str)]) -> BTreeMap<(String, String), Polytope> {
+        keys.iter()
+            .enumerate()
+            .map(|(i, (c, e))| {
+                let p = Polytope::aabb([0.0; 3], [1.0, 1.0, i as f64 + 1.0]);
+                ((c.to_string(), e.to_string()), p)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_only_character_is_the_default() {
+        let all = lib(&[("c1", "left_foot"), ("c1", "right_foot")]);
+        let got = character_polytopes(&all, None, Path::new("L")).unwrap();
+        assert_eq!(got.len(), 2);
+        assert_eq!(got["right_foot"], all[&("c1".into(), "right_foot".into())]);
+    }
+
+    #[test]
+    fn several_characters_need_a_choice() {
+        let all = lib(&[("a", "left_foot"), ("b", "left_foot"), ("b", "left_hand")]);
+        let e = character_polytopes(&all, None, Path::new("L")).unwrap_err();
+        assert!(e.to_string().contains("--character"), "{e}");
+        let got = character_polytopes(&all, Some("b"), Path::new("L")).unwrap();
+        assert_eq!(got.keys().collect::<Vec<_>>(), ["left_foot", "left_hand"]);
+        assert_eq!(got["left_foot"], all[&("b".into(), "left_foot".into())]);
+        assert!(character_polytopes(&all, Some("z"), Path::new("L")).is_err());
+        assert!(character_polytopes(&BTreeMap::new(), None, Path::new("L")).is_err());
+    }
 }
