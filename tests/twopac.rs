@@ -413,3 +413,42 @@ fn twopac_named_kinematics_need_a_library() {
         "effectors.left_foot.kinematics: unknown polytope \"left_elbow\"",
     );
 }
+
+#[test]
+fn twopac_eq6_and_eq13_agree_when_static() {
+    // Spec §4: with s = 0 both forms give the same transition point (to 1e-4 m there;
+    // here the same tolerance, the QPs' regularisation moves points by far less).
+    let input = fixture(WALK);
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("eq13"), dir.path().join("eq6"));
+    ok(&["twopac", "--phases", &s(&input), "--out", &s(&a)]);
+    ok(&[
+        "twopac",
+        "--phases",
+        &s(&input),
+        "--form",
+        "eq6",
+        "--out",
+        &s(&b),
+    ]);
+    let (ta, tb) = (
+        Table::open(&a.join("transitions.parquet")).unwrap(),
+        Table::open(&b.join("transitions.parquet")).unwrap(),
+    );
+    assert!(ta.strings("form").unwrap().iter().all(|f| f == "eq13"));
+    assert!(tb.strings("form").unwrap().iter().all(|f| f == "eq6"));
+    assert!(tb
+        .opt_f64("slack_m")
+        .unwrap()
+        .iter()
+        .all(|v| v.unwrap() < 1e-9));
+    for i in 0..ta.height() {
+        let (pa, pb) = (xyz(&ta, i), xyz(&tb, i));
+        for k in 0..3 {
+            assert!(
+                (pa[k] - pb[k]).abs() < 1e-4,
+                "transition {i}: {pa:?} vs {pb:?}"
+            );
+        }
+    }
+}

@@ -71,7 +71,7 @@ fn view(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     path: &Path,
     d: &TrajectoryPlot,
-    (caption, k, y_desc): (&str, usize, &str),
+    (caption, k, y_desc, legend): (&str, usize, &str, SeriesLabelPosition),
 ) -> Result<(), PlotError> {
     let pr = |p: &[f64; 3]| (p[0], p[k]);
     let (xr, yr) = ranges(d, 0, k);
@@ -151,7 +151,7 @@ fn view(
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperRight)
+        .position(legend)
         .draw()
         .map_err(|e| err(path, e))?;
     Ok(())
@@ -169,8 +169,28 @@ pub fn trajectory_png(path: &Path, d: &TrajectoryPlot) -> Result<(), PlotError> 
         .titled(&d.title, ("sans-serif", 22))
         .map_err(|e| err(path, e))?;
     let (left, right) = root.split_horizontally(VIEW_PX.0);
-    view(&left, path, d, ("Side view (x–z)", 2, "z (m)"))?;
-    view(&right, path, d, ("Top view (x–y)", 1, "y (m)"))?;
+    view(
+        &left,
+        path,
+        d,
+        (
+            "Side view (x–z)",
+            2,
+            "z (m)",
+            SeriesLabelPosition::MiddleRight,
+        ),
+    )?;
+    view(
+        &right,
+        path,
+        d,
+        (
+            "Top view (x–y)",
+            1,
+            "y (m)",
+            SeriesLabelPosition::UpperRight,
+        ),
+    )?;
     root.present().map_err(|e| err(path, e))?;
     Ok(())
 }
