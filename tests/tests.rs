@@ -15,6 +15,8 @@
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 //! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
 //! - `stances_truth`: stances of the fixtures against the generator's truth; Parquet round trip.
+//! - `twopac`: `equilibrium` and `twopac` on `fixtures/twopac/`: reference margins, boundary
+//!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
 mod bad_input;
 mod bvh_oracle;
 mod cli;
@@ -30,4 +32,5 @@ mod real_data;
 mod regression;
 mod stances;
 mod stances_truth;
+mod twopac;
 mod util;

@@ -34,6 +34,10 @@ pub enum Command {
     /// Feasibility maps over a stance library.
     #[command(subcommand)]
     Map(MapCommand),
+    /// Equilibrium verdict and robustness margin of one contact set at many COM states.
+    Equilibrium(EquilibriumArgs),
+    /// 2PAC multi-contact COM trajectory of a contact phase sequence.
+    Twopac(TwopacArgs),
 }
 
 /// `stancelib query …`.
@@ -301,6 +305,43 @@ pub struct SynthArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Output BVH file; the truth goes beside it as `<stem>.truth.csv`.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `stancelib equilibrium` (spec two-pac §8.2).
+#[derive(Debug, Args)]
+pub struct EquilibriumArgs {
+    /// Contacts file (JSON, schema `stancelib.twopac.contacts/1`).
+    #[arg(long)]
+    pub contacts: PathBuf,
+    /// COM states: Parquet with `x`, `y`, `z` and optionally `ax`, `ay`, `az` (m, m/s²).
+    #[arg(long)]
+    pub points: PathBuf,
+    /// Output Parquet file.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `stancelib twopac` (spec two-pac §1.1, §8).
+#[derive(Debug, Args)]
+pub struct TwopacArgs {
+    /// Phase sequence (JSON, schema `stancelib.twopac.phases/1`).
+    #[arg(long, required_unless_present = "clip")]
+    pub phases: Option<PathBuf>,
+    /// Phases from a recorded clip (two-pac §1.1 `--clip`; not available yet).
+    #[arg(long, conflicts_with = "phases")]
+    pub clip: Option<PathBuf>,
+    /// Library folder with `kinematics.parquet` (for named kinematic polytopes).
+    #[arg(long)]
+    pub lib: Option<PathBuf>,
+    /// Character of the library's polytopes (default: the only one).
+    #[arg(long)]
+    pub character: Option<String>,
+    /// Transition QP form: `eq13` (equality form, default) or `eq6` (H-representation).
+    #[arg(long, default_value = "eq13")]
+    pub form: String,
+    /// Output folder.
     #[arg(long)]
     pub out: PathBuf,
 }

@@ -29,5 +29,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Query(QueryCommand::Run(a)) => cmd::query::run(a),
         Command::Query(QueryCommand::Jump(a)) => cmd::query::run_jump(a),
         Command::Map(MapCommand::Jumps(a)) => cmd::map::run(a),
+        Command::Equilibrium(a) => cmd::equilibrium::run(a),
+        Command::Twopac(a) => cmd::twopac::run(a),
     }
 }

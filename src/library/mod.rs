@@ -11,6 +11,7 @@ pub mod queries;
 pub mod read;
 pub mod schema;
 pub mod stances;
+pub mod twopac;
 pub mod write;
 
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};

@@ -13,6 +13,8 @@ use plotters::style::FontStyle;
 
 use crate::query::map::JumpMap;
 
+pub mod trajectory;
+
 /// DejaVu Sans, registered as the `sans-serif` family on first use.
 static FONT: &[u8] = include_bytes!("DejaVuSans.ttf");
 static REGISTER: Once = Once::new();

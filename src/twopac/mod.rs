@@ -50,6 +50,7 @@ pub mod bezier;
 pub mod contact;
 pub mod equilibrium;
 pub mod hull;
+pub mod phases;
 pub mod polytope;
 pub mod region;
 mod simplex;

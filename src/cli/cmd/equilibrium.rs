@@ -1,0 +1,120 @@
+//! `stancelib equilibrium`: the static/dynamic equilibrium verdict and robustness margin
+//! of one contact set at many COM states (spec two-pac §8.2, §9).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Context;
+use rayon::prelude::*;
+
+use super::super::args::EquilibriumArgs;
+use super::super::Outcome;
+use crate::library::read::Table;
+use crate::library::twopac::equilibrium_table;
+use crate::library::write::write_atomic;
+use crate::twopac::contact::{contact_points, min_mu};
+use crate::twopac::equilibrium::{EqualityForm, Status, Verdict};
+use crate::twopac::phases::parse_contacts;
+
+/// Reads a UTF-8 text file, naming it on failure.
+pub(crate) fn read_text(path: &Path) -> anyhow::Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// COM positions (m) and accelerations (m/s²), one per row.
+type ComStates = (Vec<[f64; 3]>, Vec<[f64; 3]>);
+
+/// The COM positions and accelerations of `P.parquet` (`ax`, `ay`, `az` default 0).
+fn read_points(path: &Path) -> anyhow::Result<ComStates> {
+    let t = Table::open(path)?;
+    let xyz = |names: [&str; 3], optional: bool| -> anyhow::Result<Vec<[f64; 3]>> {
+        let mut cols = Vec::with_capacity(3);
+        for n in names {
+            if optional && t.df.column(n).is_err() {
+                cols.push(vec![0.0; t.height()]);
+            } else {
+                cols.push(t.f64s(n)?);
+            }
+        }
+        Ok((0..t.height())
+            .map(|i| [cols[0][i], cols[1][i], cols[2][i]])
+            .collect())
+    };
+    Ok((xyz(["x", "y", "z"], false)?, xyz(["ax", "ay", "az"], true)?))
+}
+
+/// Run `equilibrium`.
+///
+/// # Errors
+/// An unreadable or invalid contacts file, an unreadable points table or one without
+/// `x`, `y`, `z` (float64, no nulls), an unwritable output.
+pub fn run(a: EquilibriumArgs) -> anyhow::Result<Outcome> {
+    let text = read_text(&a.contacts)?;
+    let file = parse_contacts(&text).with_context(|| a.contacts.display().to_string())?;
+    let (com, acc) = read_points(&a.points)?;
+    let form = EqualityForm::new(&file.contacts, file.mass_kg)
+        .with_context(|| a.contacts.display().to_string())?;
+    let t0 = Instant::now();
+    form.force_closure();
+    let verdicts: Vec<Verdict> = com
+        .par_iter()
+        .zip(acc.par_iter())
+        .map(|(c, a)| form.verdict(*c, *a))
+        .collect();
+    let elapsed = t0.elapsed().as_secs_f64();
+    let points = contact_points(&file.contacts);
+    let options = serde_json::json!({
+        "contacts_file_schema": crate::twopac::phases::CONTACTS_SCHEMA,
+        "mass_kg": file.mass_kg,
+        "n_contacts": file.contacts.len(),
+        "n_contact_points": points.len(),
+        "min_mu": min_mu(&points),
+    });
+    let kv = vec![
+        (
+            "stancelib.tool_version".to_string(),
+            env!("CARGO_PKG_VERSION").to_string(),
+        ),
+        ("stancelib.equilibrium".to_string(), options.to_string()),
+    ];
+    let (dir, name) = split_out(&a.out)?;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    write_atomic(dir, &name, &mut equilibrium_table(&com, &verdicts)?, &kv)?;
+    let count = |s: Status| verdicts.iter().filter(|v| v.status == s).count();
+    let n_in = verdicts.iter().filter(|v| v.in_equilibrium).count();
+    let failed = count(Status::SolverFailed);
+    println!(
+        "equilibrium: {} point(s), {} contact(s) ({} points), m = {} kg: {n_in} in equilibrium; \
+         status ok {}, force_closure {}, infeasible {}, solver_failed {failed}; {:.3} s",
+        com.len(),
+        file.contacts.len(),
+        points.len(),
+        file.mass_kg,
+        count(Status::Ok),
+        count(Status::ForceClosure),
+        count(Status::Infeasible),
+        elapsed
+    );
+    println!("  → {}", a.out.display());
+    Ok(if failed == 0 {
+        Outcome::Clean
+    } else if failed == verdicts.len() {
+        Outcome::AllFailed
+    } else {
+        Outcome::SomeFailed
+    })
+}
+
+/// `(folder, file name)` of an output file path.
+pub(crate) fn split_out(out: &Path) -> anyhow::Result<(&Path, String)> {
+    let name = out
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("--out {}: not a file name", out.display()))?
+        .to_string();
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    Ok((dir, name))
+}

@@ -1,0 +1,196 @@
+//! `trajectory.png` of `twopac` (spec two-pac §8): a side view (x–z) and a top view (x–y)
+//! of the contacts, phase states, transition points, the 2PAC curve and the quasi-static
+//! polyline, with equal scales on both axes of a view (metres).
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{err, register_font, PlotError};
+
+/// What `trajectory.png` shows (world frame, m).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TrajectoryPlot {
+    /// Title.
+    pub title: String,
+    /// Each contact's points (a rectangle's 4 corners, or one point).
+    pub contacts: Vec<Vec<[f64; 3]>>,
+    /// The 2PAC COM curve, sampled.
+    pub curve: Vec<[f64; 3]>,
+    /// The quasi-static polyline's knots.
+    pub quasi_static: Vec<[f64; 3]>,
+    /// Transition points.
+    pub transitions: Vec<[f64; 3]>,
+    /// Phase states `c^(j)`.
+    pub phase_states: Vec<[f64; 3]>,
+}
+
+/// Pixel size of one view.
+const VIEW_PX: (u32, u32) = (760, 640);
+/// Label areas of a view, px (x axis, y axis).
+const LABEL_PX: (u32, u32) = (45, 60);
+
+/// Ranges around every point on axes `(i, k)`, padded, with equal metres per pixel.
+fn ranges(d: &TrajectoryPlot, i: usize, k: usize) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
+    let all = d
+        .contacts
+        .iter()
+        .flatten()
+        .chain(&d.curve)
+        .chain(&d.quasi_static)
+        .chain(&d.transitions)
+        .chain(&d.phase_states);
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in all.filter(|p| p.iter().all(|v| v.is_finite())) {
+        for (a, axis) in [i, k].into_iter().enumerate() {
+            lo[a] = lo[a].min(p[axis]);
+            hi[a] = hi[a].max(p[axis]);
+        }
+    }
+    if !lo[0].is_finite() {
+        return (-1.0..1.0, -1.0..1.0);
+    }
+    let w = f64::from(VIEW_PX.0 - LABEL_PX.1 - 30);
+    let h = f64::from(VIEW_PX.1 - LABEL_PX.0 - 60);
+    let span = [
+        (hi[0] - lo[0]).max(0.2) * 1.15,
+        (hi[1] - lo[1]).max(0.2) * 1.15,
+    ];
+    let per_px = (span[0] / w).max(span[1] / h);
+    let half = [0.5 * per_px * w, 0.5 * per_px * h];
+    let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    (
+        (mid[0] - half[0])..(mid[0] + half[0]),
+        (mid[1] - half[1])..(mid[1] + half[1]),
+    )
+}
+
+fn view(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    path: &Path,
+    d: &TrajectoryPlot,
+    (caption, k, y_desc, legend): (&str, usize, &str, SeriesLabelPosition),
+) -> Result<(), PlotError> {
+    let pr = |p: &[f64; 3]| (p[0], p[k]);
+    let (xr, yr) = ranges(d, 0, k);
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(LABEL_PX.0)
+        .y_label_area_size(LABEL_PX.1)
+        .build_cartesian_2d(xr, yr)
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("x (m)")
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| err(path, e))?;
+    let grey = RGBColor(110, 110, 110);
+    let mut first = true;
+    for c in &d.contacts {
+        let mut pts: Vec<(f64, f64)> = c.iter().map(pr).collect();
+        if pts.len() > 1 {
+            pts.push(pts[0]);
+        }
+        chart
+            .draw_series(pts.iter().map(|p| Cross::new(*p, 4, grey)))
+            .map_err(|e| err(path, e))?;
+        let s = chart
+            .draw_series(std::iter::once(PathElement::new(pts, grey.stroke_width(2))))
+            .map_err(|e| err(path, e))?;
+        if first {
+            s.label("contacts").legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(2))
+            });
+            first = false;
+        }
+    }
+    let orange = RGBColor(255, 140, 0);
+    chart
+        .draw_series(LineSeries::new(
+            d.quasi_static.iter().map(pr),
+            orange.stroke_width(2),
+        ))
+        .map_err(|e| err(path, e))?
+        .label("quasi-static polyline")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
+    let blue = RGBColor(30, 90, 200);
+    chart
+        .draw_series(LineSeries::new(
+            d.curve.iter().map(pr),
+            blue.stroke_width(3),
+        ))
+        .map_err(|e| err(path, e))?
+        .label("2PAC COM curve")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue.stroke_width(3)));
+    let green = RGBColor(46, 139, 87);
+    chart
+        .draw_series(
+            d.phase_states
+                .iter()
+                .map(|p| Circle::new(pr(p), 5, green.filled())),
+        )
+        .map_err(|e| err(path, e))?
+        .label("phase states c(j)")
+        .legend(move |(x, y)| Circle::new((x + 8, y), 5, green.filled()));
+    chart
+        .draw_series(
+            d.transitions
+                .iter()
+                .map(|p| TriangleMarker::new(pr(p), 7, RED.filled())),
+        )
+        .map_err(|e| err(path, e))?
+        .label("transition points c(j, j+1)")
+        .legend(|(x, y)| TriangleMarker::new((x + 8, y), 7, RED.filled()));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(legend)
+        .draw()
+        .map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+/// Draws `trajectory.png`: side view (x–z) left, top view (x–y) right.
+///
+/// # Errors
+/// The file cannot be written or the font cannot be used.
+pub fn trajectory_png(path: &Path, d: &TrajectoryPlot) -> Result<(), PlotError> {
+    register_font();
+    let root = BitMapBackend::new(path, (2 * VIEW_PX.0, VIEW_PX.1 + 40)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let root = root
+        .titled(&d.title, ("sans-serif", 22))
+        .map_err(|e| err(path, e))?;
+    let (left, right) = root.split_horizontally(VIEW_PX.0);
+    view(
+        &left,
+        path,
+        d,
+        (
+            "Side view (x–z)",
+            2,
+            "z (m)",
+            SeriesLabelPosition::MiddleRight,
+        ),
+    )?;
+    view(
+        &right,
+        path,
+        d,
+        (
+            "Top view (x–y)",
+            1,
+            "y (m)",
+            SeriesLabelPosition::UpperRight,
+        ),
+    )?;
+    root.present().map_err(|e| err(path, e))?;
+    Ok(())
+}

@@ -1,0 +1,454 @@
+//! The `equilibrium` and `twopac` commands end to end on `fixtures/twopac/` (spec two-pac
+//! §1.1, §8, §8.2, §9): reference margins, the single-point-contact verdict, trajectory
+//! boundary states, transition points inside kinematic boxes recomputed here from the
+//! JSON, `timings.json` keys, and bad JSON rejected with its JSON path (exit 2, nothing
+//! written).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use polars::prelude::*;
+use stancelib::library::read::Table;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/twopac")
+        .join(name)
+}
+
+fn stancelib(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stancelib"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = stancelib(args);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        o.status.success(),
+        "stancelib {args:?} failed:\n{out}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    out
+}
+
+/// Runs a command that must fail with exit code 2; returns stderr.
+fn fails(args: &[&str]) -> String {
+    let o = stancelib(args);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "stancelib {args:?}: {err}");
+    err
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// Writes a points table with the given columns.
+fn write_points(path: &Path, cols: &[(&str, Vec<f64>)]) {
+    let mut df = DataFrame::new_infer_height(
+        cols.iter()
+            .map(|(n, v)| Column::new((*n).into(), v.clone()))
+            .collect(),
+    )
+    .unwrap();
+    ParquetWriter::new(std::fs::File::create(path).unwrap())
+        .finish(&mut df)
+        .unwrap();
+}
+
+fn equilibrium(contacts: &Path, cols: &[(&str, Vec<f64>)]) -> (tempfile::TempDir, Table) {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, r) = (dir.path().join("p.parquet"), dir.path().join("r.parquet"));
+    write_points(&p, cols);
+    ok(&[
+        "equilibrium",
+        "--contacts",
+        &s(contacts),
+        "--points",
+        &s(&p),
+        "--out",
+        &s(&r),
+    ]);
+    let t = Table::open(&r).unwrap();
+    (dir, t)
+}
+
+#[test]
+fn equilibrium_reference_case_r2() {
+    // Spec §9 R2: m = 54, μ = 0.3, four points (±0.05, ±0.1, 0): margin ≈ 38.05 N at
+    // (0, 0, 1), ≈ −77546 N with c̈ = (1000, 0, 0). Tolerances: the spec gives 4 and 5
+    // significant figures.
+    let (_d, t) = equilibrium(
+        &fixture("r2_contacts.json"),
+        &[
+            ("x", vec![0.0, 0.0]),
+            ("y", vec![0.0, 0.0]),
+            ("z", vec![1.0, 1.0]),
+            ("ax", vec![0.0, 1000.0]),
+        ],
+    );
+    let margin = t.opt_f64("margin_n").unwrap();
+    assert!((margin[0].unwrap() - 38.05).abs() < 0.01, "{margin:?}");
+    assert!((margin[1].unwrap() + 77546.0).abs() < 1.0, "{margin:?}");
+    assert_eq!(t.bools("in_equilibrium").unwrap(), [true, false]);
+    assert_eq!(t.strings("status").unwrap(), ["ok", "ok"]);
+    assert_eq!(t.f64s("z").unwrap(), [1.0, 1.0]);
+}
+
+#[test]
+fn equilibrium_single_point_contact_only_on_its_vertical() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = dir.path().join("c.json");
+    std::fs::write(
+        &c,
+        r#"{"schema": "stancelib.twopac.contacts/1", "mass_kg": 60,
+            "contacts": [{"effector": "hand", "position": [0.2, -0.1, 0.0], "normal": [0, 0, 1]}]}"#,
+    )
+    .unwrap();
+    let (_d, t) = equilibrium(
+        &c,
+        &[
+            ("x", vec![0.2, 0.25, 0.2]),
+            ("y", vec![-0.1, -0.1, 0.0]),
+            ("z", vec![1.0, 1.0, 0.8]),
+        ],
+    );
+    assert_eq!(
+        t.strings("status").unwrap(),
+        ["ok", "infeasible", "infeasible"]
+    );
+    assert_eq!(t.bools("in_equilibrium").unwrap(), [true, false, false]);
+    let m = t.opt_f64("margin_n").unwrap();
+    assert!(
+        m[0].unwrap() > 0.0 && m[1].is_none() && m[2].is_none(),
+        "{m:?}"
+    );
+}
+
+#[test]
+fn equilibrium_ring_scene_centre_in_far_out() {
+    // §8.1 ring scene: a COM above the ring's centre is held, one 3 m away is not
+    // (unless the set were in force closure, which would say so for every point).
+    let (_d, t) = equilibrium(
+        &fixture("ring_contacts.json"),
+        &[
+            ("x", vec![0.0, 3.0]),
+            ("y", vec![0.0, 0.0]),
+            ("z", vec![0.9, 0.9]),
+        ],
+    );
+    let status = t.strings("status").unwrap();
+    let inside = t.bools("in_equilibrium").unwrap();
+    assert!(inside[0], "{status:?}");
+    assert!(
+        status[1] == "force_closure" || !inside[1],
+        "{status:?} {inside:?}"
+    );
+}
+
+#[test]
+fn equilibrium_missing_column_names_file_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("p.parquet");
+    write_points(&p, &[("x", vec![0.0]), ("y", vec![0.0])]);
+    let r = dir.path().join("r.parquet");
+    let err = fails(&[
+        "equilibrium",
+        "--contacts",
+        &s(&fixture("r2_contacts.json")),
+        "--points",
+        &s(&p),
+        "--out",
+        &s(&r),
+    ]);
+    assert!(err.contains("p.parquet") && err.contains("'z'"), "{err}");
+    assert!(!r.exists());
+}
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn twopac(phases: &Path) -> (tempfile::TempDir, PathBuf, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let printed = ok(&["twopac", "--phases", &s(phases), "--out", &s(&out)]);
+    (dir, out, printed)
+}
+
+fn xyz(t: &Table, i: usize) -> [f64; 3] {
+    ["x", "y", "z"].map(|c| t.f64s(c).unwrap()[i])
+}
+
+/// The world box of a flat contact's inline box polytope (yaw 0 and axis-aligned rows
+/// in the fixtures): `lo ≤ c − p ≤ hi`.
+fn world_box(kin: &serde_json::Value, p: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let a: Vec<[f64; 3]> = serde_json::from_value(kin["A"].clone()).unwrap();
+    let b: Vec<f64> = serde_json::from_value(kin["b"].clone()).unwrap();
+    let (mut lo, mut hi) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
+    for (r, bi) in a.iter().zip(&b) {
+        let k = r.iter().position(|v| *v != 0.0).unwrap();
+        if r[k] > 0.0 {
+            hi[k] = hi[k].min(bi / r[k] + p[k]);
+        } else {
+            lo[k] = lo[k].max(bi / r[k] + p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+#[test]
+fn twopac_flat_walk_outputs() {
+    let input = fixture("walk_flat.json");
+    let json = read_json(&input);
+    let (_d, out, printed) = twopac(&input);
+    let traj = Table::open(&out.join("trajectory.parquet")).unwrap();
+    let phases = Table::open(&out.join("phases.parquet")).unwrap();
+    let trans = Table::open(&out.join("transitions.parquet")).unwrap();
+    let n = traj.height();
+    assert!(n > 100, "{printed}");
+
+    // Boundary states: the curve starts at phase 0's state with the start velocity and
+    // ends at the last phase's state at rest (§5.1, §6); 1e-9 m is round-off.
+    let time = traj.f64s("time_s").unwrap();
+    let vel = |i: usize| ["vx_mps", "vy_mps", "vz_mps"].map(|c| traj.f64s(c).unwrap()[i]);
+    for k in 0..3 {
+        assert!((xyz(&traj, 0)[k] - xyz(&phases, 0)[k]).abs() < 1e-9);
+        assert!((xyz(&traj, n - 1)[k] - xyz(&phases, phases.height() - 1)[k]).abs() < 1e-9);
+        assert!(vel(0)[k].abs() < 1e-9 && vel(n - 1)[k].abs() < 1e-9);
+    }
+    // The data clock: starts at the middle of phase 0 (0.2 s), ends at the last mid.
+    let durs: Vec<f64> = json["phases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["duration_s"].as_f64().unwrap())
+        .collect();
+    let last_mid = durs.iter().sum::<f64>() - durs[durs.len() - 1] / 2.0;
+    assert!((time[0] - durs[0] / 2.0).abs() < 1e-12);
+    assert!(
+        (time[n - 1] - last_mid).abs() < 1e-9,
+        "{} vs {last_mid}",
+        time[n - 1]
+    );
+    assert!(time.windows(2).all(|w| w[1] > w[0]));
+
+    // One transition per boundary, each inside the world boxes of the phase with more
+    // contacts (recomputed from the JSON; 1e-9 m is the QP's round-off).
+    assert_eq!(trans.height(), durs.len() - 1);
+    let kin_phase = trans.i64s("kinematics_phase").unwrap();
+    for (i, &kp) in kin_phase.iter().enumerate() {
+        let c = xyz(&trans, i);
+        for contact in json["phases"][kp as usize]["contacts"].as_array().unwrap() {
+            let eff = contact["effector"].as_str().unwrap();
+            let p: [f64; 3] = serde_json::from_value(contact["position"].clone()).unwrap();
+            let (lo, hi) = world_box(&json["effectors"][eff]["kinematics"], p);
+            for k in 0..3 {
+                assert!(
+                    c[k] >= lo[k] - 1e-9 && c[k] <= hi[k] + 1e-9,
+                    "transition {i} at {c:?} outside {eff}'s box {lo:?}..{hi:?}"
+                );
+            }
+        }
+    }
+    // Flat feet with generous boxes: every transition is statically feasible.
+    assert!(trans.bools("static_feasible").unwrap().iter().all(|v| *v));
+    assert_eq!(
+        trans.strings("change").unwrap(),
+        ["remove", "add", "remove", "add", "remove", "add", "remove", "add", "remove"]
+    );
+
+    // The §5.4 guarantee is consistent with the per-control-point violations.
+    let win = Table::open(&out.join("windows.parquet")).unwrap();
+    let viol = win.f64_lists("kept_violation_m", None).unwrap();
+    let nv = win.i64s("n_violations").unwrap();
+    for (v, n) in viol.iter().zip(&nv) {
+        assert_eq!(v.iter().filter(|x| **x > 1e-9).count() as i64, *n);
+    }
+    // A remove-then-add pair makes a two-attractor window (§6 step 1).
+    assert_eq!(win.i64s("n_attractors").unwrap()[0], 2);
+
+    // timings.json: the layout of CORRECTIONS Issue 5 item 5.
+    let t = read_json(&out.join("timings.json"));
+    let stat = |v: &serde_json::Value| {
+        let (m, p) = (v["median"].as_f64().unwrap(), v["p95"].as_f64().unwrap());
+        assert!(m > 0.0 && p >= m, "{v}");
+    };
+    assert_eq!(t["phases"].as_array().unwrap().len(), durs.len());
+    for (j, p) in t["phases"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(p["phase"], j);
+        assert!(p["n_contacts"].as_u64().unwrap() >= 1);
+        stat(&p["constraint_build_s"]);
+    }
+    assert_eq!(t["transitions"].as_array().unwrap().len(), durs.len() - 1);
+    for (j, p) in t["transitions"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(p["transition"], j);
+        stat(&p["qp_eq6_s"]);
+        stat(&p["qp_eq13_s"]);
+    }
+    stat(&t["trajectory_s"]);
+    stat(&t["validation_s"]);
+
+    // No solve time in the Parquet files (§8).
+    for f in [
+        "trajectory",
+        "transitions",
+        "phases",
+        "windows",
+        "validation",
+    ] {
+        let cols = Table::open(&out.join(format!("{f}.parquet")))
+            .unwrap()
+            .df
+            .get_column_names()
+            .iter()
+            .map(|c| c.as_str())
+            .collect::<Vec<_>>()
+            .join(",");
+        for word in ["solve", "elapsed", "timing", "qp_"] {
+            assert!(!cols.contains(word), "{f}: {cols}");
+        }
+    }
+    let png = std::fs::read(out.join("trajectory.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
+}
+
+#[test]
+fn twopac_hand_on_wall_runs_and_is_deterministic() {
+    let input = fixture("hand_wall.json");
+    let (_d1, a, _) = twopac(&input);
+    let (_d2, b, _) = twopac(&input);
+    for f in [
+        "trajectory",
+        "transitions",
+        "phases",
+        "windows",
+        "validation",
+    ] {
+        let name = format!("{f}.parquet");
+        let (ta, tb) = (
+            Table::open(&a.join(&name)).unwrap(),
+            Table::open(&b.join(&name)).unwrap(),
+        );
+        assert!(ta.df.equals_missing(&tb.df), "{name} differs between runs");
+    }
+    let trans = Table::open(&a.join("transitions.parquet")).unwrap();
+    assert_eq!(
+        trans.strings("effector").unwrap(),
+        ["right_hand", "left_foot", "left_foot", "right_hand"]
+    );
+    // The hand's polytope (wall normal −X, symmetric box) bounds the transitions that
+    // keep the hand: z ≤ 1.3 + 0.2 m.
+    let kp = trans.i64s("kinematics_phase").unwrap();
+    for (i, z) in trans.f64s("z").unwrap().iter().enumerate() {
+        if kp[i] != 0 && kp[i] != 4 {
+            assert!(
+                *z <= 1.5 + 1e-9 && *z >= 1.3 - 0.75 - 1e-9,
+                "transition {i}: z = {z}"
+            );
+        }
+    }
+}
+
+const WALK: &str = "walk_flat.json";
+
+/// Runs `twopac` on the walk fixture edited by `edit`; it must exit 2 naming `path`, and
+/// write nothing.
+fn rejected(edit: impl Fn(&mut serde_json::Value), path: &str) -> String {
+    let mut json = read_json(&fixture(WALK));
+    edit(&mut json);
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("bad.json");
+    std::fs::write(&input, serde_json::to_string_pretty(&json).unwrap()).unwrap();
+    let out = dir.path().join("out");
+    let err = fails(&["twopac", "--phases", &s(&input), "--out", &s(&out)]);
+    assert!(
+        err.contains("bad.json") && err.contains(path),
+        "expected {path}: {err}"
+    );
+    assert!(!out.exists(), "{err}");
+    err
+}
+
+#[test]
+fn twopac_rejects_unknown_key_with_its_path_and_line() {
+    let err = rejected(
+        |j| j["phases"][2]["contacts"][1]["frictoin"] = 0.5.into(),
+        "phases[2].contacts[1]: unknown field `frictoin`",
+    );
+    assert!(err.contains("line "), "{err}");
+    rejected(|j| j["mass"] = 70.into(), "unknown field `mass`");
+}
+
+#[test]
+fn twopac_rejects_zero_normal() {
+    rejected(
+        |j| j["phases"][3]["contacts"][0]["normal"] = serde_json::json!([0, 0, 0]),
+        "phases[3].contacts[0].normal: zero length",
+    );
+}
+
+#[test]
+fn twopac_rejects_two_changes_in_one_boundary() {
+    // Phase 2 moves the right foot and adds the left foot: two changes.
+    let err = rejected(
+        |j| j["phases"][2]["contacts"][1]["position"] = serde_json::json!([0.3, -0.1, 0.0]),
+        "phases[2]: differs from phases[1] by 2 added and 1 removed",
+    );
+    assert!(err.contains("exactly one change"), "{err}");
+}
+
+#[test]
+fn twopac_named_kinematics_need_a_library() {
+    let err = rejected(
+        |j| j["effectors"]["left_foot"]["kinematics"] = "left_foot".into(),
+        "--lib",
+    );
+    assert!(err.contains("left_foot"), "{err}");
+    rejected(
+        |j| j["effectors"]["left_foot"]["kinematics"] = "left_elbow".into(),
+        "effectors.left_foot.kinematics: unknown polytope \"left_elbow\"",
+    );
+}
+
+#[test]
+fn twopac_eq6_and_eq13_agree_when_static() {
+    // Spec §4: with s = 0 both forms give the same transition point (to 1e-4 m there;
+    // here the same tolerance, the QPs' regularisation moves points by far less).
+    let input = fixture(WALK);
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("eq13"), dir.path().join("eq6"));
+    ok(&["twopac", "--phases", &s(&input), "--out", &s(&a)]);
+    ok(&[
+        "twopac",
+        "--phases",
+        &s(&input),
+        "--form",
+        "eq6",
+        "--out",
+        &s(&b),
+    ]);
+    let (ta, tb) = (
+        Table::open(&a.join("transitions.parquet")).unwrap(),
+        Table::open(&b.join("transitions.parquet")).unwrap(),
+    );
+    assert!(ta.strings("form").unwrap().iter().all(|f| f == "eq13"));
+    assert!(tb.strings("form").unwrap().iter().all(|f| f == "eq6"));
+    assert!(tb
+        .opt_f64("slack_m")
+        .unwrap()
+        .iter()
+        .all(|v| v.unwrap() < 1e-9));
+    for i in 0..ta.height() {
+        let (pa, pb) = (xyz(&ta, i), xyz(&tb, i));
+        for k in 0..3 {
+            assert!(
+                (pa[k] - pb[k]).abs() < 1e-4,
+                "transition {i}: {pa:?} vs {pb:?}"
+            );
+        }
+    }
+}
