@@ -452,3 +452,108 @@ fn twopac_eq6_and_eq13_agree_when_static() {
         }
     }
 }
+
+/// A recorded walk with the library's own foot polytopes (`--lib`): the contact phases of
+/// `cmu_07_01_walk_mb` (foot contact runs from `contacts.parquet`, data COM at each phase's
+/// middle frame) planned against `kinematics.parquet` of the same library. The data COM
+/// lies in its own polytopes, so the plan must succeed, and every transition point lies
+/// inside the world-frame polytopes of its phase (kinematic feasibility never violated).
+#[test]
+fn twopac_plans_a_recorded_walk_with_the_library_polytopes() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bvh");
+    if !data.is_dir() {
+        eprintln!("SKIPPED twopac_plans_a_recorded_walk_with_the_library_polytopes: ../shared/data is absent");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let lib = dir.path().join("lib");
+    let clip = "cmu_07_01_walk_mb";
+    let files = vec![data.join("walk").join(format!("{clip}.bvh"))];
+    let opts = stancelib::pipeline::build::BuildOptions::default();
+    stancelib::pipeline::build::build_and_write(&files, &lib, &opts, false).unwrap();
+    let c = Table::open(&lib.join("contacts.parquet")).unwrap();
+    let (eff, first, last) = (
+        c.strings("effector").unwrap(),
+        c.i64s("first_frame").unwrap(),
+        c.i64s("last_frame").unwrap(),
+    );
+    let (ox, oy, oz, yaw) = (
+        c.f64s("origin_x").unwrap(),
+        c.f64s("origin_y").unwrap(),
+        c.f64s("origin_z").unwrap(),
+        c.f64s("yaw_rad").unwrap(),
+    );
+    let f = Table::open(&lib.join("frames.parquet")).unwrap();
+    let (frame, time) = (f.i64s("frame").unwrap(), f.f64s("time_s").unwrap());
+    let com = [
+        f.f64s("com_x").unwrap(),
+        f.f64s("com_y").unwrap(),
+        f.f64s("com_z").unwrap(),
+    ];
+    let row_of = |k: i64| frame.iter().position(|&x| x == k).unwrap();
+    // Events: a foot run starts at first_frame, ends after last_frame; additions first.
+    let mut events: Vec<(i64, u8, usize)> = Vec::new();
+    for i in (0..c.height()).filter(|&i| eff[i].ends_with("_foot")) {
+        events.push((first[i], 0, i));
+        events.push((last[i] + 1, 1, i));
+    }
+    events.sort();
+    let mut active: Vec<usize> = Vec::new();
+    let mut phases = Vec::new();
+    for w in events.windows(2).take(12) {
+        let (k, kind, run) = w[0];
+        if kind == 0 {
+            active.push(run);
+        } else {
+            active.retain(|&r| r != run);
+        }
+        let next = w[1].0;
+        if active.is_empty() || next <= k {
+            continue;
+        }
+        let mid = row_of((k + next - 1) / 2);
+        let contacts: Vec<serde_json::Value> = active
+            .iter()
+            .map(|&r| {
+                serde_json::json!({
+                    "effector": eff[r], "position": [ox[r], oy[r], oz[r]],
+                    "normal": [0.0, 0.0, 1.0], "yaw_rad": yaw[r],
+                    "surface": {"length_m": 0.22, "width_m": 0.09}
+                })
+            })
+            .collect();
+        let dur = time[row_of(next - 1)] - time[row_of(k)];
+        phases.push(serde_json::json!({
+            "duration_s": dur, "com": [com[0][mid], com[1][mid], com[2][mid]],
+            "contacts": contacts
+        }));
+    }
+    assert!(phases.len() >= 4, "{} phases", phases.len());
+    let walk = serde_json::json!({
+        "schema": "stancelib.twopac.phases/1", "mass_kg": 70.0,
+        "effectors": {"left_foot": {"kinematics": "left_foot"},
+                      "right_foot": {"kinematics": "right_foot"}},
+        "phases": phases,
+    });
+    let file = dir.path().join("walk_lib.json");
+    std::fs::write(&file, serde_json::to_string_pretty(&walk).unwrap()).unwrap();
+    let out = dir.path().join("out");
+    ok(&[
+        "twopac",
+        "--phases",
+        &s(&file),
+        "--lib",
+        &s(&lib),
+        "--out",
+        &s(&out),
+    ]);
+    let t = Table::open(&out.join("transitions.parquet")).unwrap();
+    assert_eq!(t.height(), phases.len() - 1);
+    for (i, m) in t.opt_f64("kinematic_margin_m").unwrap().iter().enumerate() {
+        let m = m.unwrap_or_else(|| panic!("transition {i}: no kinematic margin"));
+        assert!(
+            m >= -1e-9,
+            "transition {i} outside the library polytopes by {m} m"
+        );
+    }
+}

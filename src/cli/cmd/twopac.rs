@@ -49,15 +49,9 @@ fn parse_form(s: &str) -> anyhow::Result<QpForm> {
     }
 }
 
-/// The library's kinematic polytopes keyed by `(character_id, effector)`.
-///
-/// The reader is `stancelib::library::kinematics::read_polytopes`, being added to main by
-/// the lead; until it is merged here this says so (see the branch notes).
+/// The library's kinematic polytopes keyed by `(character_id, effector)` (two-pac §3).
 fn read_library_polytopes(lib: &Path) -> anyhow::Result<BTreeMap<(String, String), Polytope>> {
-    anyhow::bail!(
-        "{}: reading kinematics.parquet is not available in this build yet; use inline {{\"A\", \"b\"}} polytopes",
-        lib.display()
-    )
+    Ok(crate::library::kinematics::read_polytopes(lib)?)
 }
 
 /// The polytopes of one character: `character`, or the only one in the library.
