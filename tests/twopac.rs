@@ -556,4 +556,33 @@ fn twopac_plans_a_recorded_walk_with_the_library_polytopes() {
             "transition {i} outside the library polytopes by {m} m"
         );
     }
+    // The same clip through `--clip` (static / multi-contact mode, phases from its own
+    // contact runs): planned, and its COM compared with the recorded one.
+    let out = dir.path().join("clip");
+    let walk_bvh = s(&files[0]);
+    let printed = ok(&[
+        "twopac",
+        "--clip",
+        &walk_bvh,
+        "--lib",
+        &s(&lib),
+        "--out",
+        &s(&out),
+    ]);
+    let rec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("recorded.json")).unwrap()).unwrap();
+    let rms = rec["rms_to_recorded_m"].as_f64().unwrap();
+    assert!(rec["n_phases"].as_u64().unwrap() >= 4, "{rec}");
+    // Measured 0.10 m on this walk (dynamic walking is not quasi-static); 0.2 m would
+    // mean the phases or the clock were wrong.
+    assert!(rms > 0.0 && rms < 0.2, "RMS {rms} m\n{printed}");
+    let t = Table::open(&out.join("transitions.parquet")).unwrap();
+    for (i, m) in t.opt_f64("kinematic_margin_m").unwrap().iter().enumerate() {
+        assert!(
+            m.unwrap() >= -1e-9,
+            "--clip transition {i} outside the polytopes"
+        );
+    }
+    let no_lib = fails(&["twopac", "--clip", &walk_bvh, "--out", &s(&out)]);
+    assert!(no_lib.contains("--lib"), "{no_lib}");
 }

@@ -329,7 +329,7 @@ pub struct TwopacArgs {
     /// Phase sequence (JSON, schema `stancelib.twopac.phases/1`).
     #[arg(long, required_unless_present = "clip")]
     pub phases: Option<PathBuf>,
-    /// Phases from a recorded clip (two-pac §1.1 `--clip`; not available yet).
+    /// Phases from a recorded clip (two-pac §1.1 `--clip`; needs `--lib`).
     #[arg(long, conflicts_with = "phases")]
     pub clip: Option<PathBuf>,
     /// Library folder with `kinematics.parquet` (for named kinematic polytopes).

@@ -47,6 +47,7 @@
 #![warn(missing_docs)]
 
 pub mod bezier;
+pub mod clip;
 pub mod contact;
 pub mod equilibrium;
 pub mod hull;

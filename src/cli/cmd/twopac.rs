@@ -23,7 +23,8 @@ use crate::library::twopac::{
 use crate::library::write::write_atomic;
 use crate::plot::trajectory::{trajectory_png, TrajectoryPlot};
 use crate::twopac::bezier::ComState;
-use crate::twopac::phases::{parse_phases, PhasesFile};
+use crate::twopac::clip::{phases_from_runs, rms_to_recording, RecordedRun, Recording};
+use crate::twopac::phases::{parse_phases, KinematicsRef, PhasesFile};
 use crate::twopac::polytope::Polytope;
 use crate::twopac::region::{static_region, RegionStatus};
 use crate::twopac::trajectory::{
@@ -287,22 +288,100 @@ fn plot_data(
     }
 }
 
+/// The recorded motion of a `--clip` run (kept frames), and where its phases start.
+struct Recorded {
+    frame: Vec<i64>,
+    time_s: Vec<f64>,
+    com: Vec<[f64; 3]>,
+    start_s: f64,
+}
+
+/// Phases from a clip (two-pac §1.1 `--clip`): ingest with the static / multi-contact
+/// mode on, contact runs → phases of the first stretch of continuous support, library
+/// polytopes for every effector.
+fn clip_phases(clip: &Path, has_lib: bool) -> anyhow::Result<(PhasesFile, Recorded)> {
+    anyhow::ensure!(
+        has_lib,
+        "--clip {}: the effectors' kinematic polytopes come from the library: give --lib LIB",
+        clip.display()
+    );
+    let bvh = crate::bvh::parse_file(clip).with_context(|| clip.display().to_string())?;
+    let mut opts = crate::ingest::IngestOptions::default();
+    opts.contacts.static_mode = true;
+    let outcome = crate::ingest::ingest(&bvh, &opts).with_context(|| clip.display().to_string())?;
+    let crate::ingest::ClipOutcome::Body {
+        frames, contacts, ..
+    } = outcome
+    else {
+        anyhow::bail!("{}: not a body or too short to plan", clip.display());
+    };
+    let runs: Vec<RecordedRun> = contacts
+        .iter()
+        .map(|r| RecordedRun {
+            effector: r.effector.to_string(),
+            frames: (r.first_frame, r.last_frame),
+            origin: r.origin,
+            yaw_rad: r.yaw_rad,
+            normal: r.normal,
+        })
+        .collect();
+    let recording = Recording {
+        frame: &frames.frame,
+        time_s: &frames.time_s,
+        com: &frames.com,
+    };
+    let (phases, start_s) = phases_from_runs(&runs, recording, DEFAULT_CLIP_MU)
+        .with_context(|| clip.display().to_string())?;
+    anyhow::ensure!(
+        !phases.is_empty(),
+        "{}: no contact phase to plan (no support detected)",
+        clip.display()
+    );
+    let effectors = phases
+        .iter()
+        .flat_map(|p| p.contacts.iter().map(|c| c.effector.clone()))
+        .map(|e| (e.clone(), KinematicsRef::Named(e)))
+        .collect();
+    let file = PhasesFile {
+        mass_kg: opts.mass_kg,
+        start: ComState::default(),
+        effectors,
+        phases,
+    };
+    let rec = Recorded {
+        frame: frames.frame,
+        time_s: frames.time_s,
+        com: frames.com,
+        start_s,
+    };
+    Ok((file, rec))
+}
+
+/// Friction coefficient of contacts taken from a clip (two-pac §1 default).
+const DEFAULT_CLIP_MU: f64 = 0.7;
+
 /// Run `twopac`.
 ///
 /// # Errors
 /// A bad option, an unreadable or invalid phases file (exit 2, nothing written), a phase
 /// sequence the core rejects (empty kinematics of a transition), an unwritable output.
 pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
-    if let Some(clip) = &a.clip {
-        anyhow::bail!(
-            "--clip {}: phases from a clip are not available yet; write a --phases JSON file (two-pac §1.1)",
-            clip.display()
-        );
-    }
     let form = parse_form(&a.form)?;
-    let path = a.phases.clone().context("give --phases FILE")?;
-    let text = read_text(&path)?;
-    let file = parse_phases(&text).with_context(|| path.display().to_string())?;
+    let (file, path, recorded) = match &a.clip {
+        Some(clip) => {
+            let (file, rec) = clip_phases(clip, a.lib.is_some())?;
+            (file, clip.clone(), Some(rec))
+        }
+        None => {
+            let path = a
+                .phases
+                .clone()
+                .context("give --phases FILE or --clip CLIP.bvh")?;
+            let text = read_text(&path)?;
+            let file = parse_phases(&text).with_context(|| path.display().to_string())?;
+            (file, path, None)
+        }
+    };
     let phases = resolve(&file, &path, &a)?;
     let opts = PlanOptions {
         form,
@@ -378,6 +457,29 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
         &(serde_json::to_string_pretty(&timings)? + "\n"),
     )?;
     write_png(&a.out, &plot_data(&phases, &p, &curve_rows, &qs))?;
+    if let Some(rec) = &recorded {
+        let planned: Vec<(f64, [f64; 3])> =
+            curve_rows.iter().map(|r| (r.t_s, r.state.pos)).collect();
+        let recording = Recording {
+            frame: &rec.frame,
+            time_s: &rec.time_s,
+            com: &rec.com,
+        };
+        let rms = rms_to_recording(&planned, recording, rec.start_s);
+        let cmp = serde_json::json!({
+            "clip": path.display().to_string(), "start_s": rec.start_s,
+            "n_phases": phases.len(), "rms_to_recorded_m": rms,
+        });
+        write_text(
+            &a.out,
+            "recorded.json",
+            &(serde_json::to_string_pretty(&cmp)? + "\n"),
+        )?;
+        println!(
+            "  recorded COM vs 2PAC COM over the planned span: RMS {} m",
+            rms.map_or("-".into(), |v| format!("{v:.4}"))
+        );
+    }
 
     let n_static = p
         .transitions
