@@ -18,11 +18,13 @@ lint:
 	$(CARGO) clippy --all-targets -- -D warnings
 
 ## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances
-## (library); candidate evaluations and the 200 × 200 jump map (queries).
+## (library); candidate evaluations and the 200 × 200 jump map (queries); 2PAC H-rep,
+## transition QP and 10-phase trajectory (twopac).
 bench:
 	$(CARGO) bench --bench stages
 	$(CARGO) bench --bench library
 	$(CARGO) bench --bench queries
+	$(CARGO) bench --bench twopac
 
 ## The nightly job over ../shared/data (pipelines/nightly.toml).
 nightly:
