@@ -37,6 +37,8 @@ pub mod query;
 pub mod skeleton;
 pub mod stances;
 pub mod synth;
+#[cfg(test)]
+pub(crate) mod testkit;
 pub mod twopac;
 
 pub use error::{Error, ErrorKind, Result};

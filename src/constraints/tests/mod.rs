@@ -10,34 +10,8 @@ mod impulse;
 
 use super::StanceContext;
 use crate::force_model::{AxisModel, ForceModel, GRAVITY};
+pub(super) use crate::testkit::Rng;
 use std::f64::consts::PI;
-
-/// SplitMix64: a seeded generator for test data.
-pub(super) struct Rng(u64);
-
-impl Rng {
-    pub(super) fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi)`.
-    pub(super) fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform integer in `lo..=hi`.
-    pub(super) fn int(&mut self, lo: u32, hi: u32) -> u32 {
-        lo + (self.next_u64() % u64::from(hi - lo + 1)) as u32
-    }
-}
 
 /// A random axis: DC `c0` plus 1–4 harmonics `j ∈ 1..=6` of amplitude up to `amp` (N).
 fn random_axis(rng: &mut Rng, c0: f64, amp: f64) -> AxisModel {

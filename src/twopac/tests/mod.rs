@@ -22,25 +22,7 @@ mod transition;
 use super::contact::{Contact, ContactShape};
 use super::polytope::Polytope;
 
-/// Deterministic SplitMix64 generator for test data.
-pub(crate) struct Rng(u64);
-
-impl Rng {
-    pub(crate) fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[lo, hi)`.
-    pub(crate) fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
+pub(crate) use crate::testkit::Rng;
 
 /// A flat rectangular foot, `length × width`, centred at `pos`, normal `+z`.
 pub(crate) fn flat_foot(name: &str, pos: [f64; 3], length: f64, width: f64, mu: f64) -> Contact {
