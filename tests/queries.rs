@@ -188,6 +188,23 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
             (bv1 - 1.0).abs() <= 0.05 && (bv2 - 1.0).abs() <= 0.05,
             "β_v {bv1}, {bv2}"
         );
+        // The reported margins agree with the verdict: all met iff feasible.
+        let margins = [
+            "margin_force1_n",
+            "margin_mu1",
+            "margin_ext_min1_m",
+            "margin_ext_max1_m",
+            "margin_force2_n",
+            "margin_mu2",
+            "margin_ext_min2_m",
+            "margin_ext_max2_m",
+        ]
+        .map(get);
+        assert_eq!(
+            margins.iter().all(|&m| m >= 0.0),
+            feasible,
+            "{margins:?} vs {why:?}"
+        );
         if [bh1, bv1, bh2, bv2].iter().all(|b| (b - 1.0).abs() <= 0.05) {
             assert!(
                 feasible,

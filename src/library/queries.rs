@@ -7,7 +7,7 @@
 use polars::prelude::*;
 
 use super::columns::{col, list_col};
-use crate::query::feasibility::{Limits, Verdict, Violation};
+use crate::query::feasibility::{relative_limits, Limits, Verdict, Violation};
 use crate::query::jump::Jump;
 use crate::query::map::JumpMap;
 use crate::query::pool::Prepared;
@@ -223,6 +223,17 @@ pub fn jump_table(rows: &[JumpRow]) -> PolarsResult<DataFrame> {
         col("d_flight_m", o(&|j| j.d_flight)),
         col("force_change", o(&Jump::force_change)),
     ];
+    // Slack to each limit (≥ 0 where met): the stance's relative limits, as `query jump`
+    // checks them (§7.5).
+    let margin = |k: usize, g: &dyn Fn(&ScaledStance, &Limits) -> f64| -> Vec<Option<f64>> {
+        rows.iter()
+            .map(|r| {
+                let p = if k == 0 { r.liftoff } else { r.landing };
+                let lim = relative_limits(&p.stance.coef);
+                r.jump.as_ref().ok().map(|j| g(&j.sides[k].1, &lim))
+            })
+            .collect()
+    };
     for (k, n) in [(0, "1"), (1, "2")] {
         let x = |j: &Jump| j.sides[k].0.x;
         cols.extend([
@@ -239,6 +250,22 @@ pub fn jump_table(rows: &[JumpRow]) -> PolarsResult<DataFrame> {
             col(&format!("ext_max{n}_m"), side(k, &|s| s.verdict.ext_max)),
             col(&format!("cp_h{n}_m"), side(k, &|s| s.cp[0])),
             col(&format!("cp_p{n}_m"), side(k, &|s| s.cp[1])),
+            col(
+                &format!("margin_force{n}_n"),
+                margin(k, &|s, l| l.f_max - s.verdict.f_peak),
+            ),
+            col(
+                &format!("margin_mu{n}"),
+                margin(k, &|s, l| l.mu - s.verdict.mu_req),
+            ),
+            col(
+                &format!("margin_ext_min{n}_m"),
+                margin(k, &|s, l| s.verdict.ext_min - l.chi_min),
+            ),
+            col(
+                &format!("margin_ext_max{n}_m"),
+                margin(k, &|s, l| l.chi_max - s.verdict.ext_max),
+            ),
         ]);
     }
     let flag = |g: &dyn Fn(&Jump) -> bool| -> Vec<bool> {
