@@ -106,6 +106,28 @@ fn run_sweep_reproduces_table_one_pattern() {
     // The slow end is feasible; the recorded stances' own friction need (μ_req up to 1.4
     // on cmu_09_01's R:40, from the model's edge ringing) exceeds μ = 0.7 near 4 m/s.
     assert!(feasible[0], "the 0 m/s bounce is infeasible:\n{printed}");
+    // §7.5 override: at its own speed the recorded cycle (k = 1, the identity) meets its
+    // stances' relative limits, while the absolute μ = 0.7 rejects it (μ_req 1.42).
+    let own = lib.parent().unwrap().join("own.parquet");
+    let v0 = v_orig[0].to_string();
+    let l = lib.display().to_string();
+    for (form, want) in [("relative", true), ("absolute", false)] {
+        stancelib(&[
+            "query",
+            "run",
+            "--lib",
+            &l,
+            "--speed",
+            &v0,
+            "--limits",
+            form,
+            "--out",
+            &own.display().to_string(),
+        ]);
+        let t = Table::open(&own).unwrap();
+        let f = t.bools("feasible").unwrap();
+        assert_eq!(f[0], want, "--limits {form} at the recorded speed");
+    }
     eprintln!("query run on the shared library: {n_cycles} cycles\n{printed}");
 }
 

@@ -93,6 +93,12 @@ pub struct RunQueryArgs {
     /// Body-mass ratio target/recorded character.
     #[arg(long = "mass-scale", default_value_t = 1.0)]
     pub mass_scale: f64,
+    /// Limit form: absolute (per character) or relative (per stance) (§7.5).
+    #[arg(long, value_parser = ["absolute", "relative"])]
+    pub limits: Option<String>,
+    /// Friction limit μ of the absolute form (default 0.7).
+    #[arg(long)]
+    pub mu: Option<f64>,
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
@@ -132,6 +138,12 @@ pub struct JumpArgs {
     /// Rows printed (the file has every pair).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
+    /// Limit form: absolute (per character) or relative (per stance) (§7.5).
+    #[arg(long, value_parser = ["absolute", "relative"])]
+    pub limits: Option<String>,
+    /// Friction limit μ of the absolute form (default 0.7).
+    #[arg(long)]
+    pub mu: Option<f64>,
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
@@ -149,6 +161,12 @@ pub struct MapJumpsArgs {
     /// Columns: horizontal apex speeds `start:stop:step`, m/s.
     #[arg(long, default_value = "0:5:0.05")]
     pub speeds: String,
+    /// Limit form: absolute (per character) or relative (per stance) (§7.5).
+    #[arg(long, value_parser = ["absolute", "relative"])]
+    pub limits: Option<String>,
+    /// Friction limit μ of the absolute form (default 0.7).
+    #[arg(long)]
+    pub mu: Option<f64>,
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,

@@ -7,7 +7,7 @@
 use polars::prelude::*;
 
 use super::columns::{col, list_col};
-use crate::query::feasibility::{relative_limits, Limits, Verdict, Violation};
+use crate::query::feasibility::{Limits, Verdict, Violation};
 use crate::query::jump::Jump;
 use crate::query::map::JumpMap;
 use crate::query::pool::Prepared;
@@ -35,8 +35,8 @@ pub struct RunRow<'a> {
     pub stances: [&'a Prepared; 2],
     /// The outcome.
     pub candidate: RunCandidate,
-    /// The limits it was checked against.
-    pub limits: Limits,
+    /// The limits each stance was checked against.
+    pub limits: [Limits; 2],
 }
 
 impl RunRow<'_> {
@@ -87,6 +87,13 @@ pub fn run_table(rows: &[RunRow]) -> PolarsResult<DataFrame> {
     let first = |r: &RunRow| r.stances[0].stance.clone();
     let lists = |name: &str, g: &dyn Fn(&ScaledStance) -> f64| {
         list_col(name, per_stance(rows, g), DataType::Float64)
+    };
+    let lim_list = |name: &str, g: &dyn Fn(&Limits) -> f64| {
+        let v: Vec<Vec<f64>> = rows
+            .iter()
+            .map(|r| r.limits.iter().map(g).collect())
+            .collect();
+        list_col(name, v, DataType::Float64)
     };
     DataFrame::new_infer_height(vec![
         col("speed_mps", f(&|r| r.candidate.speed)),
@@ -144,10 +151,10 @@ pub fn run_table(rows: &[RunRow]) -> PolarsResult<DataFrame> {
             "violated",
             rows.iter().map(RunRow::violated).collect::<Vec<_>>(),
         ),
-        col("limit_mu", f(&|r| r.limits.mu)),
-        col("limit_f_max_n", f(&|r| r.limits.f_max)),
-        col("limit_chi_min_m", f(&|r| r.limits.chi_min)),
-        col("limit_chi_max_m", f(&|r| r.limits.chi_max)),
+        lim_list("limit_mu", &|l| l.mu)?,
+        lim_list("limit_f_max_n", &|l| l.f_max)?,
+        lim_list("limit_chi_min_m", &|l| l.chi_min)?,
+        lim_list("limit_chi_max_m", &|l| l.chi_max)?,
     ])
 }
 
@@ -161,6 +168,8 @@ pub struct JumpRow<'a> {
     pub height: f64,
     /// Requested distance, m.
     pub distance: f64,
+    /// The limits each side was checked against (liftoff, landing).
+    pub limits: [Limits; 2],
     /// The jump, or why it has no admissible scaling.
     pub jump: Result<Jump, String>,
 }
@@ -223,15 +232,10 @@ pub fn jump_table(rows: &[JumpRow]) -> PolarsResult<DataFrame> {
         col("d_flight_m", o(&|j| j.d_flight)),
         col("force_change", o(&Jump::force_change)),
     ];
-    // Slack to each limit (≥ 0 where met): the stance's relative limits, as `query jump`
-    // checks them (§7.5).
+    // Slack to each limit the side was checked against (≥ 0 where met).
     let margin = |k: usize, g: &dyn Fn(&ScaledStance, &Limits) -> f64| -> Vec<Option<f64>> {
         rows.iter()
-            .map(|r| {
-                let p = if k == 0 { r.liftoff } else { r.landing };
-                let lim = relative_limits(&p.stance.coef);
-                r.jump.as_ref().ok().map(|j| g(&j.sides[k].1, &lim))
-            })
+            .map(|r| r.jump.as_ref().ok().map(|j| g(&j.sides[k].1, &r.limits[k])))
             .collect()
     };
     for (k, n) in [(0, "1"), (1, "2")] {

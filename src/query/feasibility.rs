@@ -100,6 +100,27 @@ pub struct Limits {
     pub chi_max: f64,
 }
 
+/// Which limits a query checks (§7.5): `Absolute` per character (`query run`'s default),
+/// `Relative` to each stance's own extremes (`query jump` and `map jumps`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimitForm {
+    /// μ (0.7 or given), and 1.05 × the character's extremes (§7.5 table, left).
+    Absolute,
+    /// 1.05 × the stance's own extremes (§7.5 table, right).
+    Relative,
+}
+
+impl LimitForm {
+    /// `absolute` or `relative`; `None` otherwise.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "absolute" => Some(LimitForm::Absolute),
+            "relative" => Some(LimitForm::Relative),
+            _ => None,
+        }
+    }
+}
+
 /// The query's context: scaled stance start state and contact point, stance frame
 /// (§5, §7.3); the same fields as the stance's own [`StanceContext`].
 pub type QueryContext = StanceContext;

@@ -13,6 +13,7 @@
 //! ```
 //! Cost: `O((n1 + n2)·n_h·n_u·N_s)` for the per-stance work, `O(n1·n2·n_h·n_u)` bit
 //! operations for the pairs. Limits are relative per stance (§7.5) unless given.
+//! [`stance_relative_limits`] is the default `limits` argument of [`jump_map`].
 //!
 //! # References
 //! spec stance-model §6.9–§6.10, §7.3–§7.5; CORRECTIONS Issue 4 items 1, 3, 6.
@@ -116,6 +117,11 @@ pub fn stance_grid(
         }
     }
     out
+}
+
+/// A stance's relative limits (§7.5), the default of [`jump_map`].
+pub fn stance_relative_limits(p: &Prepared) -> Limits {
+    relative_limits(&p.stance.coef)
 }
 
 /// Counts of one pair's cells: approximate, exact, both, either.
@@ -230,18 +236,24 @@ fn pair_map(
 }
 
 /// The jump map of a pool (§6.10): every liftoff paired with every landing of the same
-/// `character_id`, relative limits per stance. Parallel over stances and pairs.
+/// `character_id`, each stance checked against `limits(stance)` (§7.5: its relative
+/// limits by default, [`relative_limits`]). Parallel over stances and pairs.
 ///
 /// Landings whose contact height differs from their liftoff's get their own grid per
 /// distinct height offset (level ground, the common case, shares one grid per stance).
-pub fn jump_map(pool: &[Prepared], heights: &[f64], speeds: &[f64]) -> JumpMap {
+pub fn jump_map(
+    pool: &[Prepared],
+    heights: &[f64],
+    speeds: &[f64],
+    limits: &(dyn Fn(&Prepared) -> Limits + Sync),
+) -> JumpMap {
     let liftoffs: Vec<usize> = (0..pool.len())
         .filter(|&i| is_liftoff(&pool[i].stance))
         .collect();
     let landings: Vec<usize> = (0..pool.len())
         .filter(|&i| is_landing(&pool[i].stance))
         .collect();
-    let lim = |i: usize| relative_limits(&pool[i].stance.coef);
+    let lim = |i: usize| limits(&pool[i]);
     let up: Vec<StanceGrid> = liftoffs
         .par_iter()
         .map(|&i| stance_grid(&pool[i], true, heights, speeds, 0.0, &lim(i)))

@@ -247,10 +247,20 @@ impl RunCandidate {
 
 /// The run-at-speed policy for one cycle of (already character-scaled) prepared stances.
 ///
-/// `v_orig` is the scaled cycle's mean speed; `lim` the target character's limits.
-pub fn run_at_speed(cycle: [&Prepared; 2], v_orig: f64, speed: f64, lim: &Limits) -> RunCandidate {
+/// `v_orig` is the scaled cycle's mean speed; `lims` each stance's limits (the target
+/// character's absolute limits by default, §7.5).
+pub fn run_at_speed(
+    cycle: [&Prepared; 2],
+    v_orig: f64,
+    speed: f64,
+    lims: [&Limits; 2],
+) -> RunCandidate {
     let k = speed / v_orig;
-    let stances = cycle.map(|p| scale_and_check(p, &policy_request(&p.stance, k), lim));
+    let check = |i: usize| {
+        let p = cycle[i];
+        scale_and_check(p, &policy_request(&p.stance, k), lims[i])
+    };
+    let stances = [check(0), check(1)];
     RunCandidate {
         speed,
         k,

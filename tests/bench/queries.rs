@@ -25,7 +25,7 @@ use stancelib::library::read::read_stances;
 use stancelib::pipeline::batch::discover;
 use stancelib::pipeline::build::{build_and_write, BuildOptions};
 use stancelib::query::feasibility::{approx, relative_limits};
-use stancelib::query::map::{jump_map, Axis};
+use stancelib::query::map::{jump_map, stance_relative_limits, Axis};
 use stancelib::query::pool::Prepared;
 use stancelib::query::solve::{solve, Refs, Request};
 
@@ -114,7 +114,7 @@ fn jump_map_200(c: &mut Criterion) {
     }
     .values();
     assert_eq!((heights.len(), speeds.len()), (200, 200));
-    let map = jump_map(&pool, &heights, &speeds);
+    let map = jump_map(&pool, &heights, &speeds, &stance_relative_limits);
     eprintln!(
         "jump_map_200: {} pairs × 40,000 cells, IoU {:.4}",
         map.pairs.len(),
@@ -124,7 +124,7 @@ fn jump_map_200(c: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(15));
     g.throughput(Throughput::Elements((map.pairs.len() * 40_000) as u64));
     g.bench_function("pairs_cells_exact", |b| {
-        b.iter(|| black_box(jump_map(&pool, &heights, &speeds).agreement))
+        b.iter(|| black_box(jump_map(&pool, &heights, &speeds, &stance_relative_limits).agreement))
     });
     g.finish();
 }

@@ -8,11 +8,13 @@ use anyhow::Context;
 
 use super::super::args::MapJumpsArgs;
 use super::super::Outcome;
-use super::query::{load_pool, query_kv};
+use super::query::{absolute_limits, limit_form, load_pool, query_kv, stance_limits};
 use crate::library::queries::{jump_map_table, jump_pairs_table};
 use crate::library::write::write_atomic;
 use crate::plot::jump_map_png;
+use crate::query::feasibility::LimitForm;
 use crate::query::map::jump_map;
+use crate::query::pool::Prepared;
 
 /// Draws the PNG under a temporary name, then renames it into place.
 fn write_png(dir: &Path, map: &crate::query::map::JumpMap) -> anyhow::Result<()> {
@@ -37,9 +39,12 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         !heights.is_empty() && !speeds.is_empty(),
         "the grid is empty: check --heights and --speeds"
     );
-    let (_, pool) = load_pool(&a.lib)?;
+    let (form, mu) = limit_form(a.limits.as_deref(), a.mu, LimitForm::Relative)?;
+    let (lib, pool) = load_pool(&a.lib)?;
+    let absolute = absolute_limits(&lib);
+    let limits = |p: &Prepared| stance_limits(p, form, &absolute, mu);
     let t0 = Instant::now();
-    let map = jump_map(&pool, &heights, &speeds);
+    let map = jump_map(&pool, &heights, &speeds, &limits);
     let elapsed = t0.elapsed().as_secs_f64();
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))?;
@@ -50,7 +55,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         "liftoffs": map.liftoffs.len(), "landings": map.landings.len(), "pairs": map.pairs.len(),
         "cells_approx": map.agreement.approx, "cells_exact": map.agreement.exact,
         "cells_both": map.agreement.both, "iou": iou,
-        "limits": "relative per stance (stance-model §7.5)",
+        "limits": format!("{form:?}").to_lowercase(),
     });
     let kv = query_kv(summary.clone());
     write_atomic(

@@ -13,7 +13,7 @@ use super::super::Outcome;
 use crate::library::queries::{jump_table, run_table, JumpRow, RunRow};
 use crate::library::read::{open_library, StanceLibrary};
 use crate::library::write::write_atomic;
-use crate::query::feasibility::Limits;
+use crate::query::feasibility::{relative_limits, LimitForm, Limits};
 use crate::query::jump::{is_landing, is_liftoff, jump};
 use crate::query::pool::Prepared;
 use crate::query::run::{run_at_speed, run_cycles, scale_limits, RunCycle};
@@ -73,6 +73,46 @@ pub fn absolute_limits(lib: &StanceLibrary) -> BTreeMap<String, Limits> {
             (k, lim)
         })
         .collect()
+}
+
+/// The limit form of a query: `--limits`, else the query's default (§7.5); and the
+/// absolute μ (`--mu`, default 0.7), checked.
+///
+/// # Errors
+/// A μ that is negative or not finite.
+pub fn limit_form(
+    limits: Option<&str>,
+    mu: Option<f64>,
+    default: LimitForm,
+) -> anyhow::Result<(LimitForm, Option<f64>)> {
+    if let Some(m) = mu {
+        anyhow::ensure!(m.is_finite() && m >= 0.0, "--mu must be ≥ 0, found {m}");
+    }
+    let form = limits.and_then(LimitForm::parse).unwrap_or(default);
+    Ok((form, mu))
+}
+
+/// A stance's limits under `form`: its character's absolute ones (μ replaced by `mu`
+/// when given) or its own relative ones.
+pub fn stance_limits(
+    p: &Prepared,
+    form: LimitForm,
+    absolute: &BTreeMap<String, Limits>,
+    mu: Option<f64>,
+) -> Limits {
+    match form {
+        LimitForm::Relative => relative_limits(&p.stance.coef),
+        LimitForm::Absolute => {
+            let l = absolute
+                .get(&p.stance.character_id)
+                .copied()
+                .unwrap_or_else(|| relative_limits(&p.stance.coef));
+            Limits {
+                mu: mu.unwrap_or(l.mu),
+                ..l
+            }
+        }
+    }
 }
 
 /// Writes `df` to the file `out` atomically (parent folder created).
@@ -138,16 +178,21 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
             S_EFF_RANGE.1
         );
     }
-    let limits = absolute_limits(&lib);
+    let (form, mu) = limit_form(a.limits.as_deref(), a.mu, LimitForm::Absolute)?;
+    // Absolute limits of the target character: the source character's, scaled by §9.
+    let limits: BTreeMap<String, Limits> = absolute_limits(&lib)
+        .into_iter()
+        .map(|(k, l)| (k, scale_limits(&l, length, mass)))
+        .collect();
     // The target character: every stance scaled once (§9), then the speed sweep.
-    let scaled: Vec<(RunCycle, [Prepared; 2], Limits)> = cycles
+    let scaled: Vec<(RunCycle, [Prepared; 2], [Limits; 2])> = cycles
         .par_iter()
         .map(|c| {
             let prep = c
                 .stances
                 .map(|i| Prepared::new(pool[i].stance.scaled(length, mass)));
-            let src = &limits[&pool[c.stances[0]].stance.character_id];
-            (*c, prep, scale_limits(src, length, mass))
+            let lim = [0, 1].map(|k| stance_limits(&prep[k], form, &limits, mu));
+            (*c, prep, lim)
         })
         .collect();
     let mut rows = Vec::new();
@@ -158,7 +203,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
                 length_scale: length,
                 mass_scale: mass,
                 stances: cycle,
-                candidate: run_at_speed(cycle, c.v_orig * length.sqrt(), v, lim),
+                candidate: run_at_speed(cycle, c.v_orig * length.sqrt(), v, [&lim[0], &lim[1]]),
                 limits: *lim,
             });
         }
@@ -226,7 +271,10 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
     for (n, v) in [("--height", a.height), ("--distance", a.distance)] {
         anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
     }
-    let (_, pool) = load_pool(&a.lib)?;
+    let (form, mu) = limit_form(a.limits.as_deref(), a.mu, LimitForm::Relative)?;
+    let (lib, pool) = load_pool(&a.lib)?;
+    let absolute = absolute_limits(&lib);
+    let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);
     let ups: Vec<&Prepared> = pool.iter().filter(|p| is_liftoff(&p.stance)).collect();
     let downs: Vec<&Prepared> = pool.iter().filter(|p| is_landing(&p.stance)).collect();
     let mut rows: Vec<JumpRow> = ups
@@ -238,7 +286,9 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
             landing: p2,
             height: a.height,
             distance: a.distance,
-            jump: jump(p1, p2, a.height, a.distance, None).map_err(|e| e.to_string()),
+            limits: [lim(p1), lim(p2)],
+            jump: jump(p1, p2, a.height, a.distance, Some([lim(p1), lim(p2)]))
+                .map_err(|e| e.to_string()),
         })
         .collect();
     // Feasible first, then the least change of the recorded forces; ties by stance ids.

@@ -8,7 +8,7 @@ use anyhow::Context;
 use super::super::args::{MapJumpsArgs, RunArgs, RunQueryArgs};
 use super::super::Outcome;
 use crate::pipeline::spec::{
-    expand_inputs, load_body, load_pipeline, relative_to, resolve, QueriesTable,
+    expand_inputs, load_body, load_pipeline, relative_to, resolve, ConstraintsTable, QueriesTable,
 };
 
 /// Run a pipeline file.
@@ -38,14 +38,20 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
     let lib = relative_to(&a.pipeline, &pipe.out);
     let outcome = super::build::execute(&files, &lib, &opts, threads, a.incremental)?;
     if let Some(q) = &pipe.queries {
-        run_queries(q, &lib).with_context(|| format!("{}: [queries]", a.pipeline.display()))?;
+        run_queries(q, pipe.constraints.as_ref(), &lib)
+            .with_context(|| format!("{}: [queries]", a.pipeline.display()))?;
     }
     Ok(outcome)
 }
 
 /// The `[queries]` stages on the library just built, into `<lib>/queries/`.
-fn run_queries(q: &QueriesTable, lib: &Path) -> anyhow::Result<()> {
+fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> anyhow::Result<()> {
     let dir = lib.join("queries");
+    // `[constraints] limits`: per_query (each query's default), absolute or relative.
+    let limits = c
+        .and_then(|c| c.limits.clone())
+        .filter(|l| l != "per_query");
+    let mu = c.and_then(|c| c.mu);
     if let Some(speeds) = &q.run_speeds {
         super::query::run(RunQueryArgs {
             lib: lib.to_path_buf(),
@@ -53,6 +59,8 @@ fn run_queries(q: &QueriesTable, lib: &Path) -> anyhow::Result<()> {
             speeds: Some(speeds.clone()),
             length_scale: q.length_scale.unwrap_or(1.0),
             mass_scale: q.mass_scale.unwrap_or(1.0),
+            limits: limits.clone(),
+            mu,
             out: dir.join("runs.parquet"),
         })?;
     }
@@ -64,6 +72,8 @@ fn run_queries(q: &QueriesTable, lib: &Path) -> anyhow::Result<()> {
                 .clone()
                 .unwrap_or_else(|| "0.6:1.6:0.02".into()),
             speeds: q.map_speeds.clone().unwrap_or_else(|| "0:5:0.05".into()),
+            limits,
+            mu,
             out: dir.join("jump_map"),
         })?;
     }

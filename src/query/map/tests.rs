@@ -30,7 +30,7 @@ fn cells_agree_with_direct_jump_solves() {
         step: 0.25,
     }
     .values();
-    let map = jump_map(&pool, &heights, &speeds);
+    let map = jump_map(&pool, &heights, &speeds, &stance_relative_limits);
     assert_eq!(
         (map.liftoffs.len(), map.landings.len(), map.pairs.len()),
         (3, 4, 9)

@@ -145,12 +145,12 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
             .map(|p| Prepared::new(p.stance.scaled(l, m)));
         let big_lim = scale_limits(&lim, l, m);
         for v in [1.0, 3.0, 5.0] {
-            let a = run_at_speed([&pair[0], &pair[1]], v_orig, v, &lim);
+            let a = run_at_speed([&pair[0], &pair[1]], v_orig, v, [&lim, &lim]);
             let b = run_at_speed(
                 [&big[0], &big[1]],
                 v_orig * l.sqrt(),
                 v * l.sqrt(),
-                &big_lim,
+                [&big_lim, &big_lim],
             );
             assert_eq!(a.feasible(), b.feasible());
             assert_eq!(a.feasible_approx(), b.feasible_approx());
