@@ -399,20 +399,22 @@ pub fn solve_with(
 ) -> Result<Solution, Infeasible> {
     let (cands, branch) = candidates(shape, req, refs, opts)?;
     let mut worst = Infeasible::SignRule;
-    let mut ok = [Roots::EMPTY; 2];
-    let mut n_ok = 0;
+    // The best admissible candidate so far and the T of the other one (§6.5 choice).
+    let (mut best, mut other): (Option<Candidate>, Option<f64>) = (None, None);
     for c in cands.iter() {
         match admissible(shape, c, opts.admissible_tol) {
-            Ok(()) => {
-                ok[n_ok] = *c;
-                n_ok += 1;
-            }
+            Ok(()) => match best {
+                Some(b) if !better(c, &b, t_orig) => other = Some(c.t_e),
+                Some(b) => {
+                    other = Some(b.t_e);
+                    best = Some(*c);
+                }
+                None => best = Some(*c),
+            },
             Err(e) => worst = later(worst, e),
         }
     }
-    let ok = &mut ok[..n_ok];
-    choose(ok, t_orig);
-    let Some(best) = ok.first() else {
+    let Some(best) = best else {
         return Err(worst);
     };
     let y = req.vps * best.t_e + best.beta[1] * ((best.t_e - best.t_td) * shape.j[1] - shape.k[1]);
@@ -423,7 +425,7 @@ pub fn solve_with(
         t_e: best.t_e,
         y,
         branch,
-        other_t_e: ok.get(1).map(|c| c.t_e),
+        other_t_e: other,
     };
     let finite = (sol.beta[0] + sol.beta[1] + sol.beta[2] + sol.t_td + sol.t_lo + sol.t_e + sol.y)
         .is_finite();
@@ -434,19 +436,14 @@ pub fn solve_with(
     }
 }
 
-/// Sorts admissible candidates best first: smallest `|T − T_orig|`, ties (and every
-/// pair when `t_orig` is `None`) to the smaller `T` (§6.5).
-fn choose(ok: &mut [Candidate], t_orig: Option<f64>) {
+/// `a` is preferred to `b`: smaller `|T − T_orig|`, ties (and every pair when `t_orig` is
+/// `None`) to the smaller `T` (§6.5).
+fn better(a: &Candidate, b: &Candidate, t_orig: Option<f64>) -> bool {
     let key = |c: &Candidate| t_orig.map_or(0.0, |t| (c.t_e - t).abs());
-    if let [a, b] = ok {
-        if key(b)
-            .total_cmp(&key(a))
-            .then(b.t_e.total_cmp(&a.t_e))
-            .is_lt()
-        {
-            std::mem::swap(a, b);
-        }
-    }
+    key(a)
+        .total_cmp(&key(b))
+        .then(a.t_e.total_cmp(&b.t_e))
+        .is_lt()
 }
 
 /// The later of two rule failures (rule 1 < rule 2 < rule 3).
@@ -492,7 +489,9 @@ pub fn candidates(
         refs.beta_p,
         refs.beta_v,
     ];
-    if !(shape.derived.valid && inputs.iter().all(|v| v.is_finite())) {
+    // One test for all ten: a sum is finite iff every term is (NaN and ±∞ propagate; a
+    // finite overflow needs values near 1e308, rejected too).
+    if !(shape.derived.valid && inputs.iter().sum::<f64>().is_finite()) {
         return Err(Infeasible::InvalidInput);
     }
     let g = GRAVITY;
@@ -517,8 +516,11 @@ pub fn candidates(
         (req.vp - req.vps) * inv_jp
     };
     // t_TD, u, w and the candidate for one T > 0.
-    let make = |t: f64, beta_h: f64| {
-        let t_td = t / 2.0 - sv - dz / (g * t);
+    // `inv_t` = 1/T, passed in when a root gives it without a division.
+    let inv_g = 1.0 / GRAVITY; // a constant: the divisions by g become products
+    let dz_g = dz * inv_g;
+    let make_inv = |t: f64, inv_t: f64, beta_h: f64| {
+        let t_td = t / 2.0 - sv - dz_g * inv_t;
         let u = t_td + sv;
         Candidate {
             beta: [beta_h, beta_p, g * t * inv_jv],
@@ -528,6 +530,7 @@ pub fn candidates(
             w: t - u,
         }
     };
+    let make = |t: f64, beta_h: f64| make_inv(t, 1.0 / t, beta_h);
     // (ii) no net horizontal impulse: T from β_v,ref, β_h from A4.
     if near_zero(0) {
         if !matches(req.ve, req.vs, opts.match_tol) {
@@ -554,14 +557,15 @@ pub fn candidates(
     let sh = shape.derived.s_bar_h;
     let a = (req.vs + req.ve) / 2.0;
     let b = -(req.x + d * (sh - sv));
-    let c = d * dz / g;
-    let at = |t: f64| {
+    let c = d * dz_g;
+    let at_inv = |t: f64, inv_t: f64| {
         if t > 0.0 && t.is_finite() {
-            make(t, beta_h)
+            make_inv(t, inv_t, beta_h)
         } else {
             sign_fail(t, beta_p)
         }
     };
+    let at = |t: f64| at_inv(t, 1.0 / t);
     if a == 0.0 {
         // "Identically zero" (§6.4 (iv)) relative to the terms of b and the factors of c.
         let b_tol = opts.match_tol * 1f64.max(req.x.abs()).max((d * (sh - sv)).abs());
@@ -592,7 +596,9 @@ pub fn candidates(
     } else if disc == 0.0 {
         Roots::one(at(q / a))
     } else {
-        Roots::two(at(q / a), at(c / q))
+        // T1 = q/a, T2 = c/q: with 1/q, 1/T1 = a/q and T2 need no division of their own.
+        let inv_q = 1.0 / q;
+        Roots::two(at_inv(q / a, a * inv_q), at(c * inv_q))
     };
     Ok((roots, Branch::Quadratic))
 }

@@ -453,15 +453,13 @@ fn ties_go_to_the_smaller_t() {
         u: 0.1,
         w: 0.1,
     };
-    // 1 and 3 are exactly 1 from T_orig = 2: a tie.
+    // 1 and 3 are exactly 1 from T_orig = 2: a tie, to the smaller T (either order).
     for t_orig in [Some(2.0), None] {
-        let mut v = [c(3.0), c(1.0)];
-        choose(&mut v, t_orig);
-        assert_eq!((v[0].t_e, v[1].t_e), (1.0, 3.0));
+        assert!(better(&c(1.0), &c(3.0), t_orig));
+        assert!(!better(&c(3.0), &c(1.0), t_orig));
     }
-    let mut v = [c(1.0), c(3.0)];
-    choose(&mut v, Some(2.5));
-    assert_eq!(v[0].t_e, 3.0);
+    assert!(better(&c(3.0), &c(1.0), Some(2.5)));
+    assert!(!better(&c(1.0), &c(1.0), Some(2.5)));
 }
 
 #[test]
