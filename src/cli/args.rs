@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::pipeline::spec::Overrides;
+use crate::query::feasibility::LimitForm;
 use crate::query::map::Axis;
 use crate::skeleton::units::{parse_unit, UpAxis};
 
@@ -75,6 +76,31 @@ pub fn parse_range(flag: &str, s: &str) -> anyhow::Result<Axis> {
     }
 }
 
+/// The limit options shared by the queries (§7.5).
+#[derive(Debug, Args, Clone, Default)]
+pub struct LimitArgs {
+    /// Limit form: absolute (per character) or relative (per stance) (§7.5).
+    #[arg(long, value_parser = ["absolute", "relative"])]
+    pub limits: Option<String>,
+    /// Friction limit μ of the absolute form (default 0.7).
+    #[arg(long)]
+    pub mu: Option<f64>,
+}
+
+impl LimitArgs {
+    /// The limit form (`--limits`, else the query's `default`) and the absolute μ.
+    ///
+    /// # Errors
+    /// A μ that is negative or not finite.
+    pub fn form(&self, default: LimitForm) -> anyhow::Result<(LimitForm, Option<f64>)> {
+        if let Some(m) = self.mu {
+            anyhow::ensure!(m.is_finite() && m >= 0.0, "--mu must be ≥ 0, found {m}");
+        }
+        let form = self.limits.as_deref().and_then(LimitForm::parse);
+        Ok((form.unwrap_or(default), self.mu))
+    }
+}
+
 /// `stancelib query run`.
 #[derive(Debug, Args)]
 pub struct RunQueryArgs {
@@ -93,12 +119,9 @@ pub struct RunQueryArgs {
     /// Body-mass ratio target/recorded character.
     #[arg(long = "mass-scale", default_value_t = 1.0)]
     pub mass_scale: f64,
-    /// Limit form: absolute (per character) or relative (per stance) (§7.5).
-    #[arg(long, value_parser = ["absolute", "relative"])]
-    pub limits: Option<String>,
-    /// Friction limit μ of the absolute form (default 0.7).
-    #[arg(long)]
-    pub mu: Option<f64>,
+    /// Limit form and μ (§7.5).
+    #[command(flatten)]
+    pub lim: LimitArgs,
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
@@ -138,12 +161,9 @@ pub struct JumpArgs {
     /// Rows printed (the file has every pair).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
-    /// Limit form: absolute (per character) or relative (per stance) (§7.5).
-    #[arg(long, value_parser = ["absolute", "relative"])]
-    pub limits: Option<String>,
-    /// Friction limit μ of the absolute form (default 0.7).
-    #[arg(long)]
-    pub mu: Option<f64>,
+    /// Limit form and μ (§7.5).
+    #[command(flatten)]
+    pub lim: LimitArgs,
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
@@ -161,12 +181,9 @@ pub struct MapJumpsArgs {
     /// Columns: horizontal apex speeds `start:stop:step`, m/s.
     #[arg(long, default_value = "0:5:0.05")]
     pub speeds: String,
-    /// Limit form: absolute (per character) or relative (per stance) (§7.5).
-    #[arg(long, value_parser = ["absolute", "relative"])]
-    pub limits: Option<String>,
-    /// Friction limit μ of the absolute form (default 0.7).
-    #[arg(long)]
-    pub mu: Option<f64>,
+    /// Limit form and μ (§7.5).
+    #[command(flatten)]
+    pub lim: LimitArgs,
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,

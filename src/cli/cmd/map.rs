@@ -8,7 +8,7 @@ use anyhow::Context;
 
 use super::super::args::MapJumpsArgs;
 use super::super::Outcome;
-use super::query::{absolute_limits, limit_form, load_pool, query_kv, stance_limits};
+use super::query::{absolute_limits, load_pool, query_kv, stance_limits};
 use crate::library::queries::{jump_map_table, jump_pairs_table};
 use crate::library::write::write_atomic;
 use crate::plot::jump_map_png;
@@ -39,7 +39,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         !heights.is_empty() && !speeds.is_empty(),
         "the grid is empty: check --heights and --speeds"
     );
-    let (form, mu) = limit_form(a.limits.as_deref(), a.mu, LimitForm::Relative)?;
+    let (form, mu) = a.lim.form(LimitForm::Relative)?;
     let (lib, pool) = load_pool(&a.lib)?;
     let absolute = absolute_limits(&lib);
     let limits = |p: &Prepared| stance_limits(p, form, &absolute, mu);

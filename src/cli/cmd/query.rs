@@ -75,23 +75,6 @@ pub fn absolute_limits(lib: &StanceLibrary) -> BTreeMap<String, Limits> {
         .collect()
 }
 
-/// The limit form of a query: `--limits`, else the query's default (§7.5); and the
-/// absolute μ (`--mu`, default 0.7), checked.
-///
-/// # Errors
-/// A μ that is negative or not finite.
-pub fn limit_form(
-    limits: Option<&str>,
-    mu: Option<f64>,
-    default: LimitForm,
-) -> anyhow::Result<(LimitForm, Option<f64>)> {
-    if let Some(m) = mu {
-        anyhow::ensure!(m.is_finite() && m >= 0.0, "--mu must be ≥ 0, found {m}");
-    }
-    let form = limits.and_then(LimitForm::parse).unwrap_or(default);
-    Ok((form, mu))
-}
-
 /// A stance's limits under `form`: its character's absolute ones (μ replaced by `mu`
 /// when given) or its own relative ones.
 pub fn stance_limits(
@@ -178,7 +161,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
             S_EFF_RANGE.1
         );
     }
-    let (form, mu) = limit_form(a.limits.as_deref(), a.mu, LimitForm::Absolute)?;
+    let (form, mu) = a.lim.form(LimitForm::Absolute)?;
     // Absolute limits of the target character: the source character's, scaled by §9.
     let limits: BTreeMap<String, Limits> = absolute_limits(&lib)
         .into_iter()
@@ -271,7 +254,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
     for (n, v) in [("--height", a.height), ("--distance", a.distance)] {
         anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
     }
-    let (form, mu) = limit_form(a.limits.as_deref(), a.mu, LimitForm::Relative)?;
+    let (form, mu) = a.lim.form(LimitForm::Relative)?;
     let (lib, pool) = load_pool(&a.lib)?;
     let absolute = absolute_limits(&lib);
     let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::super::args::{MapJumpsArgs, RunArgs, RunQueryArgs};
+use super::super::args::{LimitArgs, MapJumpsArgs, RunArgs, RunQueryArgs};
 use super::super::Outcome;
 use crate::pipeline::spec::{
     expand_inputs, load_body, load_pipeline, relative_to, resolve, ConstraintsTable, QueriesTable,
@@ -59,8 +59,10 @@ fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> an
             speeds: Some(speeds.clone()),
             length_scale: q.length_scale.unwrap_or(1.0),
             mass_scale: q.mass_scale.unwrap_or(1.0),
-            limits: limits.clone(),
-            mu,
+            lim: LimitArgs {
+                limits: limits.clone(),
+                mu,
+            },
             out: dir.join("runs.parquet"),
         })?;
     }
@@ -72,8 +74,7 @@ fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> an
                 .clone()
                 .unwrap_or_else(|| "0.6:1.6:0.02".into()),
             speeds: q.map_speeds.clone().unwrap_or_else(|| "0:5:0.05".into()),
-            limits,
-            mu,
+            lim: LimitArgs { limits, mu },
             out: dir.join("jump_map"),
         })?;
     }
