@@ -69,6 +69,12 @@ pub enum ErrorKind {
         /// What is wrong.
         msg: String,
     },
+    /// A numerical step failed (a solver, a fit); `msg` names the step and the cause.
+    #[error("numeric: {msg}")]
+    Numeric {
+        /// The step and what failed.
+        msg: String,
+    },
     /// A columnar (Parquet) file could not be written or read.
     #[error("{}: {msg}", path.display())]
     Io {
@@ -83,6 +89,13 @@ pub enum ErrorKind {
 }
 
 impl Error {
+    /// A failed numerical step (solver, fit).
+    pub fn numeric(msg: impl Into<String>) -> Self {
+        Error {
+            kind: ErrorKind::Numeric { msg: msg.into() },
+        }
+    }
+
     /// A BVH error at a line, without a path yet (see [`Error::with_path`]).
     pub fn bvh(line: usize, msg: impl Into<String>) -> Self {
         ErrorKind::Bvh {

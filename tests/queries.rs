@@ -111,7 +111,9 @@ fn run_sweep_reproduces_table_one_pattern() {
     let own = lib.parent().unwrap().join("own.parquet");
     let v0 = v_orig[0].to_string();
     let l = lib.display().to_string();
-    for (form, want) in [("relative", true), ("absolute", false)] {
+    // With the ratio force model (issue 12) the recorded cycle also meets the absolute
+    // μ = 0.7 (the Fourier model's edge ringing gave μ_req 1.42 and failed it).
+    for (form, want) in [("relative", true), ("absolute", true)] {
         stancelib(&[
             "query",
             "run",
@@ -153,7 +155,7 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
         !recorded.is_empty(),
         "no recorded jump in the shared library"
     );
-    let mut identities = 0;
+    let (mut identities, mut degenerate) = (0, 0);
     for (n, &(a, b)) in recorded.iter().enumerate() {
         let (s1, s2) = (&stances[a], &stances[b]);
         let (ve1, vs2) = (s1.params.ve, s2.params.vs);
@@ -198,6 +200,17 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
                 .unwrap()
                 .get(row)
                 .map(str::to_string);
+        // A vertical jump (J_h ≈ 0 on both sides): the distance cannot set u_apex, and the
+        // solver says so instead of returning a huge β_h (the degenerate case of §6.4 is not
+        // yet solved with β_h = β_h,ref; issue 12 item 3 keeps it open).
+        if why.as_deref() == Some("distance does not determine u_apex") {
+            eprintln!(
+                "identity jump {} → {}: degenerate (vertical jump, d {d:.3} m): {why:?}",
+                s1.stance_id, s2.stance_id
+            );
+            degenerate += 1;
+            continue;
+        }
         let get =
             |c: &str| t.opt_f64(c).unwrap()[row].unwrap_or_else(|| panic!("{c} null: {why:?}"));
         let [bh1, bv1, bh2, bv2] = ["beta_h1", "beta_v1", "beta_h2", "beta_v2"].map(get);
@@ -227,18 +240,20 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
             feasible,
             "{margins:?} vs {why:?}"
         );
-        if [bh1, bv1, bh2, bv2].iter().all(|b| (b - 1.0).abs() <= 0.05) {
-            assert!(
-                feasible,
-                "{} → {}: β within 5 % but {why:?}",
-                s1.stance_id, s2.stance_id
-            );
-            identities += 1;
-        }
+        // Issue 12: with flight edge states the identity jump is found at β = 1 within 3 %.
+        assert!(
+            [bh1, bv1, bh2, bv2].iter().all(|b| (b - 1.0).abs() <= 0.03),
+            "{} → {}: β [{bh1}, {bv1}, {bh2}, {bv2}] not within 3 % of 1",
+            s1.stance_id,
+            s2.stance_id
+        );
+        assert!(feasible, "{} → {}: {why:?}", s1.stance_id, s2.stance_id);
+        identities += 1;
     }
+    eprintln!("identity jumps: {identities} feasible at β = 1 ± 3 %, {degenerate} degenerate");
     assert!(
-        identities >= 2,
-        "only {identities} identity jumps within 5 %"
+        identities >= 4,
+        "only {identities} identity jumps within 3 %"
     );
 }
 

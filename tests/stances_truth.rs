@@ -751,7 +751,8 @@ fn force_models_round_trip_through_parquet() {
                 let amp = list_f64(&df, &format!("amp_{ax}"), i);
                 let ph = list_f64(&df, &format!("phase_{ax}"), i);
                 assert_eq!((h.len(), amp.len()), (ph.len(), ph.len()), "{sid} {ax}");
-                (c0[a][i], h, amp, ph)
+                let poly = list_f64(&df, &format!("poly_{ax}"), i);
+                (c0[a][i], h, amp, ph, poly)
             })
             .collect();
         let (eh, ep) = ([hx[i], hy[i], 0.0], [-hy[i], hx[i], 0.0]);
@@ -762,7 +763,7 @@ fn force_models_round_trip_through_parquet() {
             let tau = (t - td[i]) / dts[i];
             let f: Vec<f64> = axes
                 .iter()
-                .map(|(c0, h, amp, ph)| {
+                .map(|(c0, h, amp, ph, poly)| {
                     if !(0.0..=1.0).contains(&tau) {
                         return 0.0;
                     }
@@ -772,6 +773,11 @@ fn force_models_round_trip_through_parquet() {
                         .zip(ph)
                         .map(|((&h, &a), &p)| a * (2.0 * PI * h as f64 * tau + p).cos())
                         .sum::<f64>()
+                        + poly
+                            .iter()
+                            .enumerate()
+                            .map(|(k, &c)| c * tau.powi(k as i32))
+                            .sum::<f64>()
                 })
                 .collect();
             let stored: [f64; 3] =
@@ -801,4 +807,4 @@ fn force_models_round_trip_through_parquet() {
 }
 
 /// One stance axis as stored: (c0, harmonics, amplitudes, phases).
-type StoredAxis = (f64, Vec<i32>, Vec<f64>, Vec<f64>);
+type StoredAxis = (f64, Vec<i32>, Vec<f64>, Vec<f64>, Vec<f64>);

@@ -1,5 +1,6 @@
 //! Raw command-line arguments (clap) and their validation into typed values.
 
+use crate::force_model::ForceModelKind;
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
@@ -207,6 +208,11 @@ impl MapJumpsArgs {
     }
 }
 
+/// `ratio` or `fourier`.
+fn parse_force_model(s: &str) -> Result<ForceModelKind, String> {
+    ForceModelKind::parse(s).ok_or_else(|| format!("'{s}' is not a force model: ratio or fourier"))
+}
+
 /// Options shared by `frames` and `run` (each wins over the pipeline and body files).
 #[derive(Debug, Args, Clone, Default)]
 pub struct BodyArgs {
@@ -231,9 +237,9 @@ pub struct BodyArgs {
     /// Also write joints.parquet (every joint's world position).
     #[arg(long)]
     pub joints: bool,
-    /// Refit each stance by least squares on the raw COM positions (Stage B).
-    #[arg(long = "stage-b")]
-    pub stage_b: bool,
+    /// Stance force model: `ratio` (default; friction-faithful) or `fourier` (the paper's).
+    #[arg(long = "force-model", value_parser = parse_force_model)]
+    pub force_model: Option<ForceModelKind>,
     /// Worker threads (0 = all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,

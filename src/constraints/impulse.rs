@@ -43,13 +43,14 @@
 
 use super::tables::dc_term;
 use super::StanceContext;
-use crate::force_model::{ForceModel, GRAVITY};
+use crate::force_model::{basis, ForceModel, GRAVITY};
 use std::f64::consts::TAU;
 
 /// One cosine term of an axis: `Ω`, amplitude (N), `cos φ`, `sin φ`.
 #[derive(Debug, Clone, Copy)]
 struct Term {
     j: u32,
+    phi: f64,
     omega: f64,
     amp: f64,
     cos_phi: f64,
@@ -57,13 +58,16 @@ struct Term {
 }
 
 /// One axis (0, 1, 2 = h, p, v) as `r_a = p0 + p1 τ + p2 τ² + Σ ρ cos(…)` and
-/// `f_a = d + Σ c cos(…)`.
+/// `f_a = d + Σ c cos(…)`, plus the polynomial parts `f_a += P_a(τ)` and
+/// `r_a += κ F2[P_a](τ)` (power basis, empty for the Fourier model).
 #[derive(Debug, Clone)]
 struct AxisForm {
     d: f64,
     p: [f64; 3],
     kappa: f64,
     terms: Vec<Term>,
+    f_poly: Vec<f64>,
+    r_poly: Vec<f64>,
 }
 
 impl AxisForm {
@@ -81,6 +85,7 @@ impl AxisForm {
                 let (sin_phi, cos_phi) = phi.sin_cos();
                 Term {
                     j,
+                    phi,
                     omega: TAU * f64::from(j),
                     amp,
                     cos_phi,
@@ -100,11 +105,18 @@ impl AxisForm {
                     .map(|t| t.amp * t.sin_phi / t.omega)
                     .sum::<f64>();
         let p2 = l2 + 0.5 * kappa * d;
+        let f_poly = model.axes.get(axis).map_or(Vec::new(), |a| a.poly.clone());
+        let r_poly = basis::poly_f2_coeffs(&f_poly)
+            .into_iter()
+            .map(|c| kappa * c)
+            .collect();
         Self {
             d,
             p: [p0, p1, p2],
             kappa,
             terms,
+            f_poly,
+            r_poly,
         }
     }
 }
@@ -124,6 +136,33 @@ fn integral_r_f(ra: &AxisForm, fb: &AxisForm) -> f64 {
             let cos_diff = k.cos_phi * l.cos_phi + k.sin_phi * l.sin_phi;
             sum += 0.5 * rho * l.amp * cos_diff;
         }
+    }
+    if !(ra.f_poly.is_empty() && fb.f_poly.is_empty()) {
+        sum += polynomial_cross_terms(ra, fb);
+    }
+    sum
+}
+
+/// The terms of `∫₀¹ r_a f_b dτ` that involve a polynomial part (m·N):
+///
+/// ```text
+/// r_a = Q_a(τ) + R_a(τ) + Σ_k ρ_k cos(Ω_kτ+φ_k),  Q_a = p0 + p1τ + p2τ²,  R_a = κ F2[P_a]
+/// f_b = d_b + P_b(τ) + Σ_l c_l cos(Ω_lτ+φ_l)
+/// extra = ∫ Q_a P_b + ∫ R_a (d_b + P_b) + Σ_l c_l Σ_n R_a[n] C_n(j_l) + Σ_k ρ_k Σ_n P_b[n] C_n(j_k)
+/// ```
+/// with `C_n(j) = ∫₀¹ τⁿ cos(2πjτ+φ) dτ` ([`basis::harmonic_power_moments`]).
+fn polynomial_cross_terms(ra: &AxisForm, fb: &AxisForm) -> f64 {
+    let mut sum = basis::poly_moment(&basis::poly_mul(&ra.p, &fb.f_poly), 0);
+    sum += basis::poly_moment(&basis::poly_mul(&ra.r_poly, &fb.f_poly), 0);
+    sum += fb.d * basis::poly_moment(&ra.r_poly, 0);
+    for l in &fb.terms {
+        let c = basis::harmonic_power_moments(l.j, l.phi, ra.r_poly.len());
+        sum += l.amp * ra.r_poly.iter().zip(&c).map(|(r, c)| r * c).sum::<f64>();
+    }
+    for k in &ra.terms {
+        let rho = -ra.kappa * k.amp / (k.omega * k.omega);
+        let c = basis::harmonic_power_moments(k.j, k.phi, fb.f_poly.len());
+        sum += rho * fb.f_poly.iter().zip(&c).map(|(p, c)| p * c).sum::<f64>();
     }
     sum
 }

@@ -48,6 +48,7 @@
 //!     harmonics: vec![1],
 //!     amps: vec![amp],
 //!     phases: vec![phase],
+//!     poly: Vec::new(),
 //!     fit_rms: 0.0,
 //! };
 //! // f_v = 2mg (1 − cos 2πτ): a bell that supports the body.

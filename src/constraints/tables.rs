@@ -5,10 +5,11 @@
 //! Per stance axis `a ∈ {h, p, v}`, on the grid `τ_k = k/(N_s − 1)` of §4.3:
 //!
 //! ```text
-//! f_a(τ) = d_a + Σ_i c_i cos(Ω_i τ + φ_i),        Ω_i = 2π j_i,  j_i ≥ 1      (N)
+//! f_a(τ) = d_a + Σ_i c_i cos(Ω_i τ + φ_i) + P_a(τ),   Ω_i = 2π j_i,  j_i ≥ 1    (N)
 //! d_a    = c0_a + Σ_{i: j_i = 0} c_i cos φ_i                                   (N)
 //! S_a(τ) = κ F2_a(τ)                                                          (m)
 //!        = κ [q0 + q1 τ + q2 τ² − Σ_i (c_i/Ω_i²) cos(Ω_i τ + φ_i)]
+//!          + κ Σ_k p_k τ^(k+2)/((k+1)(k+2))          (polynomial part P_a = Σ_k p_k τ^k)
 //! κ = Δt²/m (s²/kg),  q0 = Σ c_i cos φ_i/Ω_i²,  q1 = −Σ c_i sin φ_i/Ω_i,  q2 = d_a/2
 //! ```
 //!
@@ -27,7 +28,7 @@
 //!
 //! Stance frame (h, p, v); forces in N, `S_a` in m, `τ` dimensionless.
 
-use crate::force_model::{ForceModel, UNILATERAL_FRACTION};
+use crate::force_model::{basis, ForceModel, UNILATERAL_FRACTION};
 use std::f64::consts::TAU;
 
 /// `f_a(τ_k)` and `S_a(τ_k)` of one stance on its grid; reusable across stances.
@@ -113,6 +114,7 @@ impl SampledTables {
                     }
                 }
             }
+            add_polynomial_part(model, axis, kappa, &self.tau, f, s);
         }
         self.summarise_vertical();
     }
@@ -141,6 +143,27 @@ impl SampledTables {
     /// True when the grid is empty.
     pub fn is_empty(&self) -> bool {
         self.tau.is_empty()
+    }
+}
+
+/// Adds the polynomial part `P_a(τ_k)` to `f` and `κ F2[P_a](τ_k)` to `s`.
+fn add_polynomial_part(
+    model: &ForceModel,
+    axis: usize,
+    kappa: f64,
+    tau: &[f64],
+    f: &mut [f64],
+    s: &mut [f64],
+) {
+    let Some(poly) = model.axes.get(axis).map(|a| &a.poly) else {
+        return;
+    };
+    if poly.is_empty() {
+        return;
+    }
+    for ((&t, fk), sk) in tau.iter().zip(f.iter_mut()).zip(s.iter_mut()) {
+        *fk += basis::poly_eval(poly, t);
+        *sk += kappa * basis::poly_f2(poly, t);
     }
 }
 

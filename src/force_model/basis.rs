@@ -110,6 +110,83 @@ pub fn m1_harmonic(j: u32, phi: f64) -> f64 {
     }
 }
 
+/// `P(τ) = Σ_k p_k τ^k` by Horner's rule (N for force coefficients).
+pub fn poly_eval(p: &[f64], tau: f64) -> f64 {
+    p.iter().rev().fold(0.0, |acc, &c| acc * tau + c)
+}
+
+/// `∫₀¹ τⁿ P(τ) dτ = Σ_k p_k / (k + n + 1)`.
+pub fn poly_moment(p: &[f64], n: usize) -> f64 {
+    p.iter()
+        .enumerate()
+        .map(|(k, &c)| c / (k + n + 1) as f64)
+        .sum()
+}
+
+/// `F1(τ) = ∫₀^τ P = Σ_k p_k τ^(k+1)/(k+1)`.
+pub fn poly_f1(p: &[f64], tau: f64) -> f64 {
+    p.iter()
+        .enumerate()
+        .rev()
+        .fold(0.0, |acc, (k, &c)| acc * tau + c / (k + 1) as f64)
+        * tau
+}
+
+/// `F2(τ) = ∫₀^τ∫₀ˢ P = Σ_k p_k τ^(k+2)/((k+1)(k+2))`.
+pub fn poly_f2(p: &[f64], tau: f64) -> f64 {
+    p.iter().enumerate().rev().fold(0.0, |acc, (k, &c)| {
+        acc * tau + c / ((k + 1) * (k + 2)) as f64
+    }) * tau
+        * tau
+}
+
+/// Coefficients of `F2(τ) = ∫₀^τ∫₀ˢ P` in the power basis: `[0, 0, p_0/2, p_1/6, …]`.
+pub fn poly_f2_coeffs(p: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; p.len() + 2];
+    for (k, &c) in p.iter().enumerate() {
+        out[k + 2] = c / ((k + 1) * (k + 2)) as f64;
+    }
+    out
+}
+
+/// Product of two power-basis polynomials.
+pub fn poly_mul(a: &[f64], b: &[f64]) -> Vec<f64> {
+    if a.is_empty() || b.is_empty() {
+        return Vec::new();
+    }
+    let mut out = vec![0.0; a.len() + b.len() - 1];
+    for (i, &x) in a.iter().enumerate() {
+        for (j, &y) in b.iter().enumerate() {
+            out[i + j] += x * y;
+        }
+    }
+    out
+}
+
+/// `C_n = ∫₀¹ τⁿ cos(2πjτ + φ) dτ` for `n = 0 … n_max` and an integer harmonic `j ≥ 1`.
+///
+/// ```text
+/// C_0 = S_0 = 0,   C_n = (sin φ − n S_(n−1))/Ω,   S_n = (n C_(n−1) − cos φ)/Ω,   Ω = 2πj
+/// ```
+/// (`S_n = ∫₀¹ τⁿ sin(Ωτ + φ) dτ`, integration by parts with `sin(Ω+φ) = sin φ`,
+/// `cos(Ω+φ) = cos φ`.) The upward recursion multiplies errors by `n/Ω` per step, below 1
+/// for `n < 2π`; over `n ≤ 24` the product stays below 10 (the tests bound it).
+pub fn harmonic_power_moments(j: u32, phi: f64, n_max: usize) -> Vec<f64> {
+    let omega = omega_of(j);
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let mut out = Vec::with_capacity(n_max + 1);
+    let (mut c, mut s) = (0.0, 0.0);
+    out.push(c);
+    for n in 1..=n_max {
+        let nf = n as f64;
+        let c_n = (sin_phi - nf * s) / omega;
+        let s_n = (nf * c - cos_phi) / omega;
+        (c, s) = (c_n, s_n);
+        out.push(c);
+    }
+    out
+}
+
 /// Composite Simpson rule of `f` over `[a, b]` with `n` (made even) intervals; tests only.
 #[cfg(test)]
 pub(crate) fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
@@ -184,6 +261,53 @@ mod tests {
                 assert!((i1(om, ph) - i1_spec).abs() < 1e-14);
                 assert!((m1(om, ph) - m1_spec).abs() < 1e-14);
                 assert!((d(om, ph) - d_spec).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn polynomial_closed_forms_match_simpson() {
+        // A degree-8 polynomial with O(1e3 N) coefficients: Simpson is exact to 1e-9 here
+        // (h⁴/180·max|P⁗| ≈ 2e-13·1e7).
+        let p = [
+            120.0, 3000.0, -4100.0, 900.0, 1500.0, -800.0, 60.0, -300.0, 210.0,
+        ];
+        for &tau in &[0.0, 0.3, 0.71, 1.0] {
+            let q1 = simpson(|u| poly_eval(&p, u), 0.0, tau, N_SIMPSON);
+            let q2 = simpson(|u| (tau - u) * poly_eval(&p, u), 0.0, tau, N_SIMPSON);
+            assert!((poly_f1(&p, tau) - q1).abs() < 1e-9, "F1 at {tau}");
+            assert!((poly_f2(&p, tau) - q2).abs() < 1e-9, "F2 at {tau}");
+            assert!((poly_eval(&poly_f2_coeffs(&p), tau) - q2).abs() < 1e-9);
+        }
+        for n in 0..3 {
+            let q = simpson(|u| u.powi(n as i32) * poly_eval(&p, u), 0.0, 1.0, N_SIMPSON);
+            assert!((poly_moment(&p, n) - q).abs() < 1e-9, "moment {n}");
+        }
+        let b = [2.0, -1.0, 0.5];
+        let ab = poly_mul(&p, &b);
+        for &tau in &[0.1, 0.9] {
+            let want = poly_eval(&p, tau) * poly_eval(&b, tau);
+            assert!((poly_eval(&ab, tau) - want).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn harmonic_power_moments_match_simpson() {
+        // Up to τ²⁰ against Simpson (error ≤ h⁴/180·max|f⁗| ≈ 3e-16·(Ω+20)⁴ ≤ 1e-10).
+        for j in [1u32, 2, 5] {
+            for &ph in &[0.0, 0.8, -2.4] {
+                let c = harmonic_power_moments(j, ph, 20);
+                let om = omega_of(j);
+                for (n, &cn) in c.iter().enumerate() {
+                    let q = simpson(
+                        |u| u.powi(n as i32) * (om * u + ph).cos(),
+                        0.0,
+                        1.0,
+                        N_SIMPSON,
+                    );
+                    assert!((cn - q).abs() < 1e-10, "j={j} φ={ph} n={n}: {cn} vs {q}");
+                }
+                assert!((c[1] - m1_harmonic(j, ph)).abs() < 1e-15);
             }
         }
     }

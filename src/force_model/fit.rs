@@ -219,6 +219,63 @@ fn rms_residual(samples: &[f64], model: &AxisModel) -> f64 {
     (ss / nf).sqrt()
 }
 
+/// The kinematic applied force of one stance, `R_s · m (a(t) − g⃗)` (N, stance axes).
+pub struct StanceForce<'a> {
+    /// Natural splines of the SG world acceleration (x, y, z; m/s²) over clip time (s).
+    pub acc: &'a [NaturalSpline; 3],
+    /// Touchdown (s, the splines' time axis).
+    pub t_td: f64,
+    /// Stance duration `Δt` (s).
+    pub dt: f64,
+    /// Rows `e_h, e_p, e_v` in world coordinates.
+    pub r_s: [[f64; 3]; 3],
+    /// Body mass `m` (kg).
+    pub mass_kg: f64,
+}
+
+impl StanceForce<'_> {
+    /// Checks `Δt > 0`, `m > 0` and finite `t_TD`, `R_s`; `step` prefixes the message.
+    ///
+    /// # Errors
+    /// A config error saying which value is bad.
+    pub fn check(&self, step: &str) -> Result<()> {
+        let bad = |what: String| Err(Error::config(None, None, format!("{step}: {what}")));
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return bad(format!("stance duration {} s is not positive", self.dt));
+        }
+        if !(self.mass_kg.is_finite() && self.mass_kg > 0.0) {
+            return bad(format!("body mass {} kg is not positive", self.mass_kg));
+        }
+        if !self.t_td.is_finite() || self.r_s.iter().flatten().any(|v| !v.is_finite()) {
+            return bad("touchdown time or stance rotation is not finite".into());
+        }
+        Ok(())
+    }
+
+    /// Fills `out[a][j]` with the force at `t = t_TD + Δt·τ_j`; false if any is not finite.
+    pub fn sample(&self, tau: impl Iterator<Item = f64>, out: &mut [Vec<f64>; 3]) -> bool {
+        let mut j = 0;
+        for (k, t) in tau.map(|u| self.t_td + self.dt * u).enumerate() {
+            let m = self.mass_kg;
+            let f_world = [
+                m * self.acc[0].eval(t),
+                m * self.acc[1].eval(t),
+                m * (self.acc[2].eval(t) + GRAVITY),
+            ];
+            for (axis, row) in self.r_s.iter().enumerate() {
+                let f = row[0] * f_world[0] + row[1] * f_world[1] + row[2] * f_world[2];
+                match out[axis].get_mut(k) {
+                    Some(slot) => *slot = f,
+                    None => out[axis].push(f),
+                }
+            }
+            j = k + 1;
+        }
+        out.iter_mut().for_each(|o| o.truncate(j));
+        out.iter().flatten().all(|v| v.is_finite())
+    }
+}
+
 /// Stage A (§4.1 steps 2–5) for one stance: the stance-frame [`ForceModel`].
 ///
 /// # Arguments
@@ -245,29 +302,17 @@ pub fn fit_stage_a(
 ) -> Result<ForceModel> {
     let bad = |what: String| Err(Error::config(None, None, format!("stage a: {what}")));
     check_options(opts)?;
-    if !(dt.is_finite() && dt > 0.0) {
-        return bad(format!("stance duration {dt} s is not positive"));
-    }
-    if !(mass_kg.is_finite() && mass_kg > 0.0) {
-        return bad(format!("body mass {mass_kg} kg is not positive"));
-    }
-    if !t_td.is_finite() || r_s.iter().flatten().any(|v| !v.is_finite()) {
-        return bad("touchdown time or stance rotation is not finite".into());
-    }
+    let stance = StanceForce {
+        acc,
+        t_td,
+        dt,
+        r_s,
+        mass_kg,
+    };
+    stance.check("stage a")?;
     ws.ensure(opts.samples);
     let n = ws.n;
-    for j in 0..n {
-        let t = t_td + dt * (j as f64 / n as f64);
-        let f_world = [
-            mass_kg * acc[0].eval(t),
-            mass_kg * acc[1].eval(t),
-            mass_kg * (acc[2].eval(t) + GRAVITY),
-        ];
-        for (axis, row) in r_s.iter().enumerate() {
-            ws.samples[axis][j] = row[0] * f_world[0] + row[1] * f_world[1] + row[2] * f_world[2];
-        }
-    }
-    if ws.samples.iter().flatten().any(|v| !v.is_finite()) {
+    if !stance.sample((0..n).map(|j| j as f64 / n as f64), &mut ws.samples) {
         return bad(format!("sampled force is not finite near t = {t_td} s"));
     }
     let k_max = k_max(n, n_st);

@@ -11,7 +11,6 @@
 //! ```
 //! Modules: [`basis`] (closed forms of one term, any Ω), [`model`] ([`AxisModel`],
 //! [`ForceModel`], grid and flags), [`fit`] ([`fit_stage_a`], [`FitWorkspace`]).
-//! Stage B (§4.2, off by default) refits by least squares on the raw COM positions: [`stage_b`].
 //!
 //! # Frames and units
 //! Stance frame `h, p, v` (index 0, 1, 2; spec §2): `f_stance = R_s · f_world`, with `R_s`
@@ -45,11 +44,11 @@
 pub mod basis;
 pub mod fit;
 pub mod model;
-pub mod stage_b;
+pub mod ratio;
 
-pub use fit::{fit_axis, fit_stage_a, j_cap, k_max, FitWorkspace};
+pub use fit::{fit_axis, fit_stage_a, j_cap, k_max, FitWorkspace, StanceForce};
 pub use model::{AxisModel, ForceModel};
-pub use stage_b::{fit_stage_b, to_stance_model, StageBFit, StageBInput, MAX_CONDITION};
+pub use ratio::{fit_ratio, EdgeTargets, RatioFit, RatioOptions};
 
 /// Gravity magnitude `g` (m/s²); the gravity vector is `g⃗ = (0, 0, −g)` (spec preamble).
 pub const GRAVITY: f64 = 9.81;
@@ -62,9 +61,43 @@ pub const DEFAULT_ENERGY: f64 = 0.99;
 /// Unilateral test fraction: `f_v ≥ −0.05 · max f_v` on the grid (spec §4.3).
 pub const UNILATERAL_FRACTION: f64 = 0.05;
 
-/// Stage A tuning knobs (pipeline `fit.*`); see the `DEFAULT_*` constants.
+/// Which stance force model a build fits (pipeline `fit.model`, `--force-model`).
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ForceModelKind {
+    /// The friction-ratio model of [`ratio`] (default).
+    #[default]
+    Ratio,
+    /// The paper's Fourier model, Stage A of spec §4.1 ([`fit`]).
+    Fourier,
+}
+
+impl ForceModelKind {
+    /// The name used in options, stance rows and the manifest.
+    pub fn name(self) -> &'static str {
+        match self {
+            ForceModelKind::Ratio => "ratio",
+            ForceModelKind::Fourier => "fourier",
+        }
+    }
+
+    /// Parses `ratio` or `fourier`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "ratio" => Some(ForceModelKind::Ratio),
+            "fourier" => Some(ForceModelKind::Fourier),
+            _ => None,
+        }
+    }
+}
+
+/// Force-model tuning knobs (pipeline `fit.*`); see the `DEFAULT_*` constants.
 #[derive(serde::Serialize, Debug, Clone, Copy, PartialEq)]
 pub struct FitOptions {
+    /// The model to fit; default [`ForceModelKind::Ratio`].
+    pub model: ForceModelKind,
+    /// Knobs of the ratio model.
+    pub ratio: RatioOptions,
     /// Samples `N` per stance (≥ 2), at `τ_j = j/N`; default [`DEFAULT_SAMPLES`].
     pub samples: usize,
     /// At most `K_max` harmonics per axis; default [`DEFAULT_MAX_HARMONICS`].
@@ -76,9 +109,88 @@ pub struct FitOptions {
 impl Default for FitOptions {
     fn default() -> Self {
         FitOptions {
+            model: ForceModelKind::default(),
+            ratio: RatioOptions::default(),
             samples: DEFAULT_SAMPLES,
             max_harmonics: DEFAULT_MAX_HARMONICS,
             energy: DEFAULT_ENERGY,
+        }
+    }
+}
+
+/// A stance's fitted force model: which model, and the ratio polynomials of the ratio model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceFit {
+    /// The force model in the stance frame.
+    pub model: ForceModel,
+    /// Which model was fitted.
+    pub kind: ForceModelKind,
+    /// `q_h`, `q_p` of the ratio model (power basis); empty for the Fourier model.
+    pub ratio: [Vec<f64>; 2],
+    /// Vertical edge targets met (see [`RatioFit::vertical_targets_met`]); 0 for Fourier.
+    pub targets_met: usize,
+}
+
+/// Fits the model `opts.model` to one stance's kinematic force (`n_st` stance frames).
+///
+/// `targets` (ratio model only; the paper's Fourier model ignores them) make the force
+/// integrate to the stance's edge states.
+///
+/// The Fourier model samples `τ_j = j/N` ([`fit_stage_a`]); the ratio model samples
+/// `τ_j = j/(N−1)`, both edges included ([`ratio::fit_ratio`]).
+///
+/// # Errors
+/// Bad options or stance values (config), a non-finite sampled force, a failed QP.
+pub fn fit_stance(
+    ws: &mut FitWorkspace,
+    force: &StanceForce,
+    n_st: usize,
+    targets: Option<&EdgeTargets>,
+    opts: &FitOptions,
+) -> crate::Result<StanceFit> {
+    match opts.model {
+        ForceModelKind::Fourier => {
+            let model = fit_stage_a(
+                ws,
+                force.acc,
+                force.t_td,
+                force.dt,
+                force.r_s,
+                force.mass_kg,
+                n_st,
+                opts,
+            )?;
+            Ok(StanceFit {
+                model,
+                kind: ForceModelKind::Fourier,
+                ratio: Default::default(),
+                targets_met: 0,
+            })
+        }
+        ForceModelKind::Ratio => {
+            force.check("ratio model")?;
+            let n = opts.samples.clamp(fit::MIN_SAMPLES, fit::MAX_SAMPLES);
+            let mut samples: [Vec<f64>; 3] = Default::default();
+            if !force.sample(ratio::sample_grid(n).into_iter(), &mut samples) {
+                return Err(crate::Error::numeric(format!(
+                    "ratio model: sampled force is not finite near t = {} s",
+                    force.t_td
+                )));
+            }
+            let fit = fit_ratio(
+                &samples,
+                n_st,
+                force.mass_kg,
+                force.dt,
+                targets,
+                &opts.ratio,
+            )?;
+            Ok(StanceFit {
+                model: fit.model,
+                kind: ForceModelKind::Ratio,
+                ratio: fit.ratio,
+                targets_met: fit.vertical_targets_met,
+            })
         }
     }
 }

@@ -2,8 +2,8 @@
 //!
 //! # Model
 //! ```text
-//! f_a(τ) = c0_a + Σ_i c_ia cos(2π j_ia τ + φ_ia),   τ = (t − t_TD)/Δt ∈ [0, 1]    N
-//! J_a = (Δt/m)  ∫₀¹ f_a dτ                 = c0_a Δt/m for j ≥ 1 harmonics      m/s
+//! f_a(τ) = c0_a + Σ_i c_ia cos(2π j_ia τ + φ_ia) + Σ_k p_ka τ^k,   τ = (t − t_TD)/Δt ∈ [0, 1]   N
+//! J_a = (Δt/m)  ∫₀¹ f_a dτ = (c0_a + Σ_k p_ka/(k+1)) Δt/m  (j ≥ 1 harmonics)      m/s
 //! K_a = (Δt²/m) ∫₀¹ τ f_a dτ                                                      m
 //! P_a = (Δt²/m) ∫₀¹∫₀ˢ f_a = (Δt²/m) F2_a(1) = Δt·J_a − K_a                     m
 //! S_a(τ) = (Δt²/m) F2_a(τ)                 COM displacement from the force         m
@@ -11,6 +11,9 @@
 //! support_ok    ⇔ J_v > 0
 //! unilateral_ok ⇔ f_v(τ_j) ≥ −0.05 · max_j f_v(τ_j)  for every grid point
 //! ```
+//! The Fourier part is the paper's model ([`super::fit`]); the polynomial part `p_k` carries
+//! the friction-ratio model ([`super::ratio`]). A fit fills one part and leaves the other
+//! empty, but every closed form here and in the constraints adds both, so any mix is exact.
 //! A non-positive or non-finite `mass_kg` or `dt_s` (never produced by
 //! [`super::fit_stage_a`]) makes `J`, `K`, `P` and `S` non-finite, following IEEE
 //! arithmetic, and then `support_ok` is false; nothing panics.
@@ -30,7 +33,8 @@ pub const GRID_SAMPLES_PER_HARMONIC: usize = 16;
 /// never produces (`j ≤ (N−1)/2`); it keeps a hand-built model from exhausting memory.
 pub const GRID_MAX_SAMPLES: usize = (1 << 24) + 1;
 
-/// One stance axis: `f(τ) = c0 + Σ_i amps[i]·cos(2π·harmonics[i]·τ + phases[i])`, τ ∈ [0, 1].
+/// One stance axis: `f(τ) = c0 + Σ_i amps[i]·cos(2π·harmonics[i]·τ + phases[i]) + Σ_k poly[k]·τ^k`,
+/// τ ∈ [0, 1].
 ///
 /// Newtons (applied force). The three vectors have the same length, in the order of
 /// selection (largest amplitude first, spec §4.1 step 5); if they differ, the extra
@@ -45,6 +49,9 @@ pub struct AxisModel {
     pub amps: Vec<f64>,
     /// Phases `φ_i` (rad).
     pub phases: Vec<f64>,
+    /// Polynomial part: the coefficient `p_k` of `τ^k` (N), `k = 0, 1, …` (empty for the
+    /// Fourier model).
+    pub poly: Vec<f64>,
     /// RMS over the fitted samples of (sample − model) (N); 0 for a hand-built model.
     pub fit_rms: f64,
 }
@@ -79,6 +86,7 @@ impl AxisModel {
                 .terms()
                 .map(|(j, c, p)| c * (basis::omega_of(j) * tau + p).cos())
                 .sum::<f64>()
+            + basis::poly_eval(&self.poly, tau)
     }
 
     /// `F1(τ) = ∫₀^τ f = c0 τ + Σ c_i (sin(Ω_iτ + φ_i) − sin φ_i)/Ω_i` (N per unit τ).
@@ -88,6 +96,7 @@ impl AxisModel {
                 .terms()
                 .map(|(j, c, p)| c * basis::f1(basis::omega_of(j), p, tau))
                 .sum::<f64>()
+            + basis::poly_f1(&self.poly, tau)
     }
 
     /// `F2(τ) = ∫₀^τ∫₀ˢ f = c0 τ²/2 + Σ c_i [(cos φ_i − cos(Ω_iτ+φ_i))/Ω_i² − τ sin φ_i/Ω_i]`.
@@ -97,24 +106,28 @@ impl AxisModel {
                 .terms()
                 .map(|(j, c, p)| c * basis::f2(basis::omega_of(j), p, tau))
                 .sum::<f64>()
+            + basis::poly_f2(&self.poly, tau)
     }
 
-    /// `∫₀¹ f dτ`: exactly `c0` when every harmonic is ≥ 1 (their `I1` is 0, spec §5).
+    /// `∫₀¹ f dτ`: exactly `c0` for the Fourier model with every harmonic ≥ 1 (their `I1` is
+    /// 0, spec §5), plus `Σ_k p_k/(k+1)` for the polynomial part.
     pub fn integral(&self) -> f64 {
         self.c0
             + self
                 .terms()
                 .map(|(j, c, p)| c * basis::i1_harmonic(j, p))
                 .sum::<f64>()
+            + basis::poly_moment(&self.poly, 0)
     }
 
-    /// `∫₀¹ τ f dτ = c0/2 + Σ c_i sin φ_i / Ω_i` (N per unit τ).
+    /// `∫₀¹ τ f dτ = c0/2 + Σ c_i sin φ_i / Ω_i + Σ_k p_k/(k+2)` (N per unit τ).
     pub fn first_moment(&self) -> f64 {
         self.c0 / 2.0
             + self
                 .terms()
                 .map(|(j, c, p)| c * basis::m1_harmonic(j, p))
                 .sum::<f64>()
+            + basis::poly_moment(&self.poly, 1)
     }
 }
 
@@ -267,6 +280,26 @@ mod tests {
     }
 
     #[test]
+    fn mixed_fourier_and_polynomial_parts_match_simpson() {
+        // The polynomial part (degree 7, O(1e3 N) coefficients) adds to the Fourier part in
+        // every closed form; Simpson with 4000 intervals is exact to ~1e-8 N here.
+        let mut rng = Rng(0xfeed_0042);
+        for _ in 0..20 {
+            let mut m = random_axis(&mut rng);
+            m.poly = (0..8).map(|_| 2000.0 * (rng.next() - 0.5)).collect();
+            let n = 4000;
+            for &tau in &[0.0, 0.37, 1.0] {
+                assert!((m.f1(tau) - simpson(|u| m.eval(u), 0.0, tau, n)).abs() < 1e-7);
+                let q2 = simpson(|u| (tau - u) * m.eval(u), 0.0, tau, n);
+                assert!((m.f2(tau) - q2).abs() < 1e-7);
+            }
+            assert!((m.integral() - simpson(|u| m.eval(u), 0.0, 1.0, n)).abs() < 1e-7);
+            let qm = simpson(|u| u * m.eval(u), 0.0, 1.0, n);
+            assert!((m.first_moment() - qm).abs() < 1e-7);
+        }
+    }
+
+    #[test]
     fn j_k_p_identities() {
         // Identities hold to roundoff: 1e-12 relative to the O(1) m, m/s values.
         let mut rng = Rng(77);
@@ -345,6 +378,7 @@ mod tests {
                     harmonics: vec![1],
                     amps: vec![a],
                     phases: vec![0.0],
+                    poly: Vec::new(),
                     fit_rms: 0.0,
                 },
             ],

@@ -235,18 +235,20 @@ fn fixed<const N: usize>(v: &[f64]) -> [f64; N] {
     out
 }
 
-/// One stance axis's model columns: `c0_*`, `harmonic_*`, `amp_*`, `phase_*`, `fit_rms_*`.
+/// One stance axis's model columns: `c0_*`, `harmonic_*`, `amp_*`, `phase_*`, `fit_rms_*`,
+/// `poly_*`.
 type AxisColumns = (
     Vec<f64>,
     Vec<Vec<i32>>,
     Vec<Vec<f64>>,
     Vec<Vec<f64>>,
     Vec<f64>,
+    Vec<Vec<f64>>,
 );
 
 /// The force model of row `i` from one axis's columns.
 fn axis_model(t: &Table, name: &str, i: usize, cols: &AxisColumns) -> Result<AxisModel> {
-    let (c0, h, a, p, rms) = cols;
+    let (c0, h, a, p, rms, poly) = cols;
     if h[i].len() != a[i].len() || h[i].len() != p[i].len() {
         return Err(Error::column(
             &t.path,
@@ -272,6 +274,7 @@ fn axis_model(t: &Table, name: &str, i: usize, cols: &AxisColumns) -> Result<Axi
         harmonics,
         amps: a[i].clone(),
         phases: p[i].clone(),
+        poly: poly[i].clone(),
         fit_rms: rms[i],
     })
 }
@@ -307,6 +310,7 @@ pub fn read_stances(path: &Path) -> Result<Vec<PoolStance>> {
                 t.f64_lists(&format!("amp_{a}"), None)?,
                 t.f64_lists(&format!("phase_{a}"), None)?,
                 f(&format!("fit_rms_{a}"))?,
+                t.f64_lists(&format!("poly_{a}"), None)?,
             ))
         })
         .into_iter()

@@ -1,12 +1,16 @@
 //! `stances.parquet` and `errors.parquet` (spec stance-model §11).
 //!
 //! Stance rows are sorted by (`clip`, `first_frame`, `label`); the force model is stored as
-//! parallel list columns per stance axis (`harmonic_*`, `amp_*`, `phase_*`), from which
+//! parallel list columns per stance axis (`harmonic_*`, `amp_*`, `phase_*`: the Fourier
+//! model) and a power-basis list `poly_*` (the ratio model), from which
 //!
 //! ```text
-//! τ = (t − td_clip_s)/dt_s,   f_a(t) = c0_a + Σ_i amp_a[i]·cos(2π·harmonic_a[i]·τ + phase_a[i])
+//! τ = (t − td_clip_s)/dt_s,
+//! f_a(t) = c0_a + Σ_i amp_a[i]·cos(2π·harmonic_a[i]·τ + phase_a[i]) + Σ_k poly_a[k]·τ^k
 //! ```
-//! rebuilds the applied force (N) on stance axis `a` for 0 ≤ τ ≤ 1 (0 outside).
+//! rebuilds the applied force (N) on stance axis `a` for 0 ≤ τ ≤ 1 (0 outside). The
+//! `force_model` column says which model the row holds (`ratio` or `fourier`); `ratio_h`,
+//! `ratio_p` are the ratio model's `q_h`, `q_p` (power basis, `f_h = f_v·q_h`).
 
 use polars::prelude::*;
 
@@ -163,13 +167,25 @@ pub fn stances_table(rows: &[Stance]) -> PolarsResult<DataFrame> {
             f(&|r| r.model.axes[a].fit_rms),
         ));
     }
+    for (a, name) in axis.iter().enumerate() {
+        cols.push(list_col(
+            &format!("poly_{name}"),
+            rows.iter().map(|r| r.model.axes[a].poly.clone()).collect(),
+            DataType::Float64,
+        )?);
+    }
+    for (q, name) in ["h", "p"].iter().enumerate() {
+        cols.push(list_col(
+            &format!("ratio_{name}"),
+            rows.iter().map(|r| r.ratio[q].clone()).collect(),
+            DataType::Float64,
+        )?);
+    }
     cols.push(col(
-        "fit_pos_rms_m",
-        rows.iter().map(|r| r.fit_pos_rms_m).collect::<Vec<_>>(),
-    ));
-    cols.push(col(
-        "stage",
-        rows.iter().map(|r| r.stage).collect::<Vec<_>>(),
+        "force_model",
+        rows.iter()
+            .map(|r| r.force_model.name())
+            .collect::<Vec<_>>(),
     ));
     for (q, get) in [("j", 0usize), ("k", 1)] {
         for (a, name) in axis.iter().enumerate() {

@@ -6,6 +6,7 @@
 //! # References
 //! spec README "Configuration files".
 
+use crate::force_model::ForceModelKind;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -72,6 +73,10 @@ pub struct ContactsTable {
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct FitTable {
+    pub model: Option<String>,
+    pub vertical_degree: Option<u32>,
+    pub ratio_degree_h: Option<u32>,
+    pub ratio_degree_p: Option<u32>,
     pub stage_b: Option<bool>,
     pub stage_b_time_refinement: Option<bool>,
     pub max_harmonics: Option<u32>,
@@ -248,12 +253,31 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
     }
     check_common(path, text, p.mass_kg, p.unit.as_ref(), p.up_axis.as_deref())?;
     if let Some(f) = &p.fit {
-        if f.stage_b_time_refinement == Some(true) {
-            return Err(bad(
+        for (key, set) in [
+            ("stage_b", f.stage_b.is_some()),
+            (
                 "stage_b_time_refinement",
-                "stage_b_time_refinement is not implemented (spec stance-model §4.2, optional)"
-                    .into(),
-            ));
+                f.stage_b_time_refinement.is_some(),
+            ),
+        ] {
+            if set {
+                return Err(bad(
+                    key,
+                    format!("{key} was removed: Stage B made every force-plate figure worse; the ratio model (fit.model = \"ratio\") takes its edge states from the flights"),
+                ));
+            }
+        }
+        if let Some(m) = &f.model {
+            if ForceModelKind::parse(m).is_none() {
+                return Err(bad(
+                    "model",
+                    format!("model = \"{m}\" is not ratio or fourier"),
+                ));
+            }
+        }
+        let ratio = resolve_fit(Some(&p), None).fit.ratio;
+        if let Err(e) = ratio.check() {
+            return Err(bad("degree", e.to_string()));
         }
         if f.energy.is_some_and(|e| !(0.0..=1.0).contains(&e)) {
             return Err(bad("energy", "energy must lie in [0, 1]".into()));
@@ -357,16 +381,27 @@ fn apply_contacts(o: &mut ContactOptions, c: &ContactsTable) {
     set(&mut o.floor_window_s, c.floor_window_s);
 }
 
-/// Stance options from a pipeline's `[fit]` table and the command line (`--stage-b`).
-pub fn resolve_fit(pipe: Option<&PipelineFile>, cli_stage_b: bool) -> StanceOptions {
+/// Stance options from a pipeline's `[fit]` table and the command line (`--force-model`).
+pub fn resolve_fit(
+    pipe: Option<&PipelineFile>,
+    cli_model: Option<ForceModelKind>,
+) -> StanceOptions {
     let mut o = StanceOptions::default();
     if let Some(f) = pipe.and_then(|p| p.fit.as_ref()) {
-        o.stage_b = f.stage_b.unwrap_or(false);
+        if let Some(m) = f.model.as_deref().and_then(ForceModelKind::parse) {
+            o.fit.model = m;
+        }
+        let deg = |v: Option<u32>, d: usize| v.map_or(d, |v| v as usize);
+        o.fit.ratio.vertical_degree = deg(f.vertical_degree, o.fit.ratio.vertical_degree);
+        o.fit.ratio.ratio_degree_h = deg(f.ratio_degree_h, o.fit.ratio.ratio_degree_h);
+        o.fit.ratio.ratio_degree_p = deg(f.ratio_degree_p, o.fit.ratio.ratio_degree_p);
         o.fit.max_harmonics = f.max_harmonics.map_or(o.fit.max_harmonics, |v| v as usize);
         o.fit.energy = f.energy.unwrap_or(o.fit.energy);
         o.fit.samples = f.samples.map_or(o.fit.samples, |v| v as usize);
     }
-    o.stage_b |= cli_stage_b;
+    if let Some(m) = cli_model {
+        o.fit.model = m;
+    }
     o
 }
 

@@ -60,9 +60,9 @@
 //!
 //! let bell = 2.0 * 70.0 * GRAVITY;
 //! let v = AxisModel { c0: bell, harmonics: vec![1], amps: vec![bell],
-//!                     phases: vec![std::f64::consts::PI], fit_rms: 0.0 };
+//!                     phases: vec![std::f64::consts::PI], poly: vec![], fit_rms: 0.0 };
 //! let h = AxisModel { c0: 0.0, harmonics: vec![1], amps: vec![200.0], phases: vec![0.0],
-//!                     fit_rms: 0.0 };
+//!                     poly: vec![], fit_rms: 0.0 };
 //! let model = ForceModel { mass_kg: 70.0, dt_s: 0.25, axes: [h, AxisModel::constant(0.0), v] };
 //! let ctx = StanceContext { vs: 3.0, vps: 0.0, t_td: 0.1, z_td: 0.9, cp: [0.2, 0.0] };
 //! let coef = precompute(&model, &ctx);
@@ -78,7 +78,7 @@ use crate::constraints::{
     contact_point_matrix, force_filter_accepts, friction_filter_accepts, linear_impulse,
     Coefficients, SampledTables, StanceContext, ACTIVE_FRACTION, RELATIVE_MARGIN,
 };
-use crate::force_model::{ForceModel, GRAVITY};
+use crate::force_model::{basis, ForceModel, GRAVITY};
 use std::f64::consts::TAU;
 
 /// Absolute friction coefficient `μ` of `query run` (§7.5).
@@ -436,10 +436,14 @@ pub fn exact_at_contact_point(
     (exact(tables, model, &at, beta, lim), u)
 }
 
-/// `(∫₀¹ τ f_b dτ, ∫₀¹ τ² f_b dτ)` for integer harmonics, N.
+/// `(∫₀¹ τ f_b dτ, ∫₀¹ τ² f_b dτ)` for integer harmonics and the polynomial part, N.
 fn tau_moments(model: &ForceModel, axis: usize) -> (f64, f64) {
     let d = dc_term(model, axis);
     let (mut t1, mut t2) = (d / 2.0, d / 3.0);
+    if let Some(ax) = model.axes.get(axis) {
+        t1 += basis::poly_moment(&ax.poly, 1);
+        t2 += basis::poly_moment(&ax.poly, 2);
+    }
     for (j, c, phi) in harmonic_terms(model, axis) {
         let omega = TAU * f64::from(j);
         let (sin_phi, cos_phi) = phi.sin_cos();

@@ -88,6 +88,7 @@ impl PoolStance {
         for axis in &mut model.axes {
             axis.c0 *= m;
             axis.amps.iter_mut().for_each(|c| *c *= m);
+            axis.poly.iter_mut().for_each(|c| *c *= m);
             axis.fit_rms *= m;
         }
         let c = &self.coef;

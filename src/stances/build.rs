@@ -5,13 +5,14 @@ use super::segment::{segment, Boundary, Segment, SegmentInput, V_QUIET};
 use super::{FlightRef, Stance};
 use crate::constraints::{precompute, StanceContext};
 use crate::contacts::flight::Flight;
+use crate::contacts::flight::FlightFit;
 use crate::contacts::EFFECTORS;
-use crate::force_model::fit::j_cap;
-use crate::force_model::stage_b::{
-    fit_stage_b, to_stance_model, StageBFit, StageBInput, MAX_CONDITION,
+use crate::force_model::{
+    fit_stance, EdgeTargets, FitOptions, FitWorkspace, ForceModelKind, StanceFit, StanceForce,
+    GRAVITY,
 };
-use crate::force_model::{fit_stage_a, FitOptions, FitWorkspace, ForceModel};
 use crate::ingest::{ClipFrames, ClipSummary};
+use crate::math::polyfit::{fit as poly_fit, fit_fixed_curvature};
 use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
 use crate::math::spline::NaturalSpline;
 use crate::math::stats::median;
@@ -21,10 +22,8 @@ type V3 = [f64; 3];
 /// Options of the stance stage.
 #[derive(serde::Serialize, Debug, Clone, PartialEq, Default)]
 pub struct StanceOptions {
-    /// Force-model fit (Stage A).
+    /// Force-model fit (model and its knobs).
     pub fit: FitOptions,
-    /// Refit by least squares on the raw COM positions (Stage B, spec §4.2; off by default).
-    pub stage_b: bool,
 }
 
 /// Natural cubic splines of the three coordinates of a per-frame vector series.
@@ -135,88 +134,62 @@ fn flight_ref(f: &Flight, t: f64) -> FlightRef {
     }
 }
 
-/// `fit_rms` of a refitted model (spec §11): RMS over the Stage A samples (taken in the
-/// frame `r_a`, rotated into the model's frame `r_b`) of sample − model.
-fn set_fit_rms(model: &mut ForceModel, samples: &[Vec<f64>; 3], r_a: [V3; 3], r_b: [V3; 3]) {
-    let n = samples[0].len();
-    if n == 0 {
-        return;
-    }
-    let mut ss = [0.0; 3];
-    #[allow(clippy::needless_range_loop)] // j indexes three parallel sample columns
-    for j in 0..n {
-        let s_a: V3 = std::array::from_fn(|a| samples[a][j]);
-        // world = R_aᵀ s_a, then s_b = R_b · world
-        let world: V3 = std::array::from_fn(|i| (0..3).map(|a| r_a[a][i] * s_a[a]).sum());
-        let tau = j as f64 / n as f64;
-        for (b, acc) in ss.iter_mut().enumerate() {
-            let s_b: f64 = (0..3).map(|i| r_b[b][i] * world[i]).sum();
-            *acc += (s_b - model.axes[b].eval(tau)).powi(2);
-        }
-    }
-    for (axis, acc) in model.axes.iter_mut().zip(ss) {
-        axis.fit_rms = (acc / n as f64).sqrt();
-    }
+/// Frames dropped at each end of a flight before its ballistic fit: the contact edges are
+/// about one frame uncertain, and SG-free raw positions still carry the transition there.
+pub const BALLISTIC_EDGE_FRAMES: usize = 2;
+/// Fewest interior frames of a flight for a ballistic edge state.
+pub const BALLISTIC_MIN_FRAMES: usize = 2;
+
+/// The flight whose last frame is `last_frame`.
+fn flight_ending_at(summary: &ClipSummary, last_frame: i64) -> Option<&Flight> {
+    summary.flights.iter().find(|f| f.last_frame == last_frame)
 }
 
-/// The inputs of one stance's Stage B refit (spec §4.2).
-struct StageB<'a> {
-    seg: &'a Segment,
-    fr: &'a ClipFrames,
-    summary: &'a ClipSummary,
-    model: &'a ForceModel,
-    t_td: f64,
-    dt_s: f64,
-    mass_kg: f64,
-    state: (V3, V3),
+/// The ballistic fit of a flight that a stance takes its edge state from: the flight's own
+/// free fit when it has one (≥ 4 interior frames), else the raw COM over the flight's frames
+/// less [`BALLISTIC_EDGE_FRAMES`] at each end with `x(t)`, `y(t)` lines and `z(t)` a
+/// parabola of curvature −g. Both stances beside one flight use the same parabola, so they
+/// agree on its state. `None` for a non-ballistic flight or too few frames.
+fn ballistic_fit(fr: &ClipFrames, f: &Flight) -> Option<FlightFit> {
+    if !f.ballistic {
+        return None;
+    }
+    if f.tested {
+        // A flight long enough for its own free-curvature fit (spec com-from-bvh §7.7):
+        // that parabola is the flight the data show, and both neighbours share it.
+        return f.fit.clone();
+    }
+    let frame0 = fr.frame[0];
+    let a = usize::try_from(f.first_frame - frame0).ok()? + BALLISTIC_EDGE_FRAMES;
+    let b = usize::try_from(f.last_frame - frame0)
+        .ok()?
+        .checked_sub(BALLISTIC_EDGE_FRAMES)?;
+    if b < a || b + 1 - a < BALLISTIC_MIN_FRAMES || b >= fr.com.len() {
+        return None;
+    }
+    let t = &fr.time_s[a..=b];
+    let axis = |i: usize| -> Vec<f64> { fr.com[a..=b].iter().map(|c| c[i]).collect() };
+    Some(FlightFit {
+        axes: [
+            poly_fit(t, &axis(0), 1)?,
+            poly_fit(t, &axis(1), 1)?,
+            fit_fixed_curvature(t, &axis(2), -GRAVITY)?,
+        ],
+    })
 }
 
-impl StageB<'_> {
-    /// Fit window: the stance frames, extended over an adjacent flight's frames (only where
-    /// the boundary is a flight); harmonics: the union of Stage A's, capped at `j_cap`;
-    /// touchdown state fixed to the SG one when neither side is a flight.
-    fn fit(&self) -> crate::Result<StageBFit> {
-        let (seg, fr) = (self.seg, self.fr);
-        let frame0 = fr.frame[0];
-        let kept = |f: i64| (f - frame0).max(0) as usize;
-        let start = match seg.start {
-            Boundary::Flight => self
-                .summary
-                .flights
-                .iter()
-                .find(|f| f.last_frame == fr.frame[seg.i0] - 1)
-                .map_or(seg.i0, |f| kept(f.first_frame)),
-            _ => seg.i0,
-        };
-        let end = match seg.end {
-            Boundary::Flight => self
-                .summary
-                .flights
-                .iter()
-                .find(|f| f.first_frame == fr.frame[seg.i1] + 1)
-                .map_or(seg.i1, |f| kept(f.last_frame)),
-            _ => seg.i1,
-        };
-        let cap = j_cap(seg.i1 - seg.i0 + 1);
-        let mut harmonics: Vec<u32> = self
-            .model
-            .axes
-            .iter()
-            .flat_map(|a| a.harmonics.iter().copied())
-            .filter(|&j| j <= cap)
-            .collect();
-        harmonics.sort_unstable();
-        harmonics.dedup();
-        let no_flight = seg.start != Boundary::Flight && seg.end != Boundary::Flight;
-        fit_stage_b(&StageBInput {
-            t: &fr.time_s[start..=end],
-            com: &fr.com[start..=end],
-            t_td: self.t_td,
-            dt: self.dt_s,
-            mass_kg: self.mass_kg,
-            harmonics: &harmonics,
-            fixed_state: no_flight.then_some(self.state),
-        })
+/// The force integrals that join the touchdown state `(p, v)_TD` to the liftoff state
+/// `(p, v)_LO` over `Δt` (world states, stance frame `h`), see [`EdgeTargets`].
+fn edge_targets(h: &Heading, td: (V3, V3), lo: (V3, V3), dt: f64, m: f64) -> EdgeTargets {
+    let dv = h.to_stance(std::array::from_fn(|i| lo.1[i] - td.1[i]));
+    let impulse = std::array::from_fn(|a| {
+        let g = if a == 2 { GRAVITY * dt } else { 0.0 };
+        m * (dv[a] + g) / dt
+    });
+    let dz = lo.0[2] - td.0[2];
+    EdgeTargets {
+        impulse,
+        vertical_double: m * (dz - td.1[2] * dt + 0.5 * GRAVITY * dt * dt) / (dt * dt),
     }
 }
 
@@ -309,22 +282,56 @@ pub fn build_clip(
             fr.time_s[seg.i1] + dt / 2.0
         };
         let dt_s = t_lo - t_td;
-        let (mut p_td, mut v_td) = (pos.at(t_td), vel.at(t_td));
+        let fit_before = (seg.start == Boundary::Flight)
+            .then(|| flight_ending_at(summary, frame0 + seg.i0 as i64 - 1))
+            .flatten()
+            .and_then(|f| ballistic_fit(fr, f));
+        let fit_after = (seg.end == Boundary::Flight)
+            .then(|| flight_at(seg.i1 + 1))
+            .flatten()
+            .and_then(|f| ballistic_fit(fr, f));
+        let (p_td, v_td) = fit_before
+            .as_ref()
+            .map_or((pos.at(t_td), vel.at(t_td)), |f| {
+                (f.position(t_td), f.velocity(t_td))
+            });
+        let (p_lo, v_lo) = fit_after
+            .as_ref()
+            .map_or((pos.at(t_lo), vel.at(t_lo)), |f| {
+                (f.position(t_lo), f.velocity(t_lo))
+            });
         let facing_td: V3 = match seg.i0 {
             0 => fr.facing[0],
             i => std::array::from_fn(|a| 0.5 * (fr.facing[i - 1][a] + fr.facing[i][a])),
         };
-        let mut h: Heading = heading(v_td, facing_td, previous);
+        // A standing liftoff (no flight before, a flight after) heads where it leaves to.
+        let v_heading = if fit_before.is_none() && fit_after.is_some() {
+            v_lo
+        } else {
+            v_td
+        };
+        let h: Heading = heading(v_heading, facing_td, previous);
+        let targets = (fit_before.is_some() || fit_after.is_some())
+            .then(|| edge_targets(&h, (p_td, v_td), (p_lo, v_lo), dt_s, mass_kg));
         let z_c = median(&fr.ground_z[seg.i0..=seg.i1]).unwrap_or(0.0);
         let (label, effectors) = label(&seg, &fr.contact);
-        let mut model = match fit_stage_a(
-            &mut ws,
-            &acc.0,
+        let force = StanceForce {
+            acc: &acc.0,
             t_td,
-            dt_s,
-            h.rotation(),
+            dt: dt_s,
+            r_s: h.rotation(),
             mass_kg,
+        };
+        let StanceFit {
+            model,
+            kind: force_model,
+            ratio,
+            targets_met,
+        } = match fit_stance(
+            &mut ws,
+            &force,
             seg.i1 - seg.i0 + 1,
+            targets.as_ref(),
             &opts.fit,
         ) {
             Ok(m) => m,
@@ -340,41 +347,16 @@ pub fn build_clip(
             }
         };
         let mut sw = Vec::new();
-        let (mut stage, mut fit_pos_rms_m) = ("A", None);
-        if opts.stage_b {
-            let refit = StageB {
-                seg: &seg,
-                fr,
-                summary,
-                model: &model,
-                t_td,
-                dt_s,
-                mass_kg,
-                state: (p_td, v_td),
-            }
-            .fit();
-            match refit {
-                Ok(fit) if fit.condition <= MAX_CONDITION => {
-                    (p_td, v_td) = (fit.p_td, fit.v_td);
-                    let r_a = h.rotation();
-                    h = heading(v_td, facing_td, previous);
-                    model = to_stance_model(&fit, h.rotation(), mass_kg, dt_s);
-                    set_fit_rms(&mut model, ws.last_samples(), r_a, h.rotation());
-                    (stage, fit_pos_rms_m) = ("B", Some(fit.pos_rms_m));
-                }
-                Ok(fit) => sw.push(format!(
-                    "stage B fallback to A: condition {:.2e} above {MAX_CONDITION:e}",
-                    fit.condition
-                )),
-                Err(e) => sw.push(format!("stage B fallback to A: {e}")),
-            }
+        if targets.is_some() && force_model == ForceModelKind::Ratio && targets_met < 2 {
+            sw.push(format!(
+                "the force model meets {targets_met} of 2 vertical edge targets of the adjacent flight(s)"
+            ));
         }
         previous = Some(h.e_h);
         let (j, p) = (model.j(), model.p());
         let v_td_s = h.to_stance(v_td);
         let z_td = p_td[2] - z_c;
         let prm = model_consistent(v_td_s, z_td, j, p, dt_s);
-        let (p_lo, v_lo) = (pos.at(t_lo), vel.at(t_lo));
         let dp = h.to_stance(std::array::from_fn(|i| p_lo[i] - p_td[i]));
         let measured = params::from_states(v_td_s, z_td, dp, h.to_stance(v_lo), dt_s);
         let cp = contact_point(&seg, fr).map_or([0.0, 0.0], |c| {
@@ -401,12 +383,7 @@ pub fn build_clip(
         let rest_at_edge = (seg.start == Boundary::ClipEdge && edge_rest(seg.i0))
             || (seg.end == Boundary::ClipEdge && edge_rest(seg.i1));
         let before = (seg.start == Boundary::Flight)
-            .then(|| {
-                summary
-                    .flights
-                    .iter()
-                    .find(|f| f.last_frame == frame0 + seg.i0 as i64 - 1)
-            })
+            .then(|| flight_ending_at(summary, frame0 + seg.i0 as i64 - 1))
             .flatten()
             .map(|f| flight_ref(f, t_td));
         let after = (seg.end == Boundary::Flight)
@@ -437,8 +414,8 @@ pub fn build_clip(
             model,
             cp,
             coef,
-            stage,
-            fit_pos_rms_m,
+            force_model,
+            ratio,
             warnings: sw,
         });
     }

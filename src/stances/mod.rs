@@ -16,7 +16,7 @@ pub mod segment;
 pub use build::{build_clip, StanceOptions};
 
 use crate::constraints::Coefficients;
-use crate::force_model::ForceModel;
+use crate::force_model::{ForceModel, ForceModelKind};
 use params::{Heading, StanceParams};
 use segment::Boundary;
 
@@ -87,10 +87,10 @@ pub struct Stance {
     pub cp: [f64; 2],
     /// Precomputed constraint coefficients and extremes.
     pub coef: Coefficients,
-    /// `A` or `B` (Stage B without fallback).
-    pub stage: &'static str,
-    /// Stage B position residual RMS, m.
-    pub fit_pos_rms_m: Option<f64>,
+    /// Which force model was fitted.
+    pub force_model: ForceModelKind,
+    /// `q_h`, `q_p` of the ratio model (power basis in τ, unit-free); empty for Fourier.
+    pub ratio: [Vec<f64>; 2],
     /// Advisory messages.
     pub warnings: Vec<String>,
 }

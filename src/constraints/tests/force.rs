@@ -130,6 +130,7 @@ fn a_stance_without_load_needs_infinite_friction() {
         harmonics: vec![2],
         amps: vec![10.0],
         phases: vec![0.3],
+        poly: Vec::new(),
         fit_rms: 0.0,
     };
     let model = ForceModel {

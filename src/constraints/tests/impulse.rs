@@ -99,6 +99,7 @@ fn degenerate_models_do_not_panic() {
         harmonics,
         amps,
         phases,
+        poly: Vec::new(),
         fit_rms: 0.0,
     };
     let cases = [
@@ -143,6 +144,7 @@ fn j_zero_terms_and_repeated_harmonics_match_simpson() {
         harmonics: vec![0, 2, 2, 5],
         amps: vec![40.0, 120.0, 60.0, 30.0],
         phases: vec![0.7, -1.1, 2.0, 0.4],
+        poly: Vec::new(),
         fit_rms: 0.0,
     };
     let model = ForceModel {

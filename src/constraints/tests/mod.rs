@@ -22,6 +22,7 @@ fn random_axis(rng: &mut Rng, c0: f64, amp: f64) -> AxisModel {
         amps: (0..n).map(|_| rng.uniform(0.0, amp)).collect(),
         phases: (0..n).map(|_| rng.uniform(-PI, PI)).collect(),
         harmonics,
+        poly: Vec::new(),
         fit_rms: 0.0,
     }
 }

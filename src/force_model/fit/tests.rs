@@ -90,6 +90,7 @@ fn dft_reconstruction_reproduces_all_samples() {
         samples: 0,
         max_harmonics: usize::MAX,
         energy: 1.0,
+        ..Default::default()
     };
     let mut ws = FitWorkspace::new(63);
     // Odd N: every nonzero bin is a candidate, so arbitrary samples are reproduced.

@@ -126,6 +126,7 @@ fn pulling_dip_is_infeasible_for_every_beta() {
         harmonics: vec![1, 4],
         amps: vec![w, 0.5 * w],
         phases: vec![PI, 0.0],
+        poly: Vec::new(),
         fit_rms: 0.0,
     };
     let h = AxisModel {
@@ -133,6 +134,7 @@ fn pulling_dip_is_infeasible_for_every_beta() {
         harmonics: vec![1],
         amps: vec![0.2 * w],
         phases: vec![0.0],
+        poly: Vec::new(),
         fit_rms: 0.0,
     };
     let model = ForceModel {

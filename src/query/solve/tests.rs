@@ -163,6 +163,7 @@ fn model_with(c0: [f64; 3], phi: f64) -> ForceModel {
         harmonics: vec![1],
         amps: vec![amp],
         phases: vec![phi],
+        poly: Vec::new(),
         fit_rms: 0.0,
     };
     ForceModel {
@@ -504,8 +505,8 @@ fn shape_from_a_library_stance() {
         coef: precompute(&model, &ctx),
         model: model.clone(),
         cp: [0.0; 2],
-        stage: "A",
-        fit_pos_rms_m: None,
+        force_model: crate::force_model::ForceModelKind::Fourier,
+        ratio: Default::default(),
         warnings: vec![],
     };
     let shape = StanceShape::from_stance(&stance);

@@ -1,0 +1,446 @@
+//! The friction-ratio stance force model, the library's default (a departure from the paper).
+//!
+//! # Model
+//! ```text
+//! f_v(τ) = Σ_{i=0..d} b_i B_i^d(τ),   B_i^d(τ) = C(d,i) τ^i (1−τ)^(d−i),   b_i ≥ 0      N
+//! f_h(τ) = f_v(τ) · q_h(τ),   q_h(τ) = Σ_{k ≤ d_h} r_hk τ^k                              N
+//! f_p(τ) = f_v(τ) · q_p(τ),   q_p(τ) = Σ_{k ≤ d_p} r_pk τ^k                              N
+//! d = clamp(n_st − 3, MIN_VERTICAL_DEGREE, vertical_degree)
+//! fit on τ_j = j/(N−1), j = 0 … N−1 (both stance edges sampled):
+//!   b   = argmin_{b ≥ 0} Σ_j (f_v(τ_j) − s_vj)²           (non-negative least squares)
+//!   r_a = argmin Σ_j (f_v(τ_j) q_a(τ_j) − s_aj)²          (linear least squares, a = h, p)
+//! ```
+//! `s_aj` are the stance-axis samples of `m (a(t) − g⃗)` that Stage A also uses.
+//!
+//! Why: the paper's truncated periodic Fourier series rings at the stance edges, where
+//! `f_v` is small, so the friction ratio `|f_t|/f_v` (and with it `μ_req`, eq 7) was 3–4×
+//! the force plates' on real runs. Here `f_v ≥ 0` everywhere (non-negative Bernstein
+//! coefficients), the series is not periodic, and the ratio `|f_t|/f_v = hypot(q_h, q_p)`
+//! is a low-order polynomial: smooth and bounded at the edges, fitted where `f_v` is large
+//! (the residual of the ratio is weighted by `f_v`). Under scaling by `β` the ratio is
+//! `hypot(β_h q_h, β_p q_p)/β_v`, so the friction filter of eq 12 is exact.
+//!
+//! Every axis is a polynomial in τ, stored in the power basis ([`AxisModel::poly`]), so
+//! `J`, `K`, `P`, `S(τ)` and every moment the queries use stay closed form.
+//!
+//! # Frames and units
+//! Stance frame `h, p, v`; forces in N, `τ` unit-free, `q` unit-free.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::{AxisModel, ForceModel};
+use crate::{Error, Result};
+
+/// Default largest Bernstein degree `d` of `f_v` (fit option `vertical_degree`).
+pub const DEFAULT_VERTICAL_DEGREE: usize = 8;
+/// Smallest degree of `f_v` (a bell needs 2).
+pub const MIN_VERTICAL_DEGREE: usize = 2;
+/// Largest accepted `vertical_degree`: the power-basis coefficients of a degree-d
+/// Bernstein polynomial grow like 2^d C(d, d/2); at 16 that keeps them below 1e9 × the
+/// force, so evaluation stays accurate to ~1e-6 N.
+pub const MAX_VERTICAL_DEGREE: usize = 16;
+/// Default degree of the heading ratio `q_h` (fit option `ratio_degree_h`).
+pub const DEFAULT_RATIO_DEGREE_H: usize = 1;
+/// Default degree of the perpendicular ratio `q_p` (fit option `ratio_degree_p`).
+pub const DEFAULT_RATIO_DEGREE_P: usize = 1;
+/// Largest accepted ratio degree.
+pub const MAX_RATIO_DEGREE: usize = 6;
+/// Relative singular-value cut-off of the ratio least squares (a stance whose `f_v` is
+/// zero on most samples has no defined ratio there; the minimum-norm solution is taken).
+const RATIO_SVD_EPS: f64 = 1e-12;
+/// Ridge added to the NNLS normal matrix, relative to its mean diagonal, so that it is
+/// strictly positive definite (the Bernstein basis on ≥ d+1 distinct samples already is).
+const NNLS_RIDGE_REL: f64 = 1e-12;
+
+/// The ratio-model knobs (pipeline `[fit]`); see the `DEFAULT_*` constants.
+#[derive(serde::Serialize, Debug, Clone, Copy, PartialEq)]
+pub struct RatioOptions {
+    /// Largest Bernstein degree of `f_v`; default [`DEFAULT_VERTICAL_DEGREE`].
+    pub vertical_degree: usize,
+    /// Degree of `q_h`; default [`DEFAULT_RATIO_DEGREE_H`].
+    pub ratio_degree_h: usize,
+    /// Degree of `q_p`; default [`DEFAULT_RATIO_DEGREE_P`].
+    pub ratio_degree_p: usize,
+}
+
+impl Default for RatioOptions {
+    fn default() -> Self {
+        RatioOptions {
+            vertical_degree: DEFAULT_VERTICAL_DEGREE,
+            ratio_degree_h: DEFAULT_RATIO_DEGREE_H,
+            ratio_degree_p: DEFAULT_RATIO_DEGREE_P,
+        }
+    }
+}
+
+impl RatioOptions {
+    /// Checks the degrees against their bounds.
+    ///
+    /// # Errors
+    /// A config error naming the option.
+    pub fn check(&self) -> Result<()> {
+        let bad = |what: &str, v: usize, lo: usize, hi: usize| {
+            Err(Error::config(
+                None,
+                None,
+                format!("fit.{what} = {v} is not in [{lo}, {hi}]"),
+            ))
+        };
+        if !(MIN_VERTICAL_DEGREE..=MAX_VERTICAL_DEGREE).contains(&self.vertical_degree) {
+            return bad(
+                "vertical_degree",
+                self.vertical_degree,
+                MIN_VERTICAL_DEGREE,
+                MAX_VERTICAL_DEGREE,
+            );
+        }
+        for (name, d) in [
+            ("ratio_degree_h", self.ratio_degree_h),
+            ("ratio_degree_p", self.ratio_degree_p),
+        ] {
+            if d > MAX_RATIO_DEGREE {
+                return bad(name, d, 0, MAX_RATIO_DEGREE);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What the force must integrate to so that the stance joins its edge states exactly
+/// (from the adjacent flights' ballistic fits): `∫₀¹ f_a dτ = impulse[a]` (N) and
+/// `∫₀¹∫₀ˢ f_v = vertical_double` (N).
+///
+/// ```text
+/// impulse_a = m (Δv_a + g Δt δ_av)/Δt,   vertical_double = m (Δz − v_z,TD Δt + ½ g Δt²)/Δt²
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeTargets {
+    /// `∫₀¹ f_a dτ` per stance axis (h, p, v), N.
+    pub impulse: [f64; 3],
+    /// `∫₀¹∫₀ˢ f_v`, N.
+    pub vertical_double: f64,
+}
+
+/// A fitted ratio model: the force model and the ratio polynomials.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RatioFit {
+    /// The stance force model (polynomial parts only).
+    pub model: ForceModel,
+    /// `q_h`, `q_p` in the power basis (unit-free).
+    pub ratio: [Vec<f64>; 2],
+    /// Non-negative Bernstein coefficients `b_i` of `f_v` (N).
+    pub bernstein_v: Vec<f64>,
+    /// How many of the vertical edge targets hold (2: impulse and position, 1: impulse,
+    /// 0: none: the data cannot meet them with `f_v ≥ 0`).
+    pub vertical_targets_met: usize,
+}
+
+/// The degree of `f_v` for a stance of `n_st` frames: `clamp(n_st − 3, 2, max)`.
+pub fn vertical_degree(n_st: usize, max_degree: usize) -> usize {
+    n_st.saturating_sub(3)
+        .clamp(MIN_VERTICAL_DEGREE, max_degree.max(MIN_VERTICAL_DEGREE))
+}
+
+/// `C(n, k)` as f64 (exact for the small n used here).
+fn binomial(n: usize, k: usize) -> f64 {
+    (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
+}
+
+/// `B_i^d(τ)` for i = 0 … d.
+fn bernstein_row(d: usize, tau: f64) -> Vec<f64> {
+    (0..=d)
+        .map(|i| binomial(d, i) * tau.powi(i as i32) * (1.0 - tau).powi((d - i) as i32))
+        .collect()
+}
+
+/// Power-basis coefficients of `Σ_i b_i B_i^d(τ)`:
+/// `p_k = Σ_{i ≤ k} b_i C(d,i) C(d−i, k−i) (−1)^(k−i)`.
+pub fn bernstein_to_power(b: &[f64]) -> Vec<f64> {
+    let Some(d) = b.len().checked_sub(1) else {
+        return Vec::new();
+    };
+    (0..=d)
+        .map(|k| {
+            (0..=k)
+                .map(|i| {
+                    let sign = if (k - i) % 2 == 0 { 1.0 } else { -1.0 };
+                    b[i] * binomial(d, i) * binomial(d - i, k - i) * sign
+                })
+                .sum()
+        })
+        .collect()
+}
+
+/// `min ½ xᵀQx + cᵀx` s.t. the first `meq` rows of `a x = b`, the rest `a x ≤ b` (quadprog,
+/// Goldfarb–Idnani); `q` gets a relative ridge so that it is strictly positive definite.
+fn qp(q: &DMatrix<f64>, c: &[f64], a: &[f64], b: &[f64], meq: usize) -> Option<Vec<f64>> {
+    let n = q.ncols();
+    let ridge = NNLS_RIDGE_REL * (0..n).map(|i| q[(i, i)]).sum::<f64>() / n as f64;
+    let mut qm: Vec<f64> = (0..n * n)
+        .map(|k| q[(k / n, k % n)] + if k / n == k % n { ridge } else { 0.0 })
+        .collect();
+    quadprog::solve_qp(&mut qm, c, a, b, meq, false)
+        .ok()
+        .map(|s| s.sol)
+        .filter(|x| x.iter().all(|v| v.is_finite()))
+}
+
+/// Non-negative least squares `argmin_{b ≥ 0} ‖B b − s‖²` under the equality rows `eq`
+/// (`e·b = target`), by [`qp`]. Tries all rows, then the first only, then none.
+fn nnls(basis: &DMatrix<f64>, s: &[f64], eq: &[(Vec<f64>, f64)]) -> Result<(Vec<f64>, usize)> {
+    let n = basis.ncols();
+    let gram = basis.transpose() * basis;
+    let rhs = basis.transpose() * DVector::from_column_slice(s);
+    let c: Vec<f64> = rhs.iter().map(|v| -v).collect();
+    for k in (0..=eq.len()).rev() {
+        let mut a: Vec<f64> = eq[..k].iter().flat_map(|(row, _)| row.clone()).collect();
+        let mut b: Vec<f64> = eq[..k].iter().map(|(_, t)| *t).collect();
+        // −b_i ≤ 0, one row per coefficient.
+        for i in 0..n {
+            a.extend((0..n).map(|j| if i == j { -1.0 } else { 0.0 }));
+            b.push(0.0);
+        }
+        if let Some(x) = qp(&gram, &c, &a, &b, k) {
+            return Ok((x.into_iter().map(|v| v.max(0.0)).collect(), k));
+        }
+    }
+    Err(Error::numeric(
+        "ratio model: the non-negative fit of f_v failed",
+    ))
+}
+
+/// Least squares `argmin_r Σ_j (f_v(τ_j) q(τ_j) − s_j)²`, `q` of degree `deg`, optionally
+/// with `∫₀¹ f_v q dτ = target` (`fv_moments[k] = ∫₀¹ τ^k f_v dτ`).
+fn ratio_fit(
+    fv: &[f64],
+    tau: &[f64],
+    s: &[f64],
+    deg: usize,
+    impulse: Option<(&[f64], f64)>,
+) -> Vec<f64> {
+    let x = DMatrix::from_fn(tau.len(), deg + 1, |j, k| fv[j] * tau[j].powi(k as i32));
+    if let Some((m, target)) = impulse {
+        let q = x.transpose() * &x;
+        let c: Vec<f64> = (x.transpose() * DVector::from_column_slice(s))
+            .iter()
+            .map(|v| -v)
+            .collect();
+        if let Some(r) = qp(&q, &c, &m[..=deg], &[target], 1) {
+            return r;
+        }
+    }
+    let svd = x.svd(true, true);
+    let cut = RATIO_SVD_EPS * svd.singular_values.max();
+    match svd.solve(&DVector::from_column_slice(s), cut) {
+        Ok(r) if r.iter().all(|v| v.is_finite()) => r.iter().copied().collect(),
+        _ => vec![0.0; deg + 1],
+    }
+}
+
+/// RMS of `samples − model(τ)` over the fit grid (N).
+fn rms(axis: &AxisModel, tau: &[f64], samples: &[f64]) -> f64 {
+    let ss: f64 = tau
+        .iter()
+        .zip(samples)
+        .map(|(&t, &s)| (s - axis.eval(t)).powi(2))
+        .sum();
+    (ss / tau.len().max(1) as f64).sqrt()
+}
+
+/// Fits the ratio model to stance-axis force samples on `τ_j = j/(N−1)`.
+///
+/// # Arguments
+/// * `samples`: `s_aj` per stance axis (h, p, v), N, all of length `N ≥ 2`;
+/// * `n_st`: stance frames (sets the degree of `f_v`); `mass_kg`, `dt_s`: for the model.
+///
+/// # Errors
+/// A config error for bad options or sample lengths; a numeric error when the QP fails.
+pub fn fit_ratio(
+    samples: &[Vec<f64>; 3],
+    n_st: usize,
+    mass_kg: f64,
+    dt_s: f64,
+    targets: Option<&EdgeTargets>,
+    opts: &RatioOptions,
+) -> Result<RatioFit> {
+    opts.check()?;
+    let n = samples[2].len();
+    if n < 2 || samples.iter().any(|s| s.len() != n) {
+        return Err(Error::config(
+            None,
+            None,
+            format!("ratio model: need ≥ 2 samples per axis, got {n}"),
+        ));
+    }
+    let tau = sample_grid(n);
+    let d = vertical_degree(n_st, opts.vertical_degree).min(n - 1);
+    let basis = DMatrix::from_fn(n, d + 1, |j, i| bernstein_row(d, tau[j])[i]);
+    // ∫₀¹ B_i^d = 1/(d+1);  ∫₀¹∫₀ˢ B_i^d = ∫₀¹ (1−τ) B_i^d = (d+1−i)/((d+1)(d+2)).
+    let eq: Vec<(Vec<f64>, f64)> = targets.map_or(Vec::new(), |t| {
+        let df = d as f64;
+        vec![
+            (vec![1.0 / (df + 1.0); d + 1], t.impulse[2]),
+            (
+                (0..=d)
+                    .map(|i| (df + 1.0 - i as f64) / ((df + 1.0) * (df + 2.0)))
+                    .collect(),
+                t.vertical_double,
+            ),
+        ]
+    });
+    let (b, met) = nnls(&basis, &samples[2], &eq)?;
+    let fv_poly = bernstein_to_power(&b);
+    let fv: Vec<f64> = (basis.clone() * DVector::from_column_slice(&b))
+        .iter()
+        .copied()
+        .collect();
+    let deg_max = opts.ratio_degree_h.max(opts.ratio_degree_p);
+    let moments: Vec<f64> = (0..=deg_max)
+        .map(|k| super::basis::poly_moment(&fv_poly, k))
+        .collect();
+    let imp = |a: usize| targets.map(|t| (moments.as_slice(), t.impulse[a]));
+    let q_h = ratio_fit(&fv, &tau, &samples[0], opts.ratio_degree_h, imp(0));
+    let q_p = ratio_fit(&fv, &tau, &samples[1], opts.ratio_degree_p, imp(1));
+    let axis = |poly: Vec<f64>, s: &[f64]| {
+        let mut a = AxisModel {
+            poly,
+            ..Default::default()
+        };
+        a.fit_rms = rms(&a, &tau, s);
+        a
+    };
+    let model = ForceModel {
+        mass_kg,
+        dt_s,
+        axes: [
+            axis(super::basis::poly_mul(&fv_poly, &q_h), &samples[0]),
+            axis(super::basis::poly_mul(&fv_poly, &q_p), &samples[1]),
+            axis(fv_poly, &samples[2]),
+        ],
+    };
+    Ok(RatioFit {
+        model,
+        ratio: [q_h, q_p],
+        bernstein_v: b,
+        vertical_targets_met: met,
+    })
+}
+
+/// The fit grid `τ_j = j/(N−1)`, `j = 0 … N−1` (both edges).
+pub fn sample_grid(n: usize) -> Vec<f64> {
+    let last = (n.max(2) - 1) as f64;
+    (0..n).map(|j| j as f64 / last).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::force_model::basis::poly_eval;
+
+    #[test]
+    fn bernstein_to_power_is_the_same_polynomial() {
+        let b = [0.0, 300.0, 2100.0, 1800.0, 900.0, 40.0, 0.0];
+        let p = bernstein_to_power(&b);
+        for k in 0..=20 {
+            let t = k as f64 / 20.0;
+            let want: f64 = bernstein_row(6, t).iter().zip(&b).map(|(x, y)| x * y).sum();
+            // Power coefficients stay below 1e5 here: 1e-9 N is ~1e4 ulps of headroom.
+            assert!((poly_eval(&p, t) - want).abs() < 1e-9, "τ = {t}");
+        }
+    }
+
+    /// Samples of a bell `f_v = W sin²(πτ)·…` with a known ratio `q_h = −0.4 + 0.9 τ`.
+    fn bell_samples(n: usize, mass: f64) -> [Vec<f64>; 3] {
+        let tau = sample_grid(n);
+        let fv: Vec<f64> = tau
+            .iter()
+            .map(|t| 2.5 * mass * 9.81 * (std::f64::consts::PI * t).sin().powi(2))
+            .collect();
+        let fh = fv
+            .iter()
+            .zip(&tau)
+            .map(|(f, t)| f * (-0.4 + 0.9 * t))
+            .collect();
+        let fp = fv.iter().map(|f| 0.05 * f).collect();
+        [fh, fp, fv]
+    }
+
+    #[test]
+    fn recovers_a_known_ratio_and_keeps_f_v_non_negative() {
+        let s = bell_samples(64, 70.0);
+        let quadratic = RatioOptions {
+            ratio_degree_h: 2,
+            ..Default::default()
+        };
+        let fit = fit_ratio(&s, 20, 70.0, 0.25, None, &quadratic).unwrap();
+        // sin²(πτ) is a degree-∞ function: a degree-8 fit is within 0.2 % of its peak.
+        assert!(fit.model.axes[2].fit_rms < 2e-3 * 2.5 * 70.0 * 9.81);
+        // The ratio is fitted exactly where f_v is not tiny (the model is f_v·q exactly).
+        assert!((fit.ratio[0][0] + 0.4).abs() < 1e-3, "{:?}", fit.ratio[0]);
+        assert!((fit.ratio[0][1] - 0.9).abs() < 5e-3, "{:?}", fit.ratio[0]);
+        assert!(fit.ratio[0][2].abs() < 5e-3);
+        assert!((fit.ratio[1][0] - 0.05).abs() < 1e-6 && fit.ratio[1][1].abs() < 1e-6);
+        assert!(fit.bernstein_v.iter().all(|&b| b >= 0.0));
+        let g = fit.model.grid();
+        assert!(fit.model.min_f_v(&g) >= -1e-6);
+        // The force model's ratio is q_h: f_h/f_v at mid-stance.
+        let (fh, fv) = (fit.model.axes[0].eval(0.5), fit.model.axes[2].eval(0.5));
+        assert!((fh / fv - poly_eval(&fit.ratio[0], 0.5)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn negative_samples_are_clipped_to_a_non_negative_force() {
+        // A pulling dip in the data (kinematic noise at the edges): the model stays ≥ 0.
+        let mut s = bell_samples(64, 60.0);
+        for j in 0..6 {
+            s[2][j] = -150.0;
+        }
+        let fit = fit_ratio(&s, 20, 60.0, 0.3, None, &RatioOptions::default()).unwrap();
+        assert!(fit.model.min_f_v(&fit.model.grid()) >= -1e-6);
+        assert!(fit.model.support_ok());
+    }
+
+    #[test]
+    fn edge_targets_are_met_exactly() {
+        // Ask for 3 % more vertical impulse and a shifted centroid than the samples carry:
+        // the constrained fit meets both to roundoff and the ratio impulses likewise.
+        let s = bell_samples(64, 70.0);
+        let free = fit_ratio(&s, 20, 70.0, 0.25, None, &RatioOptions::default()).unwrap();
+        let i = |a: usize| free.model.axes[a].integral();
+        let t = EdgeTargets {
+            impulse: [i(0) + 30.0, i(1) - 5.0, 1.03 * i(2)],
+            vertical_double: 1.01 * free.model.axes[2].f2(1.0),
+        };
+        let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&t), &RatioOptions::default()).unwrap();
+        assert_eq!(fit.vertical_targets_met, 2);
+        for a in 0..3 {
+            let got = fit.model.axes[a].integral();
+            assert!(
+                (got - t.impulse[a]).abs() < 1e-6 * t.impulse[2],
+                "axis {a}: {got}"
+            );
+        }
+        assert!((fit.model.axes[2].f2(1.0) - t.vertical_double).abs() < 1e-6 * t.impulse[2]);
+        assert!(fit.model.min_f_v(&fit.model.grid()) >= -1e-6);
+        // An impossible target (negative impulse) falls back without f_v < 0.
+        let bad = EdgeTargets {
+            impulse: [0.0, 0.0, -100.0],
+            vertical_double: -50.0,
+        };
+        let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&bad), &RatioOptions::default()).unwrap();
+        assert_eq!(fit.vertical_targets_met, 0);
+        assert!(fit.model.min_f_v(&fit.model.grid()) >= -1e-6);
+    }
+
+    #[test]
+    fn degree_follows_the_frames() {
+        assert_eq!(vertical_degree(4, 8), 2);
+        assert_eq!(vertical_degree(8, 8), 5);
+        assert_eq!(vertical_degree(40, 8), 8);
+        let bad = RatioOptions {
+            vertical_degree: 40,
+            ..Default::default()
+        };
+        assert!(bad.check().is_err());
+    }
+}
