@@ -296,3 +296,67 @@ fn jump_map_has_a_feasible_region_and_reports_agreement() {
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     eprintln!("map jumps on the shared library:\n{printed}");
 }
+
+#[test]
+fn active_set_option_acts_on_the_friction_check() {
+    // See: issue 12 item 5 — the queries' friction check uses a configurable active set;
+    // a wider one (0.05: down to 5 % of peak f_v) can only need more friction.
+    let Some(lib) = shared_library() else { return };
+    let l = lib.display().to_string();
+    let mu_at = |frac: &str| {
+        let out = lib
+            .parent()
+            .unwrap()
+            .join(format!("runs_active_{frac}.parquet"));
+        stancelib(&[
+            "query",
+            "run",
+            "--lib",
+            &l,
+            "--speeds",
+            "0:6:0.5",
+            "--active-set",
+            frac,
+            "--out",
+            &out.display().to_string(),
+        ]);
+        let t = Table::open(&out).unwrap();
+        t.opt_f64("mu_min").unwrap()
+    };
+    let (wide, robust) = (mu_at("0.05"), mu_at("0.2"));
+    assert_eq!(wide.len(), robust.len());
+    let pairs: Vec<(f64, f64)> = wide
+        .iter()
+        .zip(&robust)
+        .filter_map(|(a, b)| Some(((*a)?, (*b)?)))
+        .collect();
+    assert!(!pairs.is_empty());
+    // A superset of samples: μ_min at 0.05 ≥ μ_min at 0.2 (1e-12: the same f64 ratios).
+    assert!(pairs.iter().all(|(w, r)| w + 1e-12 >= *r), "{pairs:?}");
+    assert!(
+        pairs.iter().any(|(w, r)| w - r > 0.01),
+        "the option changed nothing"
+    );
+    let bad = Command::new(env!("CARGO_BIN_EXE_stancelib"))
+        .args([
+            "query",
+            "run",
+            "--lib",
+            &l,
+            "--speed",
+            "3",
+            "--active-set",
+            "1.5",
+        ])
+        .args([
+            "--out",
+            &lib.parent()
+                .unwrap()
+                .join("x.parquet")
+                .display()
+                .to_string(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+}

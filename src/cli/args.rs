@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::pipeline::spec::Overrides;
-use crate::query::feasibility::LimitForm;
+use crate::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::map::Axis;
 use crate::skeleton::units::{parse_unit, UpAxis};
 
@@ -86,6 +86,10 @@ pub struct LimitArgs {
     /// Friction limit μ of the absolute form (default 0.7).
     #[arg(long)]
     pub mu: Option<f64>,
+    /// Active set of the friction check: where f_v ≥ FRACTION · max f_v (default 0.2, chosen
+    /// from the force plates; the paper's is 0.05).
+    #[arg(long = "active-set")]
+    pub active_set: Option<f64>,
 }
 
 impl LimitArgs {
@@ -99,6 +103,20 @@ impl LimitArgs {
         }
         let form = self.limits.as_deref().and_then(LimitForm::parse);
         Ok((form.unwrap_or(default), self.mu))
+    }
+
+    /// The friction check's active fraction `λ_act` (`--active-set`, else
+    /// [`DEFAULT_QUERY_ACTIVE_FRACTION`]).
+    ///
+    /// # Errors
+    /// A fraction outside `[0, 1)` or not finite.
+    pub fn active_fraction(&self) -> anyhow::Result<f64> {
+        let v = self.active_set.unwrap_or(DEFAULT_QUERY_ACTIVE_FRACTION);
+        anyhow::ensure!(
+            v.is_finite() && (0.0..1.0).contains(&v),
+            "--active-set must lie in [0, 1), found {v}"
+        );
+        Ok(v)
     }
 }
 

@@ -81,20 +81,7 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
     let unilateral_floor = -UNILATERAL_FRACTION * max_f_v;
     let unilateral_ok = fv.iter().all(|&v| v >= unilateral_floor);
 
-    let (mut a_mu, mut mu_req) = ([f64::INFINITY; 2], f64::INFINITY);
-    if max_f_v > 0.0 {
-        let threshold = ACTIVE_FRACTION * max_f_v;
-        let (mut rh, mut rp, mut rt) = (0.0f64, 0.0f64, 0.0f64);
-        for ((&h, &p), &v) in fh.iter().zip(fp).zip(fv) {
-            if v >= threshold {
-                let (qh, qp) = ((h / v) * (h / v), (p / v) * (p / v));
-                rh = rh.max(qh);
-                rp = rp.max(qp);
-                rt = rt.max((h * h + p * p).sqrt() / v); // as query::feasibility::exact
-            }
-        }
-        (a_mu, mu_req) = ([rh, rp], rt);
-    }
+    let (a_mu, mu_req) = friction_demand(tables, max_f_v, ACTIVE_FRACTION);
 
     ForceCoefficients {
         a_f,
@@ -105,6 +92,28 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
         f_peak: f_peak.sqrt(),
         mu_req,
     }
+}
+
+/// `(A^μ, μ_req)` on the active set `f_v ≥ λ · max f_v` (eq 11, §7.1):
+/// `A^μ_a = max (f_a/f_v)²` (h, p) and `μ_req = max √(f_h² + f_p²)/f_v`; `+∞` for both when
+/// `max f_v ≤ 0`. `λ` is the active fraction ([`super::ACTIVE_FRACTION`] for the stored
+/// columns; the queries' `--active-set`).
+pub fn friction_demand(tables: &SampledTables, max_f_v: f64, lambda: f64) -> ([f64; 2], f64) {
+    if max_f_v.is_nan() || max_f_v <= 0.0 {
+        return ([f64::INFINITY; 2], f64::INFINITY);
+    }
+    let [fh, fp, fv] = &tables.f;
+    let threshold = lambda * max_f_v;
+    let (mut rh, mut rp, mut rt) = (0.0f64, 0.0f64, 0.0f64);
+    for ((&h, &p), &v) in fh.iter().zip(fp).zip(fv) {
+        if v >= threshold {
+            let (qh, qp) = ((h / v) * (h / v), (p / v) * (p / v));
+            rh = rh.max(qh);
+            rp = rp.max(qp);
+            rt = rt.max((h * h + p * p).sqrt() / v); // as query::feasibility::exact
+        }
+    }
+    ([rh, rp], rt)
 }
 
 /// Eq 10: the conservative force filter, `Σ_a A^F_a β_a² ≤ F_max²`.

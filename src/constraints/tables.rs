@@ -32,8 +32,11 @@ use crate::force_model::{basis, ForceModel, UNILATERAL_FRACTION};
 use std::f64::consts::TAU;
 
 /// `f_a(τ_k)` and `S_a(τ_k)` of one stance on its grid; reusable across stances.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct SampledTables {
+    /// `λ_act` of the exact friction check on these tables: the active set is
+    /// `f_v ≥ λ_act · max f_v`; [`super::ACTIVE_FRACTION`] unless a query sets it.
+    pub active_fraction: f64,
     /// The grid `τ_k = k/(N_s − 1)` (equal to `ForceModel::grid`), dimensionless.
     pub tau: Vec<f64>,
     /// `f_a(τ_k)` per axis (h, p, v), N.
@@ -46,6 +49,20 @@ pub struct SampledTables {
     pub unilateral_ok: bool,
     /// `(cos, sin)` of `2π m/(N_s − 1)`, `m = 0 … N_s − 2`, for the last grid size.
     unit_circle: Vec<(f64, f64)>,
+}
+
+impl Default for SampledTables {
+    fn default() -> Self {
+        SampledTables {
+            active_fraction: super::ACTIVE_FRACTION,
+            tau: Vec::new(),
+            f: Default::default(),
+            s: Default::default(),
+            max_f_v: 0.0,
+            unilateral_ok: true,
+            unit_circle: Vec::new(),
+        }
+    }
 }
 
 impl SampledTables {

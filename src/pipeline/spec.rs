@@ -91,6 +91,7 @@ pub struct FitTable {
 pub struct ConstraintsTable {
     pub mu: Option<f64>,
     pub limits: Option<String>,
+    pub active_set: Option<f64>,
 }
 
 /// `[queries]` of a pipeline file: query stages run on the library after the build; their
@@ -252,6 +253,14 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
         return Err(bad("inputs", "inputs must list at least one glob".into()));
     }
     check_common(path, text, p.mass_kg, p.unit.as_ref(), p.up_axis.as_deref())?;
+    if let Some(a) = p.constraints.as_ref().and_then(|c| c.active_set) {
+        if !(a.is_finite() && (0.0..1.0).contains(&a)) {
+            return Err(bad(
+                "active_set",
+                format!("active_set = {a} must lie in [0, 1)"),
+            ));
+        }
+    }
     if let Some(f) = &p.fit {
         for (key, set) in [
             ("stage_b", f.stage_b.is_some()),

@@ -14,6 +14,7 @@
 //! # References
 //! spec stance-model §9 (table), §7.2 (what is stored per stance), §11 (columns).
 
+use crate::constraints::coefficients::friction_demand;
 use crate::constraints::{Coefficients, SampledTables, StanceContext};
 use crate::force_model::ForceModel;
 use crate::stances::params::StanceParams;
@@ -142,5 +143,17 @@ impl Prepared {
             shape,
             stance,
         }
+    }
+
+    /// Builds the tables of `stance` with the friction check's active set at `λ_act`
+    /// (`f_v ≥ λ_act · max f_v`): the exact check uses it, and the stance's `A^μ` and
+    /// `μ_req` (eq 11 filter, relative limits) are recomputed on it.
+    pub fn with_active_fraction(stance: PoolStance, active_fraction: f64) -> Self {
+        let mut p = Prepared::new(stance);
+        p.tables.active_fraction = active_fraction;
+        let (a_mu, mu_req) = friction_demand(&p.tables, p.tables.max_f_v, active_fraction);
+        p.stance.coef.a_mu = a_mu;
+        p.stance.coef.mu_req = mu_req;
+        p
     }
 }

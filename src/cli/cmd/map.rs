@@ -40,7 +40,8 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         "the grid is empty: check --heights and --speeds"
     );
     let (form, mu) = a.lim.form(LimitForm::Relative)?;
-    let (lib, pool) = load_pool(&a.lib)?;
+    let active = a.lim.active_fraction()?;
+    let (lib, pool) = load_pool(&a.lib, active)?;
     let absolute = absolute_limits(&lib);
     let limits = |p: &Prepared| stance_limits(p, form, &absolute, mu);
     let t0 = Instant::now();
@@ -55,7 +56,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         "liftoffs": map.liftoffs.len(), "landings": map.landings.len(), "pairs": map.pairs.len(),
         "cells_approx": map.agreement.approx, "cells_exact": map.agreement.exact,
         "cells_both": map.agreement.both, "iou": iou,
-        "limits": format!("{form:?}").to_lowercase(),
+        "limits": format!("{form:?}").to_lowercase(), "active_set": active,
     });
     let kv = query_kv(summary.clone());
     write_atomic(

@@ -19,16 +19,20 @@ use crate::query::pool::Prepared;
 use crate::query::run::{run_at_speed, run_cycles, scale_limits, RunCycle};
 use crate::stances::limits::{limits, ClipFacts, StanceFacts, S_EFF_RANGE};
 
-/// Opens a library and prepares every stance (tables built in parallel).
+/// Opens a library and prepares every stance (tables built in parallel), the friction
+/// check on the active set `f_v ≥ active_fraction · max f_v`.
 ///
 /// # Errors
 /// A missing or malformed library table.
-pub fn load_pool(lib: &Path) -> anyhow::Result<(StanceLibrary, Vec<Prepared>)> {
+pub fn load_pool(
+    lib: &Path,
+    active_fraction: f64,
+) -> anyhow::Result<(StanceLibrary, Vec<Prepared>)> {
     let library = open_library(lib).with_context(|| format!("library {}", lib.display()))?;
     let pool = library
         .stances
         .par_iter()
-        .map(|s| Prepared::new(s.clone()))
+        .map(|s| Prepared::with_active_fraction(s.clone(), active_fraction))
         .collect();
     Ok((library, pool))
 }
@@ -148,7 +152,8 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
             "{n} must be a positive number, found {v}"
         );
     }
-    let (lib, pool) = load_pool(&a.lib)?;
+    let active = a.lim.active_fraction()?;
+    let (lib, pool) = load_pool(&a.lib, active)?;
     let all = run_cycles(&lib.stances);
     let (cycles, skipped): (Vec<RunCycle>, Vec<RunCycle>) = all
         .into_iter()
@@ -171,9 +176,9 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
     let scaled: Vec<(RunCycle, [Prepared; 2], [Limits; 2])> = cycles
         .par_iter()
         .map(|c| {
-            let prep = c
-                .stances
-                .map(|i| Prepared::new(pool[i].stance.scaled(length, mass)));
+            let prep = c.stances.map(|i| {
+                Prepared::with_active_fraction(pool[i].stance.scaled(length, mass), active)
+            });
             let lim = [0, 1].map(|k| stance_limits(&prep[k], form, &limits, mu));
             (*c, prep, lim)
         })
@@ -194,7 +199,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
     let mut df = run_table(&rows)?;
     let kv = query_kv(serde_json::json!({
         "query": "run", "lib": a.lib, "speeds_mps": speeds,
-        "length_scale": length, "mass_scale": mass,
+        "length_scale": length, "mass_scale": mass, "active_set": active,
     }));
     write_table(&a.out, &mut df, &kv)?;
     print_run(&rows);
@@ -255,7 +260,8 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
     }
     let (form, mu) = a.lim.form(LimitForm::Relative)?;
-    let (lib, pool) = load_pool(&a.lib)?;
+    let active = a.lim.active_fraction()?;
+    let (lib, pool) = load_pool(&a.lib, active)?;
     let absolute = absolute_limits(&lib);
     let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);
     let ups: Vec<&Prepared> = pool.iter().filter(|p| is_liftoff(&p.stance)).collect();
@@ -288,7 +294,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
     });
     let mut df = jump_table(&rows)?;
     let kv = query_kv(serde_json::json!({
-        "query": "jump", "lib": a.lib, "height_m": a.height, "distance_m": a.distance,
+        "query": "jump", "lib": a.lib, "height_m": a.height, "distance_m": a.distance, "active_set": active,
     }));
     write_table(&a.out, &mut df, &kv)?;
     println!(

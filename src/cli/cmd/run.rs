@@ -52,6 +52,7 @@ fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> an
         .and_then(|c| c.limits.clone())
         .filter(|l| l != "per_query");
     let mu = c.and_then(|c| c.mu);
+    let active_set = c.and_then(|c| c.active_set);
     if let Some(speeds) = &q.run_speeds {
         super::query::run(RunQueryArgs {
             lib: lib.to_path_buf(),
@@ -62,6 +63,7 @@ fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> an
             lim: LimitArgs {
                 limits: limits.clone(),
                 mu,
+                active_set,
             },
             out: dir.join("runs.parquet"),
         })?;
@@ -74,7 +76,11 @@ fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> an
                 .clone()
                 .unwrap_or_else(|| "0.6:1.6:0.02".into()),
             speeds: q.map_speeds.clone().unwrap_or_else(|| "0:5:0.05".into()),
-            lim: LimitArgs { limits, mu },
+            lim: LimitArgs {
+                limits,
+                mu,
+                active_set,
+            },
             out: dir.join("jump_map"),
         })?;
     }
