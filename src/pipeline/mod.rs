@@ -6,4 +6,5 @@ pub mod batch;
 pub mod build;
 pub mod inputs;
 pub mod names;
+pub mod output;
 pub mod spec;
