@@ -142,6 +142,25 @@ fn out_containing_or_inside_an_input_is_refused_even_with_force() {
     assert!(!data.join("clips/new").exists());
 }
 
+// See: issue 11 item 1 — a pipeline `out` naming its own input folder deleted the clips.
+#[test]
+fn a_pipeline_out_naming_its_input_folder_is_refused() {
+    let d = tmp();
+    let clips = d.path().join("clips");
+    clips_in(&clips, 1);
+    let before = snapshot(&clips);
+    let job = d.path().join("job.toml");
+    std::fs::write(&job, "inputs = [\"clips/*.bvh\"]\nout = \"clips\"\n").unwrap();
+    for extra in [&[][..], &["--force"][..]] {
+        let mut args = vec!["run", job.to_str().unwrap()];
+        args.extend(extra);
+        let (code, _, err) = stancelib(&args);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains("contains the input"), "{err}");
+        assert_eq!(snapshot(&clips), before, "{extra:?}: the inputs changed");
+    }
+}
+
 // See: issue 11 item 1 — any existing folder that is not a library was emptied.
 #[test]
 fn out_naming_a_folder_that_is_not_a_library_is_refused_unless_forced() {

@@ -28,9 +28,12 @@ use crate::library::scratch::{remove_stale, scratch_name, Scratch};
 /// manifest lists one hash per input: about 100 bytes per clip).
 pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
 
+/// Whether a JSON value has the expected type.
+type JsonTypeCheck = fn(&serde_json::Value) -> bool;
+
 /// Keys and JSON types of the manifests written before the `schema` key: a folder whose
 /// manifest has all of them is a library too.
-const LEGACY_MANIFEST_KEYS: [(&str, fn(&serde_json::Value) -> bool); 8] = [
+const LEGACY_MANIFEST_KEYS: [(&str, JsonTypeCheck); 8] = [
     ("schema_version", serde_json::Value::is_string),
     ("tool_version", serde_json::Value::is_string),
     ("options", serde_json::Value::is_object),
