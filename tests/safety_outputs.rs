@@ -207,6 +207,36 @@ fn out_naming_a_regular_file_is_refused_and_the_file_is_intact() {
     assert_eq!(names.len(), 1, "no hidden temporary is left: {names:?}");
 }
 
+// See: issue 11 item 1 — `frames --out DIR` writes into DIR by temporary and rename: it
+// replaces only its own tables, so the inputs in DIR survive.
+#[test]
+fn frames_into_its_input_folder_replaces_only_its_own_tables() {
+    let d = tmp();
+    let clips = d.path().join("clips");
+    clips_in(&clips, 2);
+    std::fs::write(clips.join("notes.txt"), "keep me").unwrap();
+    let before = snapshot(&clips);
+    let (code, _, err) = frames(&[&clips], &clips);
+    assert_eq!(code, 0, "{err}");
+    let after = snapshot(&clips);
+    for (p, bytes) in &before {
+        assert!(
+            after.contains(&(p.clone(), bytes.clone())),
+            "{} changed",
+            p.display()
+        );
+    }
+    let added: Vec<String> = after
+        .iter()
+        .filter(|f| !before.contains(f))
+        .map(|(p, _)| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        added,
+        vec!["clips.parquet", "contacts.parquet", "frames.parquet"]
+    );
+}
+
 // See: issue 11 item 12 — I/O errors dropped the OS reason.
 #[test]
 fn an_unwritable_out_names_the_os_reason() {
