@@ -127,8 +127,13 @@ pub enum InputProblem {
     #[error("is a folder, not a file")]
     Folder,
     /// A FIFO, socket or device (never opened: reading one could block or never end).
-    #[error("is a {0}, not a regular file: only regular files are read")]
-    NotRegular(&'static str),
+    #[error("is a {}{kind}, not a regular file: only regular files are read", if *via_link { "symbolic link to a " } else { "" })]
+    NotRegular {
+        /// What it is.
+        kind: &'static str,
+        /// Reached through a symbolic link.
+        via_link: bool,
+    },
     /// Larger than [`MAX_BVH_BYTES`].
     #[error("{bytes} bytes is more than the limit of {MAX_BVH_BYTES} bytes (MAX_BVH_BYTES)")]
     TooLarge {
@@ -214,7 +219,10 @@ fn check_meta(path: &Path, meta: &std::fs::Metadata) -> std::result::Result<u64,
         });
     }
     if !meta.is_file() {
-        return Err(InputProblem::NotRegular(file_kind(&meta.file_type())));
+        return Err(InputProblem::NotRegular {
+            kind: file_kind(&meta.file_type()),
+            via_link: std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()),
+        });
     }
     if meta.len() > MAX_BVH_BYTES {
         return Err(InputProblem::TooLarge { bytes: meta.len() });
