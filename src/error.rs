@@ -8,9 +8,10 @@ use std::path::PathBuf;
 /// Result alias used across the library.
 pub type Result<T> = std::result::Result<T, Error>;
 
-/// A library error: what went wrong and where.
+/// A library error: what went wrong and where. Display and `source()` are those of the
+/// kind, so the cause of an I/O error (the OS reason) stays in the chain that `{:#}` prints.
 #[derive(Debug, thiserror::Error)]
-#[error("{kind}")]
+#[error(transparent)]
 pub struct Error {
     /// What went wrong, with its location.
     pub kind: ErrorKind,
@@ -166,5 +167,20 @@ impl Error {
 impl From<ErrorKind> for Error {
     fn from(kind: ErrorKind) -> Self {
         Error { kind }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_io_error_keeps_the_os_reason_in_its_chain() {
+        let os = std::io::Error::from_raw_os_error(2);
+        let reason = os.to_string();
+        let e = Error::io("/x/lib", "cannot create folder", os);
+        assert_eq!(e.to_string(), "/x/lib: cannot create folder");
+        let chain = format!("{:#}", anyhow::Error::new(e));
+        assert!(chain.ends_with(&reason), "{chain}");
     }
 }

@@ -7,11 +7,11 @@ use std::process::Command;
 use stancelib::library::read::read_parquet;
 use stancelib::library::schema::{CLIPS_COLUMNS, CONTACTS_COLUMNS};
 
-fn root() -> &'static Path {
+pub(super) fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn stancelib(args: &[&str]) -> (i32, String, String) {
+pub(super) fn stancelib(args: &[&str]) -> (i32, String, String) {
     let o = Command::new(env!("CARGO_BIN_EXE_stancelib"))
         .args(args)
         .output()
@@ -23,12 +23,12 @@ fn stancelib(args: &[&str]) -> (i32, String, String) {
     )
 }
 
-fn fixture(name: &str) -> String {
+pub(super) fn fixture(name: &str) -> String {
     root().join("fixtures/bvh").join(name).display().to_string()
 }
 
 /// The five generated clips (not the `bad/` folder below them).
-fn good_fixtures() -> Vec<String> {
+pub(super) fn good_fixtures() -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(root().join("fixtures/bvh"))
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -48,12 +48,12 @@ fn frames_on_fixtures(extra: &[&str]) -> (i32, String, String) {
     stancelib(&args)
 }
 
-fn tmp() -> tempfile::TempDir {
+pub(super) fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
 
 /// A string column as owned strings.
-fn strings(df: &polars::prelude::DataFrame, col: &str) -> Vec<String> {
+pub(super) fn strings(df: &polars::prelude::DataFrame, col: &str) -> Vec<String> {
     df.column(col)
         .unwrap()
         .str()

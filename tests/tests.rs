@@ -6,6 +6,8 @@
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
 //! - `regression`: one test per review finding, named after it.
+//! - `safety_outputs`: issue 11 — `--out` never destroys what the tool did not write; input
+//!   links, cycles and special files; per-input errors; stale temporaries; the build lock.
 //! - `stances`: stances of real clips: flights on both sides, impulse–momentum, walks, running forces.
 //! - `util`: shared helpers (paths to `../shared`, skip messages, temp dirs, running the binary).
 //! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
@@ -30,6 +32,7 @@ mod queries;
 mod readers;
 mod real_data;
 mod regression;
+mod safety_outputs;
 mod stances;
 mod stances_truth;
 mod twopac;

@@ -318,12 +318,17 @@ pub struct BuildArgs {
     /// BVH files or folders (searched recursively for *.bvh).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
-    /// Library folder (replaced atomically).
+    /// Library folder (replaced atomically; an existing folder only when it is a library
+    /// or empty, never one that holds or lies in an input).
     #[arg(long)]
     pub out: PathBuf,
     /// Reuse the rows of clips whose path, content and options are unchanged.
     #[arg(long)]
     pub incremental: bool,
+    /// Replace an existing `--out` folder that is not a stancelib library, and everything
+    /// in it (never a file, nor a folder that holds or lies in an input).
+    #[arg(long)]
+    pub force: bool,
     /// Body and contact options.
     #[command(flatten)]
     pub body: BodyArgs,
@@ -337,6 +342,10 @@ pub struct RunArgs {
     /// Reuse the rows of clips whose path, content and options are unchanged.
     #[arg(long)]
     pub incremental: bool,
+    /// Replace the pipeline's `out` folder when it is not a stancelib library (as
+    /// `build --force`).
+    #[arg(long)]
+    pub force: bool,
     /// Body and contact options (override the pipeline file).
     #[command(flatten)]
     pub body: BodyArgs,

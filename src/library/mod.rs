@@ -10,6 +10,7 @@ pub mod kinematics;
 pub mod queries;
 pub mod read;
 pub mod schema;
+pub mod scratch;
 pub mod stances;
 pub mod twopac;
 pub mod write;
@@ -51,7 +52,7 @@ pub struct ClipRecord {
     pub status: Status,
     /// Skip reason or error message.
     pub message: Option<String>,
-    /// Where an `error` happened: `parse`, `mapping` or `frames` (`errors.parquet`).
+    /// Where an `error` happened: `input`, `parse`, `mapping` or `frames` (`errors.parquet`).
     pub error_stage: Option<&'static str>,
     /// Body mass used, kg.
     pub mass_kg: f64,

@@ -27,6 +27,11 @@ pub const ERRORS_FILE: &str = "errors.parquet";
 pub const KINEMATICS_FILE: &str = "kinematics.parquet";
 /// Points behind the kinematic polytopes (two-pac §3).
 pub const KINEMATICS_POINTS_FILE: &str = "kinematics_points.parquet";
+/// Provenance of a library (JSON).
+pub const MANIFEST_FILE: &str = "manifest.json";
+/// Start of the manifest's `schema` value, `stancelib.library/<SCHEMA_VERSION>`: what makes
+/// a folder a stancelib library, which `build` may replace.
+pub const MANIFEST_SCHEMA_PREFIX: &str = "stancelib.library/";
 
 /// Columns of `clips.parquet`, in order.
 pub const CLIPS_COLUMNS: [&str; 24] = [

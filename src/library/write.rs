@@ -11,6 +11,7 @@ use polars::prelude::*;
 use super::columns::col;
 
 use super::schema::*;
+use super::scratch::{remove_stale, scratch_name, Scratch};
 use super::ClipRecord;
 use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
@@ -335,7 +336,7 @@ pub fn write_atomic(
     kv: &[(String, String)],
 ) -> Result<()> {
     let path = dir.join(name);
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let tmp = dir.join(scratch_name(name, Scratch::Tmp));
     let result = (|| {
         let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, "cannot create", e))?;
         ParquetWriter::new(file)
@@ -373,12 +374,19 @@ fn with_portable_schema(df: &DataFrame, kv: &[(String, String)]) -> Vec<(String,
     out
 }
 
-/// Build and write every table of a `frames` run into `dir`.
+/// The tables a `frames` run writes.
+const FRAMES_RUN_FILES: [&str; 4] = [FRAMES_FILE, CLIPS_FILE, CONTACTS_FILE, JOINTS_FILE];
+
+/// Build and write every table of a `frames` run into `dir`: each table replaces only the
+/// file of its own name; nothing else in `dir` is touched, except the temporary tables
+/// (`.<table>.tmp-<pid>`) of killed runs, which are removed.
 ///
 /// # Errors
-/// As [`write_atomic`]; a table that cannot be built names its file.
+/// `dir` is not a folder and cannot be made one; as [`write_atomic`]; a table that cannot
+/// be built names its file.
 pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create output folder", e))?;
+    remove_stale(dir, &FRAMES_RUN_FILES, Scratch::Tmp);
     let mut tables = vec![
         (
             FRAMES_FILE,

@@ -9,61 +9,25 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
+use super::inputs::open_input;
+pub use super::inputs::{check_input, discover, none_readable, InputProblem, MAX_BVH_BYTES};
 use super::names::clip_names;
-use crate::error::{Error, ErrorKind, Result};
+use crate::error::{Error, ErrorKind};
 use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions};
 use crate::library::{ClipRecord, Status};
 
-/// Expand files and folders (recursively, `*.bvh` case-insensitive) into a sorted,
-/// de-duplicated list of files.
-///
-/// # Errors
-/// An input that does not exist.
-pub fn discover(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    let mut out = Vec::new();
-    for p in inputs {
-        if p.is_dir() {
-            walk(p, &mut out)?;
-        } else if p.is_file() {
-            out.push(p.clone());
-        } else {
-            return Err(Error::config(
-                Some(p.clone()),
-                None,
-                "no such file or folder",
-            ));
-        }
-    }
-    out.sort();
-    out.dedup();
-    Ok(out)
-}
-
-fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
-    let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, "cannot list folder", e))?;
-    for entry in rd {
-        let p = entry
-            .map_err(|e| Error::io(dir, "cannot list folder", e))?
-            .path();
-        if p.is_dir() {
-            walk(&p, out)?;
-        } else if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) {
-            out.push(p);
-        }
-    }
-    Ok(())
-}
-
-/// A reader that hashes what passes through it (one pass over a large file).
+/// A reader that hashes and counts what passes through it (one pass over a large file).
 struct HashingReader<R> {
     inner: R,
     hasher: Sha256,
+    bytes: u64,
 }
 
 impl<R: Read> Read for HashingReader<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
         self.hasher.update(&buf[..n]);
+        self.bytes += n as u64;
         Ok(n)
     }
 }
@@ -86,21 +50,22 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
         frames: None,
         contacts: Vec::new(),
     };
-    let file = match std::fs::File::open(path) {
+    let file = match open_input(path) {
         Ok(f) => f,
-        Err(e) => {
-            rec.message = Some(format!("{}: cannot open: {e}", path.display()));
-            rec.error_stage = Some("parse");
-            return rec;
-        }
+        Err(p) => return input_error(rec, path, &p),
     };
+    // One byte past the limit shows a file that grew after it was checked.
     let mut rdr = HashingReader {
-        inner: file,
+        inner: file.take(MAX_BVH_BYTES + 1),
         hasher: Sha256::new(),
+        bytes: 0,
     };
     let parsed = crate::bvh::parse_reader(&mut rdr).map_err(|e| e.with_path(path));
     // Hash the rest of a file whose parse stopped early, so the hash is of the whole file.
     let _ = std::io::copy(&mut rdr, &mut std::io::sink());
+    if rdr.bytes > MAX_BVH_BYTES {
+        return input_error(rec, path, &InputProblem::TooLarge { bytes: rdr.bytes });
+    }
     rec.content_sha256 = hex(&rdr.hasher.finalize());
     let outcome = match parsed {
         Err(e) => Err(("parse", e)),
@@ -137,6 +102,16 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
     rec
 }
 
+/// `rec` as an error of the `input` stage: the path could not be read as a BVH file.
+fn input_error(mut rec: ClipRecord, path: &Path, problem: &InputProblem) -> ClipRecord {
+    rec.message = Some(format!("{}: {problem}", path.display()));
+    rec.error_stage = Some(INPUT_STAGE);
+    rec
+}
+
+/// `stage` of an input that could not be read at all (`errors.parquet`).
+pub const INPUT_STAGE: &str = "input";
+
 /// A progress bar for `len` items, drawn on a terminal (stderr) and hidden otherwise.
 pub fn progress(len: usize, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);
@@ -171,10 +146,11 @@ pub fn ingest_named(files: &[(PathBuf, String)], opts: &IngestOptions) -> Vec<Cl
     recs
 }
 
-/// SHA-256 of a file's bytes, hex (`None` when unreadable).
+/// SHA-256 of an input's bytes, hex (`None` when it is not a readable regular file of at
+/// most [`MAX_BVH_BYTES`]).
 pub fn file_sha256(path: &Path) -> Option<String> {
-    let mut f = std::fs::File::open(path).ok()?;
+    let f = open_input(path).ok()?;
     let mut h = Sha256::new();
-    std::io::copy(&mut f, &mut h).ok()?;
-    Some(hex(&h.finalize()))
+    let n = std::io::copy(&mut f.take(MAX_BVH_BYTES + 1), &mut h).ok()?;
+    (n <= MAX_BVH_BYTES).then(|| hex(&h.finalize()))
 }

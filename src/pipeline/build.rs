@@ -19,14 +19,16 @@ use rayon::prelude::*;
 
 use super::batch::{file_sha256, ingest_named, progress};
 use super::names::clip_names;
+use super::output::{claim, name_of, parent_of, swap_into_place, OutputRules};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
 use crate::library::kinematics::kinematics_tables;
 use crate::library::read::read_parquet;
 use crate::library::schema::{
     CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, KINEMATICS_FILE, KINEMATICS_POINTS_FILE,
-    SCHEMA_VERSION, STANCES_FILE,
+    MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
 };
+use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, write_atomic};
 use crate::library::{ClipRecord, Status};
@@ -191,7 +193,7 @@ fn floats(df: &DataFrame, col: &str) -> Vec<Option<f64>> {
 
 /// Clips of the previous library at `out` that can be reused for `named`.
 fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTreeSet<String> {
-    let manifest: Option<serde_json::Value> = std::fs::read_to_string(out.join("manifest.json"))
+    let manifest: Option<serde_json::Value> = std::fs::read_to_string(out.join(MANIFEST_FILE))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
     let current: Option<serde_json::Value> = serde_json::from_str(fingerprint).ok();
@@ -309,17 +311,36 @@ fn limits_of(t: &Tables) -> BTreeMap<String, Limits> {
     limits(&facts, &clips)
 }
 
-/// Build the library for `files` into `out` (see the module docs); returns what was
-/// rebuilt in memory and the number of reused clips.
+/// Build the library for `files` into `out` (see the module docs) under the default
+/// [`OutputRules`] (no `--force`; `files` are the inputs); returns what was rebuilt in
+/// memory and the number of reused clips.
 ///
 /// # Errors
-/// A table that cannot be built or written, or a folder that cannot be renamed.
+/// As [`build_into`].
 pub fn build_and_write(
     files: &[PathBuf],
     out: &Path,
     opts: &BuildOptions,
     incremental: bool,
 ) -> Result<(BuildReport, usize)> {
+    build_into(files, out, opts, incremental, &OutputRules::default())
+}
+
+/// Build the library for `files` into `out` under `rules` (the output policy of
+/// [`super::output`]: `out` is checked and locked before any work); returns what was
+/// rebuilt in memory and the number of reused clips.
+///
+/// # Errors
+/// An `out` the output policy refuses or another build holds, a table that cannot be
+/// built or written, or a folder that cannot be renamed.
+pub fn build_into(
+    files: &[PathBuf],
+    out: &Path,
+    opts: &BuildOptions,
+    incremental: bool,
+    rules: &OutputRules,
+) -> Result<(BuildReport, usize)> {
+    let _claim = claim(out, files, rules)?;
     let t0 = Instant::now();
     let named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
     let fingerprint = opts.fingerprint();
@@ -346,11 +367,18 @@ pub fn build_and_write(
     Ok((report, reuse.len()))
 }
 
-/// Write an in-memory build as the library at `out` (a full build; see [`build_and_write`]).
+/// Write an in-memory build as the library at `out` (a full build; see [`build_and_write`]),
+/// under the default [`OutputRules`] with the report's paths as the inputs.
 ///
 /// # Errors
-/// A table that cannot be built or written, or a folder that cannot be renamed.
+/// As [`build_into`].
 pub fn write_library(out: &Path, report: &BuildReport, opts: &BuildOptions) -> Result<()> {
+    let files: Vec<PathBuf> = report
+        .records
+        .iter()
+        .map(|r| PathBuf::from(&r.path))
+        .collect();
+    let _claim = claim(out, &files, &OutputRules::default())?;
     let mut tables = Tables::from_report(report)?;
     let lim = limits_of(&tables);
     replace_library(out, &mut tables, &lim, &opts.fingerprint(), Instant::now())
@@ -363,16 +391,8 @@ fn replace_library(
     fingerprint: &str,
     t0: Instant,
 ) -> Result<()> {
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, "cannot create folder", e))?;
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "library".into());
-    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+    // The parent exists (the claim made it); a folder of this name is a dead process's.
+    let tmp = parent_of(out).join(scratch_name(&name_of(out)?, Scratch::Tmp));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(|e| Error::io(&tmp, "cannot create folder", e))?;
     let result =
@@ -417,6 +437,7 @@ fn write_tables(
     write_atomic(dir, KINEMATICS_FILE, &mut facets, &kv)?;
     write_atomic(dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
     let manifest = serde_json::json!({
+        "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
         "schema_version": SCHEMA_VERSION,
         "tool_version": env!("CARGO_PKG_VERSION"),
         "options": serde_json::from_str::<serde_json::Value>(fingerprint).unwrap_or_default(),
@@ -430,68 +451,8 @@ fn write_tables(
         "wall_time_s": t0.elapsed().as_secs_f64(),
     });
     let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
-    std::fs::write(dir.join("manifest.json"), text)
-        .map_err(|err| Error::io(dir.join("manifest.json"), "cannot write", err))
-}
-
-/// Put `tmp` in the place of `out`. On Linux the two folders are exchanged in one step
-/// (`renameat2` with `RENAME_EXCHANGE`), so `out` always names a complete library; the old
-/// one, now at `tmp`, is then removed. Elsewhere (or on a file system without the flag) the
-/// old library is renamed aside first: a run killed between the two renames leaves it
-/// intact at `.<name>.old-<pid>` beside `out`.
-fn swap_into_place(tmp: &Path, out: &Path) -> Result<()> {
-    if !out.exists() {
-        return std::fs::rename(tmp, out)
-            .map_err(|e| Error::io(out, "cannot move the new library into place", e));
-    }
-    if exchange(tmp, out) {
-        let _ = std::fs::remove_dir_all(tmp);
-        return Ok(());
-    }
-    let old = out.with_file_name(format!(
-        ".{}.old-{}",
-        out.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        std::process::id()
-    ));
-    std::fs::rename(out, &old)
-        .map_err(|e| Error::io(out, "cannot move the previous library aside", e))?;
-    std::fs::rename(tmp, out)
-        .map_err(|e| Error::io(out, "cannot move the new library into place", e))?;
-    let _ = std::fs::remove_dir_all(&old);
-    Ok(())
-}
-
-/// Atomically exchange two paths (Linux `renameat2(RENAME_EXCHANGE)`); false when the
-/// system or file system cannot.
-#[cfg(target_os = "linux")]
-fn exchange(a: &Path, b: &Path) -> bool {
-    use std::ffi::CString;
-    use std::os::unix::ffi::OsStrExt;
-    let (Ok(ca), Ok(cb)) = (
-        CString::new(a.as_os_str().as_bytes()),
-        CString::new(b.as_os_str().as_bytes()),
-    ) else {
-        return false;
-    };
-    // SAFETY: both arguments are valid NUL-terminated paths that outlive the call;
-    // renameat2 reads them and touches no other memory.
-    let rc = unsafe {
-        libc::renameat2(
-            libc::AT_FDCWD,
-            ca.as_ptr(),
-            libc::AT_FDCWD,
-            cb.as_ptr(),
-            libc::RENAME_EXCHANGE,
-        )
-    };
-    rc == 0
-}
-
-#[cfg(not(target_os = "linux"))]
-fn exchange(_: &Path, _: &Path) -> bool {
-    false
+    std::fs::write(dir.join(MANIFEST_FILE), text)
+        .map_err(|err| Error::io(dir.join(MANIFEST_FILE), "cannot write", err))
 }
 
 mod erased {

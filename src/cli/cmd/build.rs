@@ -7,7 +7,8 @@ use anyhow::Context;
 use super::super::args::BuildArgs;
 use super::super::Outcome;
 use crate::pipeline::batch::discover;
-use crate::pipeline::build::{build_and_write, BuildOptions};
+use crate::pipeline::build::{build_into, BuildOptions};
+use crate::pipeline::output::OutputRules;
 use crate::pipeline::spec::{load_body, resolve, resolve_fit};
 
 /// Run `build`.
@@ -21,28 +22,35 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
         ingest: resolve(body.as_ref(), None, &cli),
         stances: resolve_fit(None, a.body.force_model),
     };
+    let rules = OutputRules {
+        inputs: a.inputs.clone(),
+        force: a.force,
+    };
     execute(
         &discover(&a.inputs)?,
         &a.out,
         &opts,
         a.body.threads,
         a.incremental,
+        &rules,
     )
 }
 
-/// Build `files` into the library folder `out`.
+/// Build `files` into the library folder `out` under the output `rules`.
 ///
 /// # Errors
-/// No inputs, a thread pool that cannot start, or an unwritable library folder.
+/// No readable inputs, a thread pool that cannot start, an `out` the output policy
+/// refuses or another build holds, or an unwritable library folder.
 pub fn execute(
     files: &[PathBuf],
     out: &Path,
     opts: &BuildOptions,
     threads: usize,
     incremental: bool,
+    rules: &OutputRules,
 ) -> anyhow::Result<Outcome> {
     let (report, reused) = super::frames::worker_pool(files, threads)?
-        .install(|| build_and_write(files, out, opts, incremental))
+        .install(|| build_into(files, out, opts, incremental, rules))
         .with_context(|| format!("writing the library to {}", out.display()))?;
     let outcome = super::frames::report(&report.records, out);
     println!(

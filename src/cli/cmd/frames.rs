@@ -8,7 +8,7 @@ use super::super::args::FramesArgs;
 use super::super::Outcome;
 use crate::ingest::IngestOptions;
 use crate::library::{write::write_all, ClipRecord, Status};
-use crate::pipeline::batch::{discover, ingest_all};
+use crate::pipeline::batch::{discover, ingest_all, none_readable};
 use crate::pipeline::spec::{load_body, resolve};
 
 /// Run `frames`.
@@ -42,10 +42,14 @@ pub fn execute(
 /// Check there is work, then start the rayon pool with `threads` workers (0 = all cores).
 ///
 /// # Errors
-/// No input files, or a pool that cannot start.
+/// No input files, none that can be read (nothing is written then), or a pool that cannot
+/// start.
 pub fn worker_pool(files: &[PathBuf], threads: usize) -> anyhow::Result<rayon::ThreadPool> {
     if files.is_empty() {
         anyhow::bail!("no .bvh files found in the inputs");
+    }
+    if let Some(why) = none_readable(files) {
+        anyhow::bail!("no input can be read (nothing was written):\n{why}");
     }
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

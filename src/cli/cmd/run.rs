@@ -25,7 +25,8 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
         .or_else(|| pipe.body.as_deref().map(|b| relative_to(&a.pipeline, b)));
     let body = body_path.as_deref().map(load_body).transpose()?;
     let opts = resolve(body.as_ref(), Some(&pipe), &cli);
-    let files = crate::pipeline::batch::discover(&expand_inputs(&a.pipeline, &pipe)?)?;
+    let inputs = expand_inputs(&a.pipeline, &pipe)?;
+    let files = crate::pipeline::batch::discover(&inputs)?;
     let threads = if a.body.threads > 0 {
         a.body.threads
     } else {
@@ -36,7 +37,11 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
         stances: crate::pipeline::spec::resolve_fit(Some(&pipe), a.body.force_model),
     };
     let lib = relative_to(&a.pipeline, &pipe.out);
-    let outcome = super::build::execute(&files, &lib, &opts, threads, a.incremental)?;
+    let rules = crate::pipeline::output::OutputRules {
+        inputs,
+        force: a.force,
+    };
+    let outcome = super::build::execute(&files, &lib, &opts, threads, a.incremental, &rules)?;
     if let Some(q) = &pipe.queries {
         run_queries(q, pipe.constraints.as_ref(), &lib)
             .with_context(|| format!("{}: [queries]", a.pipeline.display()))?;
