@@ -181,6 +181,12 @@ fn no_contact_interval_of_a_real_clip_is_non_ballistic() {
     // about 2× too fast, the fast run 15–25 % too fast): their flights are not ballistic
     // at the file's clock, whatever the contacts.
     let time_scaled = ["mass_backflip.bvh", "mass_run_fast.bvh"];
+    // The one interval the speed-led rule cannot resolve (measured; see the report of
+    // issue 12): CMU 01_13, a playground clip, drops from a bar at frames 1348-1367 while
+    // the hands still move at 1.6-3.4 m/s and the feet at 2.4-3.1 m/s: the COM curves at
+    // -6 m/s² over 0.16 s, so something still holds it, but nothing is slow. It must be
+    // reported in the clip's warnings.
+    let unresolved = [("bvh-bulk/cmu/01_13.bvh", 1348, 1367)];
     let mut files = bvh_files(&data.join("bvh"));
     files.extend(bvh_files(&data.join("bvh-bulk/cmu")));
     assert!(files.len() > 100, "only {} clips found", files.len());
@@ -200,10 +206,35 @@ fn no_contact_interval_of_a_real_clip_is_non_ballistic() {
             continue;
         };
         clips += 1;
+        let known = |f: &&stancelib::contacts::flight::Flight| {
+            unresolved
+                .iter()
+                .any(|(c, a, b)| name.ends_with(c) && f.first_frame == *a && f.last_frame == *b)
+        };
+        for f in summary.flights.iter().filter(known) {
+            let reported = summary.warnings.iter().any(|w| {
+                w.starts_with("missed support")
+                    && w.contains(&format!("{}-{}", f.first_frame, f.last_frame))
+                    && w.contains("no support found")
+            });
+            outln!(
+                out,
+                "{name}: known unresolved interval {}-{} (a_z {:+.2}), reported: {reported}",
+                f.first_frame,
+                f.last_frame,
+                f.a_z_all.unwrap_or(f64::NAN)
+            );
+            if !reported {
+                failures.push(format!(
+                    "{name}: unresolved interval {}-{} not in warnings",
+                    f.first_frame, f.last_frame
+                ));
+            }
+        }
         let bad: Vec<String> = summary
             .flights
             .iter()
-            .filter(|f| stancelib::contacts::support::is_missed_support(f))
+            .filter(|f| stancelib::contacts::support::is_missed_support(f) && !known(f))
             .map(|f| {
                 format!(
                     "{}-{} ({:.2} s, a_z {:+.2})",

@@ -420,14 +420,16 @@ pub(super) fn run(
                     changed = true;
                 }
             }
-            summary.warnings.push(format!(
-                "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; speed-led contacts: {}",
-                f.first_frame,
-                f.last_frame,
-                f.duration_s,
-                f.a_z_all.unwrap_or(f64::NAN),
-                if found.is_empty() { "none found".to_string() } else { found.join(", ") }
-            ));
+            if !found.is_empty() {
+                summary.warnings.push(format!(
+                    "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; speed-led contacts: {}",
+                    f.first_frame,
+                    f.last_frame,
+                    f.events_duration_s.unwrap_or(f.duration_s),
+                    f.a_z_all.unwrap_or(f64::NAN),
+                    found.join(", ")
+                ));
+            }
         }
         if changed {
             for flags in contact.iter_mut() {
@@ -437,6 +439,17 @@ pub(super) fn run(
         }
     }
     summary.flights = flights_of(&contact, &runs_out);
+    if c.support_check {
+        for f in summary.flights.iter().filter(|f| is_missed_support(f)) {
+            summary.warnings.push(format!(
+                "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; no support found (no foot or hand slow enough)",
+                f.first_frame,
+                f.last_frame,
+                f.events_duration_s.unwrap_or(f.duration_s),
+                f.a_z_all.unwrap_or(f64::NAN),
+            ));
+        }
+    }
     let (s_eff, az) = clip_summary(&summary.flights);
     summary.s_eff = s_eff;
     summary.flight_az_median = az;
