@@ -129,11 +129,11 @@ mod tests {
         );
         assert_eq!(f.iter().position(|&x| x), Some(10));
         assert_eq!(f.iter().rposition(|&x| x), Some(29));
-        // 11 slow frames at 120 Hz (0.092 s) are shorter than the 0.1 s minimum.
+        // 5 slow frames at 120 Hz (0.042 s) are shorter than the 0.05 s minimum.
         let short = PointTrack {
             h: vec![0.05; n],
             v: (0..n)
-                .map(|k| if (10..21).contains(&k) { 0.05 } else { 3.0 })
+                .map(|k| if (10..15).contains(&k) { 0.05 } else { 3.0 })
                 .collect(),
         };
         let g = speed_led(

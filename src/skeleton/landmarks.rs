@@ -426,16 +426,17 @@ impl Finder<'_> {
         let Some(cerv) = self.overridden("CERV")?.or(default) else {
             return Ok(None);
         };
+        // A [landmarks] CERV may name an End Site, which has no children.
         let mut top = cerv;
-        while let Some(c) = (cerv < self.skel.n_joints())
-            .then(|| {
-                self.skel
-                    .children(top)
-                    .find(|&c| unsided(c, &|k| k.contains("neck")))
-            })
-            .flatten()
-        {
-            top = c;
+        while top < self.skel.n_joints() {
+            match self
+                .skel
+                .children(top)
+                .find(|&c| unsided(c, &|k| k.contains("neck")))
+            {
+                Some(c) => top = c,
+                None => break,
+            }
         }
         Ok(Some((cerv, top)))
     }
