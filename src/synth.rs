@@ -28,7 +28,8 @@
 //! ```
 //!
 //! Planted feet are flat (ankle 0.08 m above the floor, toe tip on it) at a footprint
-//! half-way between the hip at touchdown and at liftoff. A swing foot stays flat and moves
+//! half-way between the hip at touchdown and at liftoff; `platform_m` lifts the right
+//! foot's first running stance onto a step that high. A swing foot stays flat and moves
 //! from footprint P₀ to P₁ in time T as `P₀ + (P₁ − P₀)(u − (1 − r) sin(2πu)/(2π)) +
 //! v_z s (1 − u) e_z` (`u = s/T`), leaving and arriving at 3 m/s (run: 2.2 m/s of it
 //! horizontal), so the contact detector's 2 m/s gate separates it from the floor. The
@@ -81,6 +82,8 @@ pub const MAX_FRAME_RATE_HZ: f64 = 1000.0;
 pub const MAX_DURATION_S: f64 = 60.0;
 /// Gravity of the force model, m/s².
 pub const GRAVITY_MPS2: f64 = 9.81;
+/// Highest platform under the right foot's first running stance, m.
+pub const MAX_PLATFORM_M: f64 = 0.3;
 
 const G: f64 = GRAVITY_MPS2;
 const RUN_SPEED: f64 = 3.5; // m/s, mean forward speed
@@ -144,6 +147,11 @@ pub struct SynthOptions {
     pub up: SynthUp,
     /// Seed of the upper-body wobble (default [`DEFAULT_SEED`]).
     pub seed: u64,
+    /// Run only: the right foot's first stance that starts after frame 0 is planted this
+    /// high above the floor, as on a step or platform, m (default 0: every footprint on the floor; clamped to
+    /// `0..=`[`MAX_PLATFORM_M`]). The COM and the truth are unchanged: the leg reaches down
+    /// that much less.
+    pub platform_m: f64,
 }
 
 impl Default for SynthOptions {
@@ -155,6 +163,7 @@ impl Default for SynthOptions {
             unit_m: DEFAULT_UNIT_M,
             up: SynthUp::Y,
             seed: DEFAULT_SEED,
+            platform_m: 0.0,
         }
     }
 }
@@ -443,7 +452,8 @@ fn jump_timeline(dt: f64, n: i64) -> Timeline {
 
 /// Puts every footprint half-way between its hip at touchdown and at liftoff (open-ended
 /// stances: under the hip at frame 0), re-solving those frames `FOOT_PASSES − 1` times.
-fn place_footprints(tl: &mut Timeline, wob: &Wobble, o_ref: V3) {
+fn place_footprints(tl: &mut Timeline, wob: &Wobble, o_ref: V3, platform: f64) {
+    let raised = tl.stances[1].iter().position(|s| s.k_a > 0);
     for pass in 0..FOOT_PASSES {
         for (side, lateral) in [(0, HIP_Y), (1, -HIP_Y)] {
             for i in 0..tl.stances[side].len() {
@@ -460,7 +470,12 @@ fn place_footprints(tl: &mut Timeline, wob: &Wobble, o_ref: V3) {
                     root + local[HIPS] * hip
                 });
                 let mid = (hips[0] + hips[1]) * 0.5;
-                tl.stances[side][i].ankle = V3::new(mid.x, mid.y, ANKLE_Z);
+                let raise = if side == 1 && Some(i) == raised && !open {
+                    platform
+                } else {
+                    0.0
+                };
+                tl.stances[side][i].ankle = V3::new(mid.x, mid.y, ANKLE_Z + raise);
             }
         }
     }
@@ -694,7 +709,12 @@ fn build(opts: &SynthOptions) -> (SynthClip, [f64; 2]) {
     let (wob, (offs, ends)) = (Wobble::new(opts.seed), skeleton_offsets());
     let upper0 = upper_pose(&tl, &wob, 0);
     let o_ref = de_leva_com(&forward(&offs, &ends, V3::zeros(), &upper0));
-    place_footprints(&mut tl, &wob, o_ref);
+    let platform = if opts.motion == SynthMotion::Run && opts.platform_m.is_finite() {
+        opts.platform_m.clamp(0.0, MAX_PLATFORM_M)
+    } else {
+        0.0
+    };
+    place_footprints(&mut tl, &wob, o_ref, platform);
 
     let f = file_from_internal(opts.up);
     let mut clip = SynthClip::default();
@@ -767,6 +787,7 @@ mod tests {
                     unit_m,
                     up,
                     seed,
+                    platform_m: 0.0,
                 });
             }
         }

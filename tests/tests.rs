@@ -3,6 +3,8 @@
 //! - `bad_input`: malformed files name file and line; a 300 MB stream loads.
 //! - `bvh_oracle`: differential test of the BVH reader against the `bvh_anim` crate on every
 //!   shared clip it reads (f32 precision), and a write-and-reread round trip.
+//! - `contacts_physics`: sub-frame contact events against the plates, no non-ballistic
+//!   no-contact interval on real clips, a stance on a platform, a skeleton without a head.
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
 //! - `regression`: one test per review finding, named after it.
@@ -22,6 +24,7 @@
 mod bad_input;
 mod bvh_oracle;
 mod cli;
+mod contacts_physics;
 mod fixtures;
 mod forceplate;
 mod forceplate_stances;

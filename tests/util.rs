@@ -93,6 +93,7 @@ pub fn fixture_opts(c: &FixtureCase) -> SynthOptions {
         unit_m: c.unit_m,
         up: c.up,
         seed: 1,
+        platform_m: 0.0,
     }
 }
 

@@ -49,7 +49,7 @@ pub fn static_hysteresis(points: &[PointTrack]) -> (Vec<bool>, Vec<Option<usize>
     (flags, trig)
 }
 
-fn hysteresis_by(
+pub(super) fn hysteresis_by(
     points: &[PointTrack],
     enter: impl Fn(&PointTrack, usize) -> bool,
     leave: impl Fn(&PointTrack, usize) -> bool,

@@ -10,6 +10,10 @@
 //! ballistic ⇔ n·dt ≤ 1.0 s ∧ curvature ∈ [−2g, −g/2], curvature = a_z (n_int ≥ 4) or
 //!             ā_z = (v_z(b+1) − v_z(a−1)) / (t_{b+1} − t_{a−1})   (SG velocity)
 //! airborne ⇔ n·dt ≥ 0.1 s − 1 µs ∧ n·dt ≤ 1.0 s ∧ n_int ≥ 4
+//! a_z_all: curvature of the free parabola of z(t) over every frame inside the interval
+//!          (n ≥ 5): frames a … b, or, given the sub-frame liftoff before it and
+//!          touchdown after it (contacts::timing), the frames strictly between them; the
+//!          physics cross-check's measure (contacts::support)
 //! clip s_eff = median s_eff over airborne runs with a_z < 0; flight_az_median likewise of a_z
 //! ```
 //!
@@ -69,6 +73,16 @@ pub struct Flight {
     pub rms_m: Option<f64>,
     /// Effective time scale (free fit with a_z < 0).
     pub s_eff: Option<f64>,
+    /// Vertical curvature of a free parabola over every frame inside the run (at least 5;
+    /// between the sub-frame events when they are known, [`curvature_inside`]), m/s²: the
+    /// measure of the physics cross-check ([`crate::contacts::support`]). The interior
+    /// fit (`a_z`) leaves out two frames at each end; on a 0.1 s running flight that is 8
+    /// frames of 12 and ±3 m/s² of scatter.
+    pub a_z_all: Option<f64>,
+    /// Sub-frame duration `t_TD − t_LO` between the liftoff that opens the run and the
+    /// touchdown that closes it ([`crate::contacts::timing`]), s; `None` when either is
+    /// unknown.
+    pub events_duration_s: Option<f64>,
     /// Mean SG vertical acceleration across an untested run, m/s².
     pub a_z_mean: Option<f64>,
     /// Passes the ballistic test.
@@ -111,6 +125,8 @@ pub fn fit_run(
         a_y: None,
         rms_m: None,
         s_eff: None,
+        a_z_all: None,
+        events_duration_s: None,
         a_z_mean: None,
         ballistic: false,
         tested: n_int >= 4,
@@ -144,6 +160,7 @@ pub fn fit_run(
             f.fit = Some(ff);
         }
     }
+    f.a_z_all = curvature_inside(c, t, a, b, None);
     let curvature = if f.tested {
         f.a_z
     } else if a >= 1 && b + 1 < t.len() {
@@ -158,6 +175,29 @@ pub fn fit_run(
     f.airborne =
         (AIRBORNE_MIN_S - AIRBORNE_TOL_S..=T_FLIGHT_MAX_S).contains(&duration_s) && f.tested;
     f
+}
+
+/// Vertical curvature of the free parabola of the raw COM height over the frames of the
+/// no-contact run `a..=b`, m/s²; with `events = Some((t_lo, t_td))` (the sub-frame
+/// liftoff that opens it and touchdown that closes it) over the frames strictly between
+/// the two instead. `None` with fewer than 5 frames.
+pub fn curvature_inside(
+    c: &[[f64; 3]],
+    t: &[f64],
+    a: usize,
+    b: usize,
+    events: Option<(f64, f64)>,
+) -> Option<f64> {
+    let ks: Vec<usize> = match events {
+        None => (a..=b).collect(),
+        Some((lo, td)) => (0..t.len()).filter(|&k| t[k] > lo && t[k] < td).collect(),
+    };
+    if ks.len() < 5 {
+        return None;
+    }
+    let tk: Vec<f64> = ks.iter().map(|&k| t[k]).collect();
+    let zk: Vec<f64> = ks.iter().map(|&k| c[k][2]).collect();
+    fit(&tk, &zk, 2).map(|p| p.curvature())
 }
 
 /// Clip summary: (median s_eff, median a_z) over airborne runs with a_z < 0.

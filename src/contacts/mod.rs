@@ -8,6 +8,8 @@ pub mod detect;
 pub mod flight;
 pub mod floor;
 pub mod options;
+pub mod support;
+pub mod timing;
 
 pub use options::ContactOptions;
 

@@ -64,6 +64,9 @@ pub struct ContactOptions {
     pub min_gap_s: f64,
     /// Local floor half-window, s.
     pub floor_window_s: f64,
+    /// Physics cross-check: re-detect the support of a non-ballistic no-contact interval
+    /// with the speed-led rule ([`crate::contacts::support`]); on by default.
+    pub support_check: bool,
 }
 
 impl Default for ContactOptions {
@@ -86,6 +89,7 @@ impl Default for ContactOptions {
             min_on_s: DEFAULT_MIN_ON_S,
             min_gap_s: DEFAULT_MIN_GAP_S,
             floor_window_s: DEFAULT_FLOOR_WINDOW_S,
+            support_check: true,
         }
     }
 }

@@ -4,13 +4,18 @@
 //! # Model
 //! ```text
 //! run a..b:  t_TD = t[a] − dt/2 (null at the first kept frame), t_LO = t[b] + dt/2 (null at the last)
+//!            td_time, lo_time: feet, sub-frame times (contacts::timing); hands, t_TD and t_LO
 //! origin    = mean of the effector's contact points over the run
 //! yaw       = atan2 of the mean horizontal ankle→toe (wrist→MET3) direction; facing from the
 //!             hips when that is vertical
-//! surface_z = static run: median height of its triggering point; else median ground_z
+//! surface_z = static run: median height of its triggering point; speed-led run
+//!             (contacts::support): median ground_z + the lowest over its points of the
+//!             median height above the point's own floor (§7.1), the step it stands on;
+//!             else median ground_z
 //! ```
 
-use crate::contacts::{runs, EFFECTORS};
+use crate::contacts::detect::PointTrack;
+use crate::contacts::{runs, timing, EFFECTORS};
 use crate::math::stats::median;
 
 type V3 = [f64; 3];
@@ -28,6 +33,13 @@ pub struct ContactRun {
     pub t_td_s: Option<f64>,
     /// Liftoff time, s (null at a clip edge).
     pub t_lo_s: Option<f64>,
+    /// Sub-frame touchdown time, s (null at a clip edge; [`crate::contacts::timing`]).
+    pub td_time_s: Option<f64>,
+    /// Sub-frame liftoff time, s (null at a clip edge).
+    pub lo_time_s: Option<f64>,
+    /// Some frame of the run was found by the speed-led rule of the physics cross-check
+    /// ([`crate::contacts::support`]).
+    pub speed_led: bool,
     /// Static contact on some frame of the run.
     pub is_static: bool,
     /// Contact height, m.
@@ -40,9 +52,16 @@ pub struct ContactRun {
     pub normal: V3,
 }
 
+/// What the detector saw, per effector: its point tracks and the speed-led frames.
+pub(super) struct Detector<'a> {
+    pub tracks: &'a [Vec<PointTrack>; 4],
+    pub speed_led: &'a [Vec<bool>; 4],
+}
+
 /// Collect the runs of every effector (sorted by effector, then first frame).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn collect(
+    det: &Detector,
     contact: &[Vec<bool>; 4],
     stat: &[Vec<bool>; 4],
     surf: &[Vec<Option<f64>>; 4],
@@ -78,16 +97,44 @@ pub(super) fn collect(
                 dy = (a..=b).map(|f| facing[f][1]).sum();
             }
             let first_static = static_mode.then(|| (a..=b).find(|&f| stat[e][f])).flatten();
-            let surface_z = match first_static.and_then(|f| surf[e][f]) {
-                Some(z) => z,
-                None => median(&ground_z[a..=b]).unwrap_or(0.0),
+            let speed_led = det.speed_led[e][a..=b].iter().any(|&f| f);
+            let floor = median(&ground_z[a..=b]).unwrap_or(0.0);
+            let raised = || {
+                det.tracks[e]
+                    .iter()
+                    .filter_map(|p| median(&p.h[a..=b]))
+                    .reduce(f64::min)
             };
+            let surface_z = match (first_static.and_then(|f| surf[e][f]), speed_led) {
+                (Some(z), _) => z,
+                (None, true) => floor + raised().unwrap_or(0.0),
+                (None, false) => floor,
+            };
+            let tracks = &det.tracks[e];
+            let prev_end = out
+                .iter()
+                .rev()
+                .find(|r: &&ContactRun| r.effector == EFFECTORS[e])
+                .map_or(0, |r| (r.last_frame - frame[0] + 1) as usize);
+            let next_start = runs(&contact[e])
+                .into_iter()
+                .find(|&(x, _)| x > b)
+                .map_or(n - 1, |(x, _)| x - 1);
             out.push(ContactRun {
                 effector: EFFECTORS[e],
                 first_frame: frame[a],
                 last_frame: frame[b],
                 t_td_s: (a > 0).then(|| time_s[a] - dt / 2.0),
                 t_lo_s: (b + 1 < n).then(|| time_s[b] + dt / 2.0),
+                td_time_s: (a > 0).then(|| match e < 2 && !tracks.is_empty() {
+                    true => timing::touchdown(tracks, time_s, a, b, prev_end),
+                    false => time_s[a] - dt / 2.0,
+                }),
+                lo_time_s: (b + 1 < n).then(|| match e < 2 && !tracks.is_empty() {
+                    true => timing::liftoff(tracks, time_s, a, b, next_start),
+                    false => time_s[b] + dt / 2.0,
+                }),
+                speed_led,
                 is_static: first_static.is_some(),
                 surface_z,
                 origin,

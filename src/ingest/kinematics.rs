@@ -5,9 +5,10 @@ use super::contact_runs::{self, ContactRun};
 use super::{ClipFrames, ClipSummary, IngestOptions};
 use crate::bvh::Bvh;
 use crate::contacts::detect::{clean, hysteresis, static_hysteresis, PointTrack};
-use crate::contacts::flight::{clip_summary, fit_run};
+use crate::contacts::flight::{clip_summary, curvature_inside, fit_run, Flight};
 use crate::contacts::options::{STATIC_MIN_GAP_S, STATIC_MIN_ON_S};
-use crate::contacts::{floor, raw_speed, runs};
+use crate::contacts::support::{is_missed_support, speed_led, SpeedLedRule};
+use crate::contacts::{floor, raw_speed, runs, EFFECTORS};
 use crate::error::{Error, Result};
 use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
 use crate::math::stats::median;
@@ -206,6 +207,14 @@ pub(super) fn run(
             summary.toe_tip_rule[1].as_deref().unwrap_or("?")
         ));
     }
+    if lm.head_from_neck {
+        summary.warnings.push(format!(
+            "no head joint: head segment from the neck chain, {} towards {}, {:.4} × the leg length long (de Leva)",
+            skel.point_name(lm.cerv),
+            skel.point_name(lm.head),
+            crate::skeleton::landmarks::HEAD_PER_LEG_LENGTH
+        ));
+    }
     for (tag, limb) in [("left", &lm.left), ("right", &lm.right)] {
         if limb.arm.is_none() {
             summary
@@ -328,31 +337,123 @@ pub(super) fn run(
         contact[e] = flags;
     }
 
-    // Flights (§7.7).
-    let any: Vec<bool> = (0..n).map(|f| contact.iter().any(|c| c[f])).collect();
+    // Physics cross-check (contacts::support): a non-ballistic no-contact interval is a
+    // missed support, re-detected by the speed-led rule inside it.
     let vz: Vec<f64> = com_v.iter().map(|v| v[2]).collect();
-    let no_contact: Vec<bool> = any.iter().map(|a| !a).collect();
-    summary.flights = runs(&no_contact)
-        .into_iter()
-        .filter(|&(a, b)| a > 0 && b + 1 < n)
-        .map(|(a, b)| fit_run(&com_pos, &time_s, &vz, a, b, dt, skip as i64))
-        .collect();
+    let mut speed_led_flags: [Vec<bool>; 4] = std::array::from_fn(|_| vec![false; n]);
+    let collect_runs = |contact: &[Vec<bool>; 4], speed_led_flags: &[Vec<bool>; 4]| {
+        let det = contact_runs::Detector {
+            tracks: &tracks,
+            speed_led: speed_led_flags,
+        };
+        contact_runs::collect(
+            &det,
+            contact,
+            &stat,
+            &surf,
+            &points,
+            &ground_z,
+            &fwd,
+            &frame,
+            &time_s,
+            dt,
+            c.static_mode,
+        )
+    };
+    // Flights (§7.7) of the no-contact runs, with the cross-check's curvature between the
+    // sub-frame events that bound each run.
+    let flights_of = |contact: &[Vec<bool>; 4], runs_out: &[ContactRun]| -> Vec<Flight> {
+        let none: Vec<bool> = (0..n).map(|f| !contact.iter().any(|c| c[f])).collect();
+        runs(&none)
+            .into_iter()
+            .filter(|&(a, b)| a > 0 && b + 1 < n)
+            .map(|(a, b)| {
+                let mut f = fit_run(&com_pos, &time_s, &vz, a, b, dt, skip as i64);
+                let lo = runs_out
+                    .iter()
+                    .filter(|r| r.last_frame == frame[a - 1])
+                    .filter_map(|r| r.lo_time_s)
+                    .reduce(f64::max);
+                let td = runs_out
+                    .iter()
+                    .filter(|r| r.first_frame == frame[b + 1])
+                    .filter_map(|r| r.td_time_s)
+                    .reduce(f64::min);
+                if let (Some(lo), Some(td)) = (lo, td) {
+                    f.a_z_all =
+                        curvature_inside(&com_pos, &time_s, a, b, Some((lo, td))).or(f.a_z_all);
+                    f.events_duration_s = Some(td - lo);
+                }
+                f
+            })
+            .collect()
+    };
+    let mut runs_out = collect_runs(&contact, &speed_led_flags);
+    if c.support_check {
+        let rule = SpeedLedRule::default();
+        let mut changed = false;
+        for f in flights_of(&contact, &runs_out) {
+            if !is_missed_support(&f) {
+                continue;
+            }
+            let (a, b) = (
+                (f.first_frame - skip as i64) as usize,
+                (f.last_frame - skip as i64) as usize,
+            );
+            let mut found = Vec::new();
+            for e in 0..4 {
+                if tracks[e].is_empty() {
+                    continue;
+                }
+                let sl = speed_led(&tracks[e], a, b, &rule, rate, c.min_gap_s);
+                for (x, y) in runs(&sl) {
+                    contact[e][a + x..=a + y].iter_mut().for_each(|v| *v = true);
+                    speed_led_flags[e][a + x..=a + y]
+                        .iter_mut()
+                        .for_each(|v| *v = true);
+                    found.push(format!(
+                        "{} {}-{}",
+                        EFFECTORS[e],
+                        skip + a + x,
+                        skip + a + y
+                    ));
+                    changed = true;
+                }
+            }
+            if !found.is_empty() {
+                summary.warnings.push(format!(
+                    "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; speed-led contacts: {}",
+                    f.first_frame,
+                    f.last_frame,
+                    f.events_duration_s.unwrap_or(f.duration_s),
+                    f.a_z_all.unwrap_or(f64::NAN),
+                    found.join(", ")
+                ));
+            }
+        }
+        if changed {
+            for flags in contact.iter_mut() {
+                clean(flags, rate, c.min_gap_s, c.min_on_s);
+            }
+            runs_out = collect_runs(&contact, &speed_led_flags);
+        }
+    }
+    summary.flights = flights_of(&contact, &runs_out);
+    if c.support_check {
+        for f in summary.flights.iter().filter(|f| is_missed_support(f)) {
+            summary.warnings.push(format!(
+                "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; no support found (no foot or hand slow enough)",
+                f.first_frame,
+                f.last_frame,
+                f.events_duration_s.unwrap_or(f.duration_s),
+                f.a_z_all.unwrap_or(f64::NAN),
+            ));
+        }
+    }
     let (s_eff, az) = clip_summary(&summary.flights);
     summary.s_eff = s_eff;
     summary.flight_az_median = az;
 
-    let runs_out = contact_runs::collect(
-        &contact,
-        &stat,
-        &surf,
-        &points,
-        &ground_z,
-        &fwd,
-        &frame,
-        &time_s,
-        dt,
-        c.static_mode,
-    );
     let joints = opts
         .joints
         .then(|| ((0..np).map(|p| skel.point_name(p)).collect(), pts.clone()));

@@ -77,14 +77,17 @@ pub const FLIGHT_FIELDS: [&str; 11] = [
 ];
 
 /// Columns of `contacts.parquet`, in order.
-pub const CONTACTS_COLUMNS: [&str; 15] = [
+pub const CONTACTS_COLUMNS: [&str; 18] = [
     "clip",
     "effector",
     "first_frame",
     "last_frame",
     "t_td_s",
     "t_lo_s",
+    "td_time_s",
+    "lo_time_s",
     "static",
+    "speed_led",
     "surface_z",
     "origin_x",
     "origin_y",

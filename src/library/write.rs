@@ -279,8 +279,20 @@ pub fn contacts_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
             rows.iter().map(|r| r.1.t_lo_s).collect::<Vec<_>>(),
         ),
         col(
+            "td_time_s",
+            rows.iter().map(|r| r.1.td_time_s).collect::<Vec<_>>(),
+        ),
+        col(
+            "lo_time_s",
+            rows.iter().map(|r| r.1.lo_time_s).collect::<Vec<_>>(),
+        ),
+        col(
             "static",
             rows.iter().map(|r| r.1.is_static).collect::<Vec<_>>(),
+        ),
+        col(
+            "speed_led",
+            rows.iter().map(|r| r.1.speed_led).collect::<Vec<_>>(),
         ),
         col("surface_z", f(&|c| c.surface_z)),
         col("origin_x", f(&|c| c.origin[0])),

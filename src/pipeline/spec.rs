@@ -66,6 +66,7 @@ pub struct ContactsTable {
     pub min_on_s: Option<f64>,
     pub min_gap_s: Option<f64>,
     pub floor_window_s: Option<f64>,
+    pub support_check: Option<bool>,
 }
 
 /// `[fit]` of a pipeline file (stance-model stage; accepted and validated here).
@@ -388,6 +389,7 @@ fn apply_contacts(o: &mut ContactOptions, c: &ContactsTable) {
     set(&mut o.min_on_s, c.min_on_s);
     set(&mut o.min_gap_s, c.min_gap_s);
     set(&mut o.floor_window_s, c.floor_window_s);
+    o.support_check = c.support_check.unwrap_or(o.support_check);
 }
 
 /// Stance options from a pipeline's `[fit]` table and the command line (`--force-model`).

@@ -8,6 +8,9 @@
 //! MET3  child keyed handmiddle1/middle1 → child with "finger" → end(WJC) → WJC + 0.32·(WJC − EJC)
 //! head  unsided joint keyed "head";  CERV first root→head joint keyed neck*, else lowerneck, else parent(head)
 //! VERT  end(head) or child keyed headtop, else head + (head − CERV)
+//! no head joint: CERV = the neck joint nearest the root (keyed neck*, else lowerneck);
+//!       VERT = CERV + 0.2907·L_leg·û, û = unit(top of the neck chain − CERV)
+//!       (else unit(CERV − MIDH)); a warning, not an error
 //! parent(·) skips helper joints and zero-length OFFSETs; end(·) is a non-degenerate End Site
 //! (|OFFSET| ≥ 0.02·L_leg) or a child whose key ends in "end".
 //! ```
@@ -31,6 +34,16 @@ pub const DEGENERATE_END_SITE_FRACTION: f64 = 0.02;
 pub const IMPLAUSIBLE_END_SITE_FRACTION: f64 = 0.5;
 /// MET3 extrapolation beyond the wrist along the forearm (spec §4.2).
 pub const MET3_EXTRAPOLATION: f64 = 0.32;
+/// Head length (vertex to the cervicale, C7) per metre of leg (`L_leg`, hip to ankle), for
+/// a skeleton without a head joint. De Leva (1996) measured the head-and-neck segment from
+/// the top of the head to C7 as 242.9 mm on his male reference subject of 1741 mm stature
+/// (his trunk, C7 to the hip-joint midpoint, is 603.3 mm: the head is 0.40 of it); with the
+/// stature from the leg as in spec com-from-bvh §4.3 (`H = 1.75 m·L_leg/0.84 m`) the head is
+/// 0.1395·H = 0.2907·L_leg. The leg, not the trunk, sets the scale: skeletons put their
+/// neck joint at different heights (the CMU neck joint sits at the top of its two spine
+/// bones, so its "trunk" is half of de Leva's), while hip, knee and ankle centres are the
+/// same anatomical points in every convention. Dimensionless.
+pub const HEAD_PER_LEG_LENGTH: f64 = 242.9 / 1741.0 * 1.75 / 0.84;
 
 /// A landmark position rule: a point, or a point extrapolated beyond another.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,6 +59,19 @@ pub enum Landmark {
         /// Extrapolation factor.
         k: f64,
     },
+    /// A head top built from the neck chain (no head joint):
+    /// `cerv + HEAD_PER_LEG_LENGTH·L_leg·û`, `û` = unit(`top` − `cerv`), or
+    /// unit(`cerv` − `midh`) when `top` is `cerv` or coincides with it; `midh` is the
+    /// midpoint of the two hip joints and `L_leg` the mean of the two legs' hip–knee plus
+    /// knee–ankle lengths in the same frame (rigid bones: a constant).
+    FromNeck {
+        /// CERV.
+        cerv: usize,
+        /// Last joint of the neck chain above CERV (CERV itself when there is none).
+        top: usize,
+        /// Hip, knee and ankle of the left and the right leg.
+        legs: [[usize; 3]; 2],
+    },
 }
 
 impl Landmark {
@@ -55,6 +81,21 @@ impl Landmark {
             Landmark::Point(p) => pts[p],
             Landmark::Beyond { from, through, k } => {
                 std::array::from_fn(|a| pts[through][a] + k * (pts[through][a] - pts[from][a]))
+            }
+            Landmark::FromNeck { cerv, top, legs } => {
+                let c = pts[cerv];
+                let [hl, hr] = [legs[0][0], legs[1][0]];
+                let midh: [f64; 3] = std::array::from_fn(|a| 0.5 * (pts[hl][a] + pts[hr][a]));
+                let trunk: [f64; 3] = std::array::from_fn(|a| c[a] - midh[a]);
+                let neck: [f64; 3] = std::array::from_fn(|a| pts[top][a] - c[a]);
+                let len = HEAD_PER_LEG_LENGTH * leg_length(pts, legs);
+                let dir = if len3(&neck) > 0.0 { neck } else { trunk };
+                let d = len3(&dir);
+                if d > 0.0 {
+                    std::array::from_fn(|a| c[a] + len * dir[a] / d)
+                } else {
+                    c
+                }
             }
         }
     }
@@ -105,6 +146,9 @@ pub struct Landmarks {
     pub cerv: usize,
     /// VERT (head top) rule.
     pub vert: Landmark,
+    /// The skeleton has no head joint: `head` is the top of the neck chain and `vert` is
+    /// [`Landmark::FromNeck`] (a warning in `clips.parquet`).
+    pub head_from_neck: bool,
 }
 
 /// Which toe-tip candidate a foot uses (spec §4.3).
@@ -165,6 +209,14 @@ impl Landmarks {
             Landmark::Beyond { from, through, k } => {
                 format!("{}+{k}*({}-{})", n(through), n(through), n(from))
             }
+            Landmark::FromNeck { cerv, top, .. } => {
+                format!(
+                    "{}+{HEAD_PER_LEG_LENGTH:.4}*L_leg*dir({}-{})",
+                    n(cerv),
+                    n(top),
+                    n(cerv)
+                )
+            }
         };
         let mut parts = Vec::new();
         for (tag, limb) in [("L", &self.left), ("R", &self.right)] {
@@ -181,7 +233,11 @@ impl Landmarks {
                 parts.push(format!("MET3_{tag}={}", lm(&a.met3)));
             }
         }
-        parts.push(format!("head={}", n(self.head)));
+        if self.head_from_neck {
+            parts.push("head=none".to_string());
+        } else {
+            parts.push(format!("head={}", n(self.head)));
+        }
         parts.push(format!("CERV={}", n(self.cerv)));
         parts.push(format!("VERT={}", lm(&self.vert)));
         parts.join(";")
@@ -352,6 +408,40 @@ impl Finder<'_> {
     }
 }
 
+impl Finder<'_> {
+    /// Without a head joint: the neck chain, from its base (CERV: the unsided joint keyed
+    /// `neck*`, else `lowerneck`, nearest the root; a `[landmarks]` CERV wins) up through
+    /// unsided non-helper children whose key contains `neck`. `(CERV, top of the chain)`.
+    fn neck_chain(&self) -> Result<Option<(usize, usize)>> {
+        let unsided = |j: usize, pred: &dyn Fn(&str) -> bool| {
+            self.names[j].side.is_none() && !self.is_helper(j) && pred(&self.names[j].key)
+        };
+        let nearest = |pred: &dyn Fn(&str) -> bool| {
+            (0..self.skel.n_joints())
+                .filter(|&j| unsided(j, pred))
+                .min_by_key(|&j| self.depth(j))
+        };
+        let default =
+            nearest(&|k| k.starts_with("neck")).or_else(|| nearest(&|k| k == "lowerneck"));
+        let Some(cerv) = self.overridden("CERV")?.or(default) else {
+            return Ok(None);
+        };
+        // A [landmarks] CERV may name an End Site, which has no children.
+        let mut top = cerv;
+        while top < self.skel.n_joints() {
+            match self
+                .skel
+                .children(top)
+                .find(|&c| unsided(c, &|k| k.contains("neck")))
+            {
+                Some(c) => top = c,
+                None => break,
+            }
+        }
+        Ok(Some((cerv, top)))
+    }
+}
+
 /// Leg length in the rest pose, file units: `|KJC − HJC| + |AJC − KJC|`, averaged over the
 /// two sides (spec com-from-bvh §3.1).
 pub fn leg_length(rest: &[[f64; 3]], legs: [[usize; 3]; 2]) -> f64 {
@@ -381,6 +471,12 @@ pub fn map(
     };
     let legs = [f.leg(Side::L, "L")?, f.leg(Side::R, "R")?];
     let head = f.head()?;
+    // No head joint: the neck chain stands in for it (a warning, not an error).
+    let neck = if head.is_none() {
+        f.neck_chain()?
+    } else {
+        None
+    };
     let mut missing = Vec::new();
     for (tag, leg) in ["L", "R"].iter().zip(&legs) {
         for (name, v) in ["HJC", "KJC", "AJC"].iter().zip(leg) {
@@ -389,7 +485,7 @@ pub fn map(
             }
         }
     }
-    if head.is_none() {
+    if head.is_none() && neck.is_none() {
         missing.push("head".to_string());
     }
     if missing.len() == 7 {
@@ -404,10 +500,23 @@ pub fn map(
     }
     let leg_idx = legs.map(|l| l.map(|v| v.unwrap_or(0)));
     let min_len = DEGENERATE_END_SITE_FRACTION * leg_length(rest, leg_idx);
-    let head = head.unwrap_or(0);
-    let cerv = f.cerv(head)?;
+    let (head, cerv, vert_default) = match (head, neck) {
+        (Some(h), _) => (h, f.cerv(h)?, None),
+        (None, Some((cerv, top))) => (
+            top,
+            cerv,
+            Some(Landmark::FromNeck {
+                cerv,
+                top,
+                legs: leg_idx,
+            }),
+        ),
+        (None, None) => (0, 0, None), // unreachable: reported as missing above
+    };
+    let head_from_neck = vert_default.is_some();
     let vert = match f.overridden("VERT")? {
         Some(p) => Landmark::Point(p),
+        None if head_from_neck => vert_default.unwrap_or(Landmark::Point(cerv)),
         None => f
             .end_of(head, min_len)
             .or_else(|| skel.children(head).find(|&c| f.names[c].key == "headtop"))
@@ -439,5 +548,6 @@ pub fn map(
         head,
         cerv,
         vert,
+        head_from_neck,
     }))
 }

@@ -34,6 +34,7 @@ pub fn run(a: SynthArgs) -> anyhow::Result<Outcome> {
         unit_m,
         up,
         seed: a.seed,
+        ..Default::default()
     };
     let clip = generate(&opts);
     std::fs::write(&a.out, &clip.bvh).with_context(|| format!("writing {}", a.out.display()))?;
