@@ -23,7 +23,7 @@ fn committed_fixtures_match_the_generator() {
 fn ingest_recovers_com_contacts_unit_and_axis_of_the_fixtures() {
     for c in &util::FIXTURES {
         let truth = generate(&util::fixture_opts(c));
-        let (summary, frames) = util::ingest_fixture(c);
+        let (summary, frames, _) = util::ingest_fixture(c);
         assert_eq!(summary.unit.as_deref(), Some(c.unit), "{}", c.file);
         assert_eq!(summary.up_axis.as_deref(), Some(c.up_axis), "{}", c.file);
         // The generator's skeleton has a 0.84 m leg by construction.

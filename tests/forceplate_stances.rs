@@ -124,15 +124,17 @@ impl PlateClip {
             mass_kg: mass,
             ..Default::default()
         };
-        let (summary, frames) = match ingest(&bvh, &ingest_opts).expect("ingest") {
+        let (summary, frames, contacts) = match ingest(&bvh, &ingest_opts).expect("ingest") {
             ClipOutcome::Body {
-                summary, frames, ..
-            } => (summary, frames),
+                summary,
+                frames,
+                contacts,
+            } => (summary, frames, contacts),
             ClipOutcome::Skipped { reason, .. } => panic!("{clip}: skipped: {reason}"),
         };
         // The force mapping below assumes the documented +Y-up file (SOURCES.md).
         assert_eq!(summary.up_axis.as_deref(), Some("+Y"), "{clip}: up axis");
-        let (stances, _) = build_clip(clip, &frames, &summary, mass, opts);
+        let (stances, _) = build_clip(clip, &frames, &summary, &contacts, mass, opts);
         let (h, cols) = util::read_csv(&dir.join("grf.csv"));
         let t_grf = util::csv_col(&h, &cols, "time_s");
         // World Z-up force (x, −z, y) of the BVH-axes columns `<p>fx_n`, `<p>fy_n`, `<p>fz_n`.

@@ -74,12 +74,21 @@ fn a_walking_stance_is_supported_by_its_labelled_foot_only() {
     };
     let bvh = stancelib::bvh::parse_file(&data.join("bvh/walk/cmu_07_01_walk_mb.bvh")).unwrap();
     let ClipOutcome::Body {
-        summary, frames, ..
+        summary,
+        frames,
+        contacts,
     } = ingest(&bvh, &IngestOptions::default()).unwrap()
     else {
         panic!()
     };
-    let (stances, _) = build_clip("w", &frames, &summary, 70.0, &StanceOptions::default());
+    let (stances, _) = build_clip(
+        "w",
+        &frames,
+        &summary,
+        &contacts,
+        70.0,
+        &StanceOptions::default(),
+    );
     let walking: Vec<_> = stances
         .iter()
         .filter(|s| s.boundary_start == Boundary::NoFlight || s.boundary_end == Boundary::NoFlight)

@@ -16,7 +16,9 @@ fn stances_and_flights(rel: &str) -> Option<(Vec<Stance>, usize)> {
     let data = util::shared_or_skip("stances")?;
     let bvh = stancelib::bvh::parse_file(&data.join("bvh").join(rel)).unwrap();
     let ClipOutcome::Body {
-        summary, frames, ..
+        summary,
+        frames,
+        contacts,
     } = ingest(&bvh, &IngestOptions::default()).unwrap()
     else {
         panic!("{rel} skipped")
@@ -28,7 +30,15 @@ fn stances_and_flights(rel: &str) -> Option<(Vec<Stance>, usize)> {
         .into_owned();
     let flights = summary.flights.iter().filter(|f| f.ballistic).count();
     Some((
-        build_clip(&clip, &frames, &summary, 70.0, &StanceOptions::default()).0,
+        build_clip(
+            &clip,
+            &frames,
+            &summary,
+            &contacts,
+            70.0,
+            &StanceOptions::default(),
+        )
+        .0,
         flights,
     ))
 }

@@ -51,12 +51,13 @@ fn load(c: &util::FixtureCase) -> Loaded {
         "{}: differs from the generator (run `make fixtures`)",
         c.file
     );
-    let (summary, frames) = util::ingest_fixture(c);
+    let (summary, frames, contacts) = util::ingest_fixture(c);
     assert_eq!(frames.frame.len(), truth.com.len(), "{}", c.file);
     let (stances, _) = build_clip(
         c.file,
         &frames,
         &summary,
+        &contacts,
         DEFAULT_MASS_KG,
         &StanceOptions::default(),
     );
@@ -363,8 +364,10 @@ fn fixture_stances_match_the_true_contact_runs() {
             );
             // One frame time: the true force starts and ends on a frame (closed flag run),
             // the half-frame convention (spec §1 step 5) adds half a frame at each contact
-            // edge; 1e-9 s: round-off of the frame-time arithmetic.
-            if err_dt.abs() > l.dt + 1e-9 {
+            // edge; plus 15 ms per edge: the sub-frame events (contacts::timing) fire where
+            // a foot point crosses 3 cm, and the generator's swing foot lands at 2 m/s
+            // without slowing, so it crosses ~15 ms early; 1e-9 s: round-off.
+            if err_dt.abs() > l.dt + 2.0 * SUBFRAME_GENERATOR_LEAD_S + 1e-9 {
                 failures.push(format!(
                     "{}: Δt {:.5} s vs true {:.5} s",
                     s.stance_id,
@@ -429,12 +432,17 @@ fn param_tolerances(rate: f64) -> (f64, f64, f64) {
     )
 }
 
+/// How early the sub-frame events fire on the generator's clips, per edge (s).
+const SUBFRAME_GENERATOR_LEAD_S: f64 = 0.015;
+
 /// Worst |Δv| (m/s: vs, ve, vp), |Δz| (m: zs, ze), |Δx| (m) measured on the noise-free run
 /// fixtures (printed by the test), rounded up. The model-consistent `ze` and `x` (spec §3)
 /// carry the Stage A force model's impulse error; the measured-LO values are 3-10× closer.
+/// With the ratio model's flight edge states (issue 12) v and z are exact at 60 and 120 Hz;
+/// at 30 Hz x measured 0.0229 m (the sub-frame events of a 3-frame flight).
 const MEAS_120: [f64; 3] = [0.0024, 0.0087, 0.0124];
 const MEAS_60: [f64; 3] = [0.0018, 0.0082, 0.0103];
-const MEAS_30: [f64; 3] = [0.0032, 0.0110, 0.0114];
+const MEAS_30: [f64; 3] = [0.0032, 0.0110, 0.0155];
 
 /// zs, vs, ze, ve, vp, x of the run stances with flights on both sides against the apices
 /// of the generator's exact ballistic flights.

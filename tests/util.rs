@@ -189,18 +189,21 @@ pub fn forceplate_clip(data: &Path, clip: &str) -> ForcePlateClip {
     }
 }
 
-/// Ingest a committed fixture with default options.
+/// Ingest a committed fixture with default options: summary, frames and contact runs.
 pub fn ingest_fixture(
     c: &FixtureCase,
 ) -> (
     stancelib::ingest::ClipSummary,
     stancelib::ingest::ClipFrames,
+    Vec<stancelib::ingest::ContactRun>,
 ) {
     let bvh = stancelib::bvh::parse_file(&fixture_path(c)).unwrap();
     match stancelib::ingest::ingest(&bvh, &stancelib::ingest::IngestOptions::default()).unwrap() {
         stancelib::ingest::ClipOutcome::Body {
-            summary, frames, ..
-        } => (summary, frames),
+            summary,
+            frames,
+            contacts,
+        } => (summary, frames, contacts),
         stancelib::ingest::ClipOutcome::Skipped { reason, .. } => {
             panic!("{} skipped: {reason}", c.file)
         }

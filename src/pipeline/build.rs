@@ -79,9 +79,14 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport 
         .par_iter()
         .map(|r| {
             let out = match (&r.frames, r.status) {
-                (Some(fr), Status::Ok) => {
-                    build_clip(&r.clip, fr, &r.summary, r.mass_kg, &opts.stances)
-                }
+                (Some(fr), Status::Ok) => build_clip(
+                    &r.clip,
+                    fr,
+                    &r.summary,
+                    &r.contacts,
+                    r.mass_kg,
+                    &opts.stances,
+                ),
                 _ => (Vec::new(), Vec::new()),
             };
             bar.inc(1);

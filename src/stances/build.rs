@@ -11,7 +11,7 @@ use crate::force_model::{
     fit_stance, EdgeTargets, FitOptions, FitWorkspace, ForceModelKind, StanceFit, StanceForce,
     GRAVITY,
 };
-use crate::ingest::{ClipFrames, ClipSummary};
+use crate::ingest::{ClipFrames, ClipSummary, ContactRun};
 use crate::math::polyfit::{fit as poly_fit, fit_fixed_curvature};
 use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
 use crate::math::spline::NaturalSpline;
@@ -134,6 +134,45 @@ fn flight_ref(f: &Flight, t: f64) -> FlightRef {
     }
 }
 
+/// A stance edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Edge {
+    Touchdown,
+    Liftoff,
+}
+
+/// The sub-frame time of a stance edge: over the supporting effectors' runs that start
+/// (touchdown) or end (liftoff) on the stance's first or last frame, the earliest
+/// touchdown or the latest liftoff; `None` when no run edge is there. A time must lie
+/// within one frame of the frame edge and keep the stance inside its frames ± 1.
+fn event_time(contacts: &[ContactRun], seg: &Segment, fr: &ClipFrames, edge: Edge) -> Option<f64> {
+    let support = supporting(seg, &fr.contact);
+    let dt = fr
+        .time_s
+        .get(1)
+        .zip(fr.time_s.first())
+        .map(|(b, a)| b - a)?;
+    let (frame, edge_t) = match edge {
+        Edge::Touchdown => (fr.frame[seg.i0], fr.time_s[seg.i0] - dt / 2.0),
+        Edge::Liftoff => (fr.frame[seg.i1], fr.time_s[seg.i1] + dt / 2.0),
+    };
+    let times = contacts.iter().filter_map(|r| {
+        let e = EFFECTORS.iter().position(|&e| e == r.effector)?;
+        if !support[e] {
+            return None;
+        }
+        match edge {
+            Edge::Touchdown => (r.first_frame == frame).then_some(r.td_time_s).flatten(),
+            Edge::Liftoff => (r.last_frame == frame).then_some(r.lo_time_s).flatten(),
+        }
+    });
+    let t = match edge {
+        Edge::Touchdown => times.fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t)))),
+        Edge::Liftoff => times.fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t)))),
+    }?;
+    (t.is_finite() && (t - edge_t).abs() <= dt).then_some(t)
+}
+
 /// Frames dropped at each end of a flight before its ballistic fit: the contact edges are
 /// about one frame uncertain, and SG-free raw positions still carry the transition there.
 pub const BALLISTIC_EDGE_FRAMES: usize = 2;
@@ -213,10 +252,16 @@ impl From<String> for StanceNote {
 }
 
 /// Build every stance of a clip. Returns the stances and clip-level notes.
+///
+/// `contacts` are the clip's contact runs: a stance edge that is a run's first or last
+/// frame takes that run's sub-frame event time ([`ContactRun::td_time_s`],
+/// [`ContactRun::lo_time_s`]); other edges, and an empty slice, use the frame edges
+/// (half a frame outside the stance's first and last frame).
 pub fn build_clip(
     clip: &str,
     fr: &ClipFrames,
     summary: &ClipSummary,
+    contacts: &[ContactRun],
     mass_kg: f64,
     opts: &StanceOptions,
 ) -> (Vec<Stance>, Vec<StanceNote>) {
@@ -274,12 +319,12 @@ pub fn build_clip(
         let t_td = if seg.i0 == 0 {
             fr.time_s[0]
         } else {
-            fr.time_s[seg.i0] - dt / 2.0
+            event_time(contacts, &seg, fr, Edge::Touchdown).unwrap_or(fr.time_s[seg.i0] - dt / 2.0)
         };
         let t_lo = if seg.i1 + 1 == n {
             fr.time_s[n - 1]
         } else {
-            fr.time_s[seg.i1] + dt / 2.0
+            event_time(contacts, &seg, fr, Edge::Liftoff).unwrap_or(fr.time_s[seg.i1] + dt / 2.0)
         };
         let dt_s = t_lo - t_td;
         let fit_before = (seg.start == Boundary::Flight)

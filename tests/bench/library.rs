@@ -56,13 +56,17 @@ fn stances_10k(c: &mut Criterion) {
     let bvh = stancelib::bvh::parse_file(&root().join("fixtures/bvh/run_120hz_m_yup.bvh"))
         .expect("fixture");
     let ClipOutcome::Body {
-        summary, frames, ..
+        summary,
+        frames,
+        contacts,
     } = ingest(&bvh, &IngestOptions::default()).expect("ingest")
     else {
         panic!("fixture skipped")
     };
     let opts = StanceOptions::default();
-    let per_clip = build_clip("run", &frames, &summary, 70.0, &opts).0.len();
+    let per_clip = build_clip("run", &frames, &summary, &contacts, 70.0, &opts)
+        .0
+        .len();
     let reps = 10_000 / per_clip.max(1);
     let mut g = c.benchmark_group("stances_10k");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
@@ -71,7 +75,7 @@ fn stances_10k(c: &mut Criterion) {
         b.iter(|| {
             let mut n = 0;
             for _ in 0..reps {
-                n += black_box(build_clip("run", &frames, &summary, 70.0, &opts))
+                n += black_box(build_clip("run", &frames, &summary, &contacts, 70.0, &opts))
                     .0
                     .len();
             }
