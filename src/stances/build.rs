@@ -12,7 +12,7 @@ use crate::force_model::stage_b::{
 };
 use crate::force_model::{fit_stage_a, FitOptions, FitWorkspace, ForceModel};
 use crate::ingest::{ClipFrames, ClipSummary};
-use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
+use crate::math::savgol::{SavGol, DEFAULT_ORDER};
 use crate::math::spline::NaturalSpline;
 use crate::math::stats::median;
 
@@ -240,6 +240,10 @@ impl From<String> for StanceNote {
 }
 
 /// Build every stance of a clip. Returns the stances and clip-level notes.
+///
+/// A clip whose smoothing filter cannot be built (a frame time beyond
+/// `MAX_SAVGOL_WINDOW`) or that is shorter than the window gives no stances and one
+/// failed note (an `errors.parquet` row), never nothing silently.
 pub fn build_clip(
     clip: &str,
     fr: &ClipFrames,
@@ -250,14 +254,26 @@ pub fn build_clip(
     let n = fr.frame.len();
     let dt = summary.frame_time_s;
     let mut warnings = Vec::new();
-    let Some(sg) = SavGol::new(window_for_rate(1.0 / dt), DEFAULT_ORDER) else {
-        return (Vec::new(), warnings);
+    let failed = |message: String| StanceNote {
+        message,
+        failed: true,
+    };
+    let sg = match SavGol::for_frame_time(dt, DEFAULT_ORDER) {
+        Ok(sg) => sg,
+        Err(e) => {
+            warnings.push(failed(format!("cannot build the smoothing filter: {e}")));
+            return (Vec::new(), warnings);
+        }
     };
     let smooth: Vec<V3> = {
         let cols: [Vec<f64>; 3] = std::array::from_fn(|i| {
             sg.apply(&fr.com.iter().map(|c| c[i]).collect::<Vec<_>>(), 0, dt)
         });
         if cols[0].len() != n {
+            warnings.push(failed(format!(
+                "{n} frames, fewer than the smoothing window of {} frames",
+                sg.window()
+            )));
             return (Vec::new(), warnings);
         }
         (0..n)
