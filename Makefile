@@ -21,7 +21,7 @@ lint:
 ## failing inputs are saved under fixtures/regressions/ (replayed by `make test`).
 STANCELIB_FUZZ_SECS ?= 300
 fuzz:
-	STANCELIB_FUZZ_SECS=$(STANCELIB_FUZZ_SECS) $(CARGO) test --release --test integration \
+	STANCELIB_FUZZ_SECS=$(STANCELIB_FUZZ_SECS) $(CARGO) test --test integration \
 		safety_inputs::mutation_fuzz_for_a_time_budget -- --ignored --nocapture
 
 ## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances

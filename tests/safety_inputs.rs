@@ -516,6 +516,10 @@ enum Mutation {
     Random(usize, Vec<u8>),
     /// Multiply every OFFSET by 10^k.
     ScaleOffsets(i32),
+    /// Replace a token with a finite number of any magnitude (the file still parses).
+    Number(usize, f64),
+    /// Multiply one motion channel (column) of every row by 10^k.
+    ScaleColumn(usize, i32),
 }
 
 fn mutation() -> impl Strategy<Value = Mutation> {
@@ -528,6 +532,9 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         2 => (any::<usize>(), proptest::collection::vec(any::<u8>(), 0..12))
             .prop_map(|(p, b)| Mutation::Random(p, b)),
         1 => (-320..320i32).prop_map(Mutation::ScaleOffsets),
+        6 => (any::<usize>(), any::<f64>().prop_filter("finite", |v| v.is_finite()))
+            .prop_map(|(p, v)| Mutation::Number(p, v)),
+        3 => (any::<usize>(), -320..320i32).prop_map(|(c, k)| Mutation::ScaleColumn(c, k)),
     ]
 }
 
@@ -557,15 +564,35 @@ fn apply(mut b: Vec<u8>, m: &Mutation) -> Vec<u8> {
             }
             ls.join(&b'\n')
         }
-        Mutation::Token(i, _) | Mutation::Random(i, _) => {
+        Mutation::Token(i, _) | Mutation::Random(i, _) | Mutation::Number(i, _) => {
             let mut toks: Vec<Vec<u8>> = b.split(|&c| c == b' ').map(<[u8]>::to_vec).collect();
             let k = i % toks.len();
             toks[k] = match m {
                 Mutation::Token(_, t) => TOKENS[*t].as_bytes().to_vec(),
                 Mutation::Random(_, r) => r.clone(),
+                Mutation::Number(_, v) => format!("{v:e}").into_bytes(),
                 _ => unreachable!(),
             };
             toks.join(&b' ')
+        }
+        Mutation::ScaleColumn(c, k) => {
+            let mut ls = lines(&b);
+            let Some(start) = ls.iter().position(|l| l.starts_with(b"Frame Time")) else {
+                return b;
+            };
+            for l in &mut ls[start + 1..] {
+                let mut toks: Vec<Vec<u8>> = l.split(|&c| c == b' ').map(<[u8]>::to_vec).collect();
+                let n = toks.len();
+                let t = &mut toks[c % n];
+                if let Some(v) = std::str::from_utf8(t)
+                    .ok()
+                    .and_then(|t| t.parse::<f64>().ok())
+                {
+                    *t = format!("{:e}", v * 10f64.powi(*k)).into_bytes();
+                }
+                *l = toks.join(&b' ');
+            }
+            ls.join(&b'\n')
         }
         Mutation::ScaleOffsets(k) => match String::from_utf8(b) {
             Ok(t) => map_lines(&t, "OFFSET", |rest| {
@@ -588,7 +615,7 @@ fn apply(mut b: Vec<u8>, m: &Mutation) -> Vec<u8> {
 fn mutated_clip() -> impl Strategy<Value = Vec<u8>> {
     (
         0..FUZZ_BASES.len(),
-        proptest::collection::vec(mutation(), 1..6),
+        proptest::collection::vec(mutation(), 1..5),
     )
         .prop_map(|(f, ms)| {
             let base = std::fs::read(fixture(FUZZ_BASES[f])).unwrap();
@@ -596,10 +623,18 @@ fn mutated_clip() -> impl Strategy<Value = Vec<u8>> {
         })
 }
 
+/// How far an input got (for the long run's statistics).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Reached {
+    ParseError,
+    IngestError,
+    Skipped,
+    Stances,
+}
+
 /// Parse, ingest and build stances of one input: an error is typed, located and printable;
-/// nothing panics (a panic fails the caller). Returns what was checked, for the caller's
-/// message.
-fn check_input(bytes: &[u8]) -> std::result::Result<(), String> {
+/// nothing panics (a panic fails the caller). Returns how far the input got.
+fn check_input(bytes: &[u8]) -> std::result::Result<Reached, String> {
     let bvh = match parse_reader(bytes) {
         Ok(b) => b,
         Err(e) => {
@@ -609,17 +644,17 @@ fn check_input(bytes: &[u8]) -> std::result::Result<(), String> {
             if *line == 0 {
                 return Err(format!("parse error at line 0: {e}"));
             }
-            return safe(&e.to_string());
+            return safe(&e.to_string()).map(|_| Reached::ParseError);
         }
     };
     match ingest(&bvh, &IngestOptions::default()) {
         Err(e) => match e.kind {
             ErrorKind::Skeleton { .. }
             | ErrorKind::NonFinite { .. }
-            | ErrorKind::Smoothing { .. } => safe(&e.to_string()),
+            | ErrorKind::Smoothing { .. } => safe(&e.to_string()).map(|_| Reached::IngestError),
             k => Err(format!("ingest error of kind {k:?}")),
         },
-        Ok(ClipOutcome::Skipped { .. }) => Ok(()),
+        Ok(ClipOutcome::Skipped { .. }) => Ok(Reached::Skipped),
         Ok(ClipOutcome::Body {
             summary, frames, ..
         }) => {
@@ -631,7 +666,8 @@ fn check_input(bytes: &[u8]) -> std::result::Result<(), String> {
                 return Err(format!("clip ok with a non-finite COM at frame {f}"));
             }
             let (_, notes) = build_clip("fuzz", &frames, &summary, 70.0, &StanceOptions::default());
-            notes.iter().try_for_each(|n| safe(&n.message))
+            notes.iter().try_for_each(|n| safe(&n.message))?;
+            Ok(Reached::Stances)
         }
     }
 }
@@ -646,7 +682,7 @@ fn safe(msg: &str) -> std::result::Result<(), String> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 160, failure_persistence: None, ..ProptestConfig::default() })]
 
     // See: issue 11 Keep — the mutation fuzzer: parse + ingest + stances never panic, and
     // every error is typed, located (line ≥ 1) and printable.
@@ -675,7 +711,7 @@ fn mutation_fuzz_regressions_replay() {
         let bytes = std::fs::read(&p).unwrap();
         let r = std::panic::catch_unwind(|| check_input(&bytes));
         match r {
-            Ok(Ok(())) => {}
+            Ok(Ok(_)) => {}
             Ok(Err(why)) => panic!("{}: {why}", p.display()),
             Err(_) => panic!("{}: panicked", p.display()),
         }
@@ -700,12 +736,16 @@ fn mutation_fuzz_for_a_time_budget() {
     let strategy = mutated_clip();
     let t0 = std::time::Instant::now();
     let (mut cases, mut saved) = (0u64, Vec::new());
+    let mut reached = std::collections::BTreeMap::new();
     while t0.elapsed().as_secs() < secs {
         let bytes = strategy.new_tree(&mut runner).unwrap().current();
         cases += 1;
         let outcome = std::panic::catch_unwind(|| check_input(&bytes));
         let why = match outcome {
-            Ok(Ok(())) => continue,
+            Ok(Ok(r)) => {
+                *reached.entry(r).or_insert(0u64) += 1;
+                continue;
+            }
             Ok(Err(why)) => why,
             Err(_) => "panic".to_string(),
         };
@@ -718,7 +758,7 @@ fn mutation_fuzz_for_a_time_budget() {
         saved.push(p);
     }
     eprintln!(
-        "mutation fuzz: {cases} inputs in {:?}, {} failing",
+        "mutation fuzz: {cases} inputs in {:?}, {} failing; reached {reached:?}",
         t0.elapsed(),
         saved.len()
     );
