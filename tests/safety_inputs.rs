@@ -157,7 +157,7 @@ fn silent_nan_offsets_scaled_by_1e155_are_a_per_clip_error() {
         ErrorKind::NonFinite {
             quantity, joint, ..
         } => {
-            assert_eq!(quantity, "leg length");
+            assert_eq!(quantity, "rest-pose leg length");
             assert_eq!(joint.as_deref(), Some("LeftUpLeg–LeftLeg–LeftFoot"));
         }
         k => panic!("expected a non-finite error, got {k:?}"),
@@ -167,7 +167,7 @@ fn silent_nan_offsets_scaled_by_1e155_are_a_per_clip_error() {
     let recs = stancelib::pipeline::batch::ingest_all(&[bad], &IngestOptions::default());
     assert_eq!(recs[0].status, Status::Error);
     let msg = recs[0].message.as_deref().unwrap();
-    assert!(msg.contains("non-finite leg length"), "{msg}");
+    assert!(msg.contains("non-finite rest-pose leg length"), "{msg}");
 }
 
 // See: issue 11 item 7 — non-finite joint positions name the first bad frame and joint.

@@ -125,7 +125,11 @@ pub(super) fn run(
     for leg in legs {
         if !leg_length(rest_file, [leg, leg]).is_finite() {
             let names = leg.map(|p| echo(&skel.point_name(p)));
-            return Err(Error::non_finite("leg length", None, Some(names.join("–"))));
+            return Err(Error::non_finite(
+                "rest-pose leg length",
+                None,
+                Some(names.join("–")),
+            ));
         }
     }
     let leg_file = leg_length(rest_file, legs);
@@ -171,7 +175,11 @@ pub(super) fn run(
     let rest: Vec<V3> = rest_file.iter().map(|p| to_int(*p)).collect();
     let leg_m = leg_file * scale;
     if !leg_m.is_finite() {
-        return Err(Error::non_finite("leg length in metres", None, None));
+        return Err(Error::non_finite(
+            "rest-pose leg length in metres",
+            None,
+            None,
+        ));
     }
     summary.unit_scale = Some(scale);
     summary.unit = Some(unit_name);
