@@ -435,6 +435,22 @@ fn line_length_bound_names_the_line() {
     assert!(msg.contains("longer than"), "{msg}");
 }
 
+/// A reader that returns one byte per call.
+struct OneByte<'a>(&'a [u8]);
+
+impl Read for OneByte<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match (self.0.split_first(), buf.first_mut()) {
+            (Some((b, rest)), Some(out)) => {
+                *out = *b;
+                self.0 = rest;
+                Ok(1)
+            }
+            _ => Ok(0),
+        }
+    }
+}
+
 // See: issue 11 item 12 — CR-only files (old Mac exports) were called "truncated"; they
 // are read as lines, with line numbers as for LF, CRLF and twice-converted CR CR LF.
 #[test]
@@ -448,6 +464,17 @@ fn cr_only_files_are_read_and_errors_keep_their_line() {
         assert_eq!(b.motion, lf.motion, "{eol:?}");
         let bad = t.replace("JOINT LeftLeg", "JOYNT LeftLeg");
         assert_eq!(bvh_err(bad.as_bytes()).0, 10, "{eol:?}");
+    }
+    // Line breaks split across reads (one byte per read) give the same result.
+    for eol in ["\r", "\r\n", "\r\r\n"] {
+        let t = text.replace('\n', eol);
+        let b = parse_reader(OneByte(t.as_bytes())).unwrap_or_else(|e| panic!("{eol:?}: {e}"));
+        assert_eq!(b.motion, lf.motion, "{eol:?}");
+        let bad = t.replace("JOINT LeftLeg", "JOYNT LeftLeg");
+        match parse_reader(OneByte(bad.as_bytes())).unwrap_err().kind {
+            ErrorKind::Bvh { line, .. } => assert_eq!(line, 10, "{eol:?}"),
+            k => panic!("{k:?}"),
+        }
     }
     // A blank line in a CR-only file is a line of its own.
     let t = text.replacen('\n', "\n\n", 1).replace('\n', "\r");
