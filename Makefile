@@ -1,7 +1,7 @@
 # stancelib: the two commands a newcomer needs are `make demo` and `make test`.
 CARGO ?= cargo
 
-.PHONY: demo test lint bench nightly build doc fixtures
+.PHONY: demo test lint bench nightly build doc fixtures fuzz
 
 ## Run the main job on the bundled fixtures (pipelines/demo.toml); tables go to out/demo/.
 demo:
@@ -16,6 +16,13 @@ test:
 lint:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets -- -D warnings
+
+## Mutation fuzzer of the reader and ingest for STANCELIB_FUZZ_SECS seconds (default 300);
+## failing inputs are saved under fixtures/regressions/ (replayed by `make test`).
+STANCELIB_FUZZ_SECS ?= 300
+fuzz:
+	STANCELIB_FUZZ_SECS=$(STANCELIB_FUZZ_SECS) $(CARGO) test --test integration \
+		safety_inputs::mutation_fuzz_for_a_time_budget -- --ignored --nocapture
 
 ## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances
 ## (library); candidate evaluations and the 200 × 200 jump map (queries); 2PAC H-rep,

@@ -76,6 +76,28 @@ pub enum ErrorKind {
         /// The step and what failed.
         msg: String,
     },
+    /// The Savitzky–Golay smoothing filter of a clip cannot be built (for example a frame
+    /// time so short that the window exceeds `math::savgol::MAX_SAVGOL_WINDOW`).
+    #[error("smoothing window of {window} frames{}: {msg}", frame_time_s.map(|dt| format!(" ({:.6} s at frame time {dt} s)", dt * *window as f64)).unwrap_or_default())]
+    Smoothing {
+        /// The clip's frame time, s, when the window came from it.
+        frame_time_s: Option<f64>,
+        /// The window, frames.
+        window: usize,
+        /// What is wrong.
+        msg: String,
+    },
+    /// A computed position or derivative is NaN or infinite (OFFSETs or channel values so
+    /// large that f64 overflows).
+    #[error("non-finite {quantity}{}{}: offsets or channel values too large for f64", joint.as_ref().map(|j| format!(" of '{j}'")).unwrap_or_default(), frame.map(|f| format!(" at frame {f}")).unwrap_or_default())]
+    NonFinite {
+        /// What overflowed (`position`, `COM`, `leg length`, …).
+        quantity: String,
+        /// The first bad frame (0-based file row), when per frame.
+        frame: Option<usize>,
+        /// The joint or point concerned, when one is.
+        joint: Option<String>,
+    },
     /// A columnar (Parquet) file could not be written or read.
     #[error("{}: {msg}", path.display())]
     Io {
@@ -136,6 +158,16 @@ impl Error {
         .into()
     }
 
+    /// A non-finite-value error (see [`ErrorKind::NonFinite`]).
+    pub fn non_finite(quantity: &str, frame: Option<usize>, joint: Option<String>) -> Self {
+        ErrorKind::NonFinite {
+            quantity: quantity.to_string(),
+            frame,
+            joint,
+        }
+        .into()
+    }
+
     /// A column error in a library table.
     pub fn column(
         path: impl Into<PathBuf>,
@@ -162,6 +194,38 @@ impl Error {
         }
         self
     }
+}
+
+/// Longest excerpt of raw input echoed in an error message, characters; longer excerpts
+/// are cut there and end in `…`.
+pub const MAX_ECHO_CHARS: usize = 80;
+
+/// Raw input made safe to print in an error message: control characters (ANSI escapes,
+/// NUL, …) and bidirectional-text controls are written as `\x1b` or `\u{202e}`, and the
+/// text is cut after [`MAX_ECHO_CHARS`] characters with `…`.
+///
+/// # Examples
+/// ```
+/// assert_eq!(stancelib::error::echo("a\x1b[31mb"), "a\\x1b[31mb");
+/// assert_eq!(stancelib::error::echo(&"x".repeat(100)).chars().count(), 81);
+/// ```
+pub fn echo(raw: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in raw.chars().enumerate() {
+        if i == MAX_ECHO_CHARS {
+            out.push('…');
+            break;
+        }
+        let bidi = matches!(c, '\u{200b}'..='\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{feff}');
+        if c.is_control() && (c as u32) < 0x100 {
+            out.push_str(&format!("\\x{:02x}", c as u32));
+        } else if c.is_control() || bidi {
+            out.push_str(&format!("\\u{{{:x}}}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 impl From<ErrorKind> for Error {

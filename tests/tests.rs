@@ -15,6 +15,9 @@
 //! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
 //! - `props`: property tests: mutated and extreme inputs never panic the reader or the ingest.
 //! - `readers`: pyarrow and DuckDB open the library (row counts, metadata, values).
+//! - `safety_inputs`: issue 11 reader and numeric items: SG window bound, no silent NaN,
+//!   100k-joint and 100k-deep files, escaped short messages, line bound, CR-only files, and
+//!   the mutation fuzzer (bounded; `make fuzz` runs it for a time budget).
 //! - `real_data`: every shared BVH loads; flight physics, walk/run contact patterns, invariance.
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 //! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
@@ -35,6 +38,7 @@ mod queries;
 mod readers;
 mod real_data;
 mod regression;
+mod safety_inputs;
 mod safety_outputs;
 mod stances;
 mod stances_truth;

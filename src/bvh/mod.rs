@@ -28,7 +28,7 @@
 
 mod parse;
 
-pub use parse::{parse_file, parse_reader, MAX_FRAME_TIME_S, MIN_FRAME_TIME_S};
+pub use parse::{parse_file, parse_reader, MAX_FRAME_TIME_S, MAX_LINE_BYTES, MIN_FRAME_TIME_S};
 
 /// One channel of a joint: a translation or a rotation about a file axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -1,48 +1,63 @@
 //! Streaming BVH parser: `parse_file(path)` opens the file and calls `parse_reader`.
 
-use std::io::{BufRead, BufReader, Read};
+use std::collections::HashMap;
+use std::io::Read;
 use std::path::Path;
 
 use super::{Bvh, Channel, Hierarchy, JointDef, Motion};
-use crate::error::{Error, Result};
+use crate::error::{echo, Error, Result, MAX_ECHO_CHARS};
 
 /// Smallest accepted frame time, s (100 kHz): anything shorter is a corrupt header.
 pub const MIN_FRAME_TIME_S: f64 = 1e-5;
 /// Largest accepted frame time, s (0.1 Hz).
 pub const MAX_FRAME_TIME_S: f64 = 10.0;
+/// Longest accepted line, bytes (line break excluded): 8 MiB. A MOTION row of a 300-joint
+/// skeleton is under 20 KB; the bound keeps the reader's memory bounded on a file with no
+/// line breaks (binary data, `/dev/zero`), which is refused at the line where it is met.
+pub const MAX_LINE_BYTES: usize = 8 << 20;
+/// Size of the reader's buffer, bytes.
+const READ_CHUNK_BYTES: usize = 1 << 16;
 
 /// Parse a BVH file from disk. Errors name the file and the line.
 ///
 /// # Errors
 /// I/O failures and every malformation listed in [`parse_reader`].
 pub fn parse_file(path: &Path) -> Result<Bvh> {
-    let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
-    parse_reader(BufReader::with_capacity(1 << 16, f)).map_err(|e| e.with_path(path))
+    let f =
+        std::fs::File::open(path).map_err(|e| Error::io(path, format!("cannot open: {e}"), e))?;
+    parse_reader(f).map_err(|e| e.with_path(path))
 }
 
 /// Parse BVH text from any reader, streaming the MOTION section row by row.
 ///
-/// Accepts CRLF, CR-less and mixed line endings, tabs, a UTF-8 BOM, scientific notation,
-/// `End Site`/`End site`, and a `Frames:` count that disagrees with the data (a warning).
+/// Accepts LF, CRLF, CR-only (old Mac) and mixed line endings, tabs, a UTF-8 BOM,
+/// scientific notation, `End Site`/`End site`, and a `Frames:` count that disagrees with the
+/// data (a warning). Joints may nest to any depth (the parser keeps its own stack).
+/// Raw input echoed in a message is escaped and cut (see [`crate::error::echo`]).
 ///
 /// # Errors
-/// `ErrorKind::Bvh` with the 1-based line for: unbalanced braces, missing or repeated
-/// sections, a missing root name, `End` without `Site`, bad OFFSET or CHANNELS lines, a
-/// duplicate joint name, a non-positive or non-finite frame time, a data row with the wrong
-/// number of values, a non-numeric or non-finite value, zero data rows, and truncation (end
-/// of file inside the header, or a partial last row).
+/// `ErrorKind::Bvh` with the 1-based line for: an empty file, a line longer than
+/// [`MAX_LINE_BYTES`], a read error (with the OS reason), unbalanced braces, missing or
+/// repeated sections, a missing root name, `End` without `Site`, bad OFFSET or CHANNELS
+/// lines, a duplicate joint name (with the line of the first), a non-positive or non-finite
+/// frame time, a data row with the wrong number of values, a non-numeric or non-finite
+/// value, zero data rows, and truncation (end of file inside the header, or a partial last
+/// row).
 pub fn parse_reader<R: Read>(reader: R) -> Result<Bvh> {
-    let mut rdr = BufReader::with_capacity(1 << 16, reader);
-    let mut lines = LineReader {
-        buf: Vec::with_capacity(4096),
-        line: 0,
-    };
+    let mut lines = LineReader::new(reader);
     let mut header = HeaderParser::default();
     loop {
-        if !lines.next(&mut rdr)? {
+        if !lines.next()? {
+            if lines.line == 0 {
+                return Err(Error::bvh(1, "empty file"));
+            }
             return Err(Error::bvh(
                 lines.line,
-                "truncated: end of file inside the header",
+                if header.seen_hierarchy {
+                    "truncated: end of file inside the header"
+                } else {
+                    "truncated: end of file before HIERARCHY"
+                },
             ));
         }
         let text = String::from_utf8_lossy(&lines.buf);
@@ -56,9 +71,9 @@ pub fn parse_reader<R: Read>(reader: R) -> Result<Bvh> {
         }
     }
     let hierarchy = header.finish(lines.line)?;
-    let (frames_header, frame_time_s) = read_motion_header(&mut rdr, &mut lines)?;
+    let (frames_header, frame_time_s) = read_motion_header(&mut lines)?;
     let n_channels = hierarchy.n_channels();
-    let values = read_rows(&mut rdr, &mut lines, n_channels)?;
+    let values = read_rows(&mut lines, n_channels)?;
     let motion = Motion {
         frames_header,
         frame_time_s,
@@ -81,27 +96,113 @@ pub fn parse_reader<R: Read>(reader: R) -> Result<Bvh> {
     })
 }
 
-/// Reads raw lines (bytes, terminator stripped) and counts them.
-struct LineReader {
+/// Reads raw lines (bytes, line break stripped) and counts them. A line ends at LF, CRLF,
+/// CR…CRLF (one break, as a CRLF file converted twice) or a lone CR (CR-only files, where
+/// each further CR is an empty line).
+struct LineReader<R> {
+    inner: R,
+    chunk: Box<[u8]>,
+    pos: usize,
+    end: usize,
+    eof: bool,
+    /// The current line, without its break.
     buf: Vec<u8>,
+    /// 1-based number of the line in `buf` (0 before the first).
     line: usize,
+    /// Empty lines still to return (the further CRs of a CR-only file).
+    pending_empty: usize,
 }
 
-impl LineReader {
-    /// Read the next line into `buf`; false at end of file.
-    fn next<R: BufRead>(&mut self, rdr: &mut R) -> Result<bool> {
-        self.buf.clear();
-        let n = rdr
-            .read_until(b'\n', &mut self.buf)
-            .map_err(|e| Error::bvh(self.line + 1, format!("read error: {e}")))?;
-        if n == 0 {
-            return Ok(false);
+impl<R: Read> LineReader<R> {
+    fn new(inner: R) -> Self {
+        LineReader {
+            inner,
+            chunk: vec![0; READ_CHUNK_BYTES].into_boxed_slice(),
+            pos: 0,
+            end: 0,
+            eof: false,
+            buf: Vec::with_capacity(4096),
+            line: 0,
+            pending_empty: 0,
         }
-        self.line += 1;
-        while matches!(self.buf.last(), Some(b'\n' | b'\r')) {
-            self.buf.pop();
+    }
+
+    /// Refill the buffer when it is used up; false at end of file.
+    fn fill(&mut self) -> Result<bool> {
+        while self.pos == self.end {
+            if self.eof {
+                return Ok(false);
+            }
+            match self.inner.read(&mut self.chunk) {
+                Ok(0) => self.eof = true,
+                Ok(n) => (self.pos, self.end) = (0, n),
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(Error::bvh(self.line + 1, format!("read error: {e}"))),
+            }
         }
         Ok(true)
+    }
+
+    /// Read the next line into `buf`; false at end of file.
+    fn next(&mut self) -> Result<bool> {
+        self.buf.clear();
+        if self.pending_empty > 0 {
+            self.pending_empty -= 1;
+            self.line += 1;
+            return Ok(true);
+        }
+        let mut started = false;
+        loop {
+            if !self.fill()? {
+                if started {
+                    self.line += 1;
+                }
+                return Ok(started);
+            }
+            started = true;
+            let avail = &self.chunk[self.pos..self.end];
+            let brk = avail.iter().position(|&b| b == b'\n' || b == b'\r');
+            let take = brk.unwrap_or(avail.len());
+            if self.buf.len() + take > MAX_LINE_BYTES {
+                return Err(Error::bvh(
+                    self.line + 1,
+                    format!(
+                        "line longer than {MAX_LINE_BYTES} bytes without a line break \
+                         (not a BVH text file?)"
+                    ),
+                ));
+            }
+            self.buf.extend_from_slice(&avail[..take]);
+            self.pos += take;
+            if let Some(i) = brk {
+                let cr = avail[i] == b'\r';
+                self.pos += 1;
+                self.line += 1;
+                if cr {
+                    self.after_cr()?;
+                }
+                return Ok(true);
+            }
+        }
+    }
+
+    /// After a CR: further CRs then LF make one break with it; otherwise each further CR
+    /// is an empty line.
+    fn after_cr(&mut self) -> Result<()> {
+        let mut extra = 0;
+        while self.fill()? {
+            match self.chunk[self.pos] {
+                b'\r' => extra += 1,
+                b'\n' => {
+                    self.pos += 1;
+                    return Ok(());
+                }
+                _ => break,
+            }
+            self.pos += 1;
+        }
+        self.pending_empty = extra;
+        Ok(())
     }
 }
 
@@ -116,6 +217,8 @@ enum Block {
 struct HeaderParser {
     seen_hierarchy: bool,
     joints: Vec<JointDef>,
+    /// Joint name → index, for the duplicate check (O(1) per joint).
+    index: HashMap<String, usize>,
     has_offset: Vec<bool>,
     stack: Vec<Block>,
     pending: Option<Block>,
@@ -137,9 +240,12 @@ fn parse_num(tok: &str, line: usize, what: &str) -> Result<f64> {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(Error::bvh(
             line,
-            format!("{what}: non-finite value '{tok}'"),
+            format!("{what}: non-finite value '{}'", echo(tok)),
         )),
-        Err(_) => Err(Error::bvh(line, format!("{what}: '{tok}' is not a number"))),
+        Err(_) => Err(Error::bvh(
+            line,
+            format!("{what}: '{}' is not a number", echo(tok)),
+        )),
     }
 }
 
@@ -200,7 +306,7 @@ impl HeaderParser {
                 other => {
                     return Err(Error::bvh(
                         line,
-                        format!("unexpected '{other}' in the HIERARCHY section"),
+                        format!("unexpected '{}' in the HIERARCHY section", echo(other)),
                     ))
                 }
             }
@@ -233,15 +339,17 @@ impl HeaderParser {
             }
             _ => return Err(Error::bvh(line, "JOINT outside a ROOT block")),
         };
-        if let Some(prev) = self.joints.iter().find(|j| j.name == name) {
+        if let Some(&prev) = self.index.get(name) {
             return Err(Error::bvh(
                 line,
                 format!(
-                    "duplicate joint name '{name}' (first at line {})",
-                    prev.line
+                    "duplicate joint name '{}' (first at line {})",
+                    echo(name),
+                    self.joints[prev].line
                 ),
             ));
         }
+        self.index.insert(name.to_string(), self.joints.len());
         self.joints.push(JointDef {
             name: name.to_string(),
             parent,
@@ -278,7 +386,7 @@ impl HeaderParser {
                 if !self.has_offset[j] {
                     return Err(Error::bvh(
                         line,
-                        format!("joint '{}' has no OFFSET", self.joints[j].name),
+                        format!("joint '{}' has no OFFSET", echo(&self.joints[j].name)),
                     ));
                 }
                 if self.stack.is_empty() {
@@ -290,7 +398,7 @@ impl HeaderParser {
                 if !self.end_offset_seen {
                     return Err(Error::bvh(
                         line,
-                        format!("End Site of '{}' has no OFFSET", self.joints[j].name),
+                        format!("End Site of '{}' has no OFFSET", echo(&self.joints[j].name)),
                     ));
                 }
                 Ok(())
@@ -347,7 +455,7 @@ impl HeaderParser {
         let n: usize = n_tok.parse().map_err(|_| {
             Error::bvh(
                 line,
-                format!("CHANNELS count '{n_tok}' is not a whole number"),
+                format!("CHANNELS count '{}' is not a whole number", echo(n_tok)),
             )
         })?;
         let names: Vec<&str> = toks.collect();
@@ -360,9 +468,12 @@ impl HeaderParser {
         let mut chans = Vec::with_capacity(n);
         for name in names {
             let c = Channel::from_name(name)
-                .ok_or_else(|| Error::bvh(line, format!("unknown channel '{name}'")))?;
+                .ok_or_else(|| Error::bvh(line, format!("unknown channel '{}'", echo(name))))?;
             if chans.contains(&c) {
-                return Err(Error::bvh(line, format!("channel '{name}' listed twice")));
+                return Err(Error::bvh(
+                    line,
+                    format!("channel '{}' listed twice", echo(name)),
+                ));
             }
             chans.push(c);
         }
@@ -386,13 +497,10 @@ impl HeaderParser {
 }
 
 /// Parse `Frames:` (optional, advisory) and `Frame Time:`.
-fn read_motion_header<R: BufRead>(
-    rdr: &mut R,
-    lines: &mut LineReader,
-) -> Result<(Option<u64>, f64)> {
+fn read_motion_header<R: Read>(lines: &mut LineReader<R>) -> Result<(Option<u64>, f64)> {
     let mut frames = None;
     loop {
-        if !lines.next(rdr)? {
+        if !lines.next()? {
             return Err(Error::bvh(
                 lines.line,
                 "truncated: end of file before 'Frame Time:'",
@@ -410,36 +518,39 @@ fn read_motion_header<R: BufRead>(
             if dt <= 0.0 {
                 return Err(Error::bvh(
                     lines.line,
-                    format!("Frame Time must be positive, found {v}"),
+                    format!("Frame Time must be positive, found {}", echo(v)),
                 ));
             }
             if !(MIN_FRAME_TIME_S..=MAX_FRAME_TIME_S).contains(&dt) {
                 return Err(Error::bvh(
                     lines.line,
-                    format!("Frame Time {v} s is outside 1e-5 to 10 s per frame"),
+                    format!("Frame Time {} s is outside 1e-5 to 10 s per frame", echo(v)),
                 ));
             }
             return Ok((frames, dt));
         } else if let Some(v) = lower.strip_prefix("frames") {
             let v = v.trim_start().strip_prefix(':').unwrap_or(v).trim();
             let n: u64 = v.parse().map_err(|_| {
-                Error::bvh(lines.line, format!("Frames: '{v}' is not a whole number"))
+                Error::bvh(
+                    lines.line,
+                    format!("Frames: '{}' is not a whole number", echo(v)),
+                )
             })?;
             frames = Some(n);
         } else {
             return Err(Error::bvh(
                 lines.line,
-                format!("expected 'Frames:' or 'Frame Time:', found '{t}'"),
+                format!("expected 'Frames:' or 'Frame Time:', found '{}'", echo(t)),
             ));
         }
     }
 }
 
 /// Read every data row; values are appended row-major.
-fn read_rows<R: BufRead>(rdr: &mut R, lines: &mut LineReader, n: usize) -> Result<Vec<f64>> {
+fn read_rows<R: Read>(lines: &mut LineReader<R>, n: usize) -> Result<Vec<f64>> {
     let mut values = Vec::new();
     let mut short: Option<(usize, usize)> = None;
-    while lines.next(rdr)? {
+    while lines.next()? {
         let start = values.len();
         let count = parse_row(&lines.buf, &mut values, lines.line)?;
         if count == 0 {
@@ -474,6 +585,14 @@ fn read_rows<R: BufRead>(rdr: &mut R, lines: &mut LineReader, n: usize) -> Resul
     Ok(values)
 }
 
+/// [`echo`] of raw bytes, converting only the prefix that can be shown.
+fn echo_bytes(raw: &[u8]) -> String {
+    // 4 bytes per character at most: this prefix holds more than MAX_ECHO_CHARS of them.
+    echo(&String::from_utf8_lossy(
+        &raw[..raw.len().min(4 * MAX_ECHO_CHARS + 4)],
+    ))
+}
+
 /// Split one row on ASCII whitespace and parse every token; returns the token count.
 fn parse_row(buf: &[u8], out: &mut Vec<f64>, line: usize) -> Result<usize> {
     let mut count = 0;
@@ -496,21 +615,13 @@ fn parse_row(buf: &[u8], out: &mut Vec<f64>, line: usize) -> Result<usize> {
             Ok(_) => {
                 return Err(Error::bvh(
                     line,
-                    format!(
-                        "value {}: non-finite '{}'",
-                        count + 1,
-                        String::from_utf8_lossy(tok)
-                    ),
+                    format!("value {}: non-finite '{}'", count + 1, echo_bytes(tok)),
                 ))
             }
             Err(_) => {
                 return Err(Error::bvh(
                     line,
-                    format!(
-                        "value {}: '{}' is not a number",
-                        count + 1,
-                        String::from_utf8_lossy(tok)
-                    ),
+                    format!("value {}: '{}' is not a number", count + 1, echo_bytes(tok)),
                 ))
             }
         }

@@ -9,8 +9,8 @@ use crate::contacts::flight::{clip_summary, curvature_inside, fit_run, Flight};
 use crate::contacts::options::{STATIC_MIN_GAP_S, STATIC_MIN_ON_S};
 use crate::contacts::support::{is_missed_support, speed_led, SpeedLedRule};
 use crate::contacts::{floor, raw_speed, runs, EFFECTORS};
-use crate::error::{Error, Result};
-use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
+use crate::error::{echo, Error, Result};
+use crate::math::savgol::{SavGol, DEFAULT_ORDER};
 use crate::math::stats::median;
 use crate::skeleton::com::{com, BodyPoints, SidePoints};
 use crate::skeleton::landmarks::{leg_length, Landmarks, Limb, ToeTipRule};
@@ -123,6 +123,16 @@ pub(super) fn run(
         [lm.left.hip, lm.left.knee, lm.left.ankle],
         [lm.right.hip, lm.right.knee, lm.right.ankle],
     ];
+    for leg in legs {
+        if !leg_length(rest_file, [leg, leg]).is_finite() {
+            let names = leg.map(|p| echo(&skel.point_name(p)));
+            return Err(Error::non_finite(
+                "rest-pose leg length",
+                None,
+                Some(names.join("–")),
+            ));
+        }
+    }
     let leg_file = leg_length(rest_file, legs);
     let (scale, unit_name) = match opts.unit_m {
         Some(u) => (u, "override".to_string()),
@@ -155,15 +165,23 @@ pub(super) fn run(
     };
     let to_int = |p: V3| up.to_internal(p).map(|v| v * scale);
     pts.iter_mut().for_each(|p| *p = to_int(*p));
-    if let Some(k) = pts.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+    if let Some(k) = first_non_finite(&pts) {
         let (f, p) = (skip + k / np, k % np);
-        return Err(Error::skeleton(format!(
-            "non-finite position of '{}' at frame {f} (offsets or angles too large for f64)",
-            skel.point_name(p)
-        )));
+        return Err(Error::non_finite(
+            "position",
+            Some(f),
+            Some(echo(&skel.point_name(p))),
+        ));
     }
     let rest: Vec<V3> = rest_file.iter().map(|p| to_int(*p)).collect();
     let leg_m = leg_file * scale;
+    if !leg_m.is_finite() {
+        return Err(Error::non_finite(
+            "rest-pose leg length in metres",
+            None,
+            None,
+        ));
+    }
     summary.unit_scale = Some(scale);
     summary.unit = Some(unit_name);
     summary.up_axis = Some(up.as_str().to_string());
@@ -245,7 +263,14 @@ pub(super) fn run(
         );
     }
 
-    let sg = SavGol::new(window_for_rate(1.0 / dt), DEFAULT_ORDER).expect("window ≥ 5 is valid");
+    if let Some(f) = first_non_finite(&com_pos) {
+        // Name the fallback toe tip when it is the culprit (it scales with the leg length).
+        let joint = (0..2)
+            .find(|&k| !toe[k][f].iter().all(|v| v.is_finite()))
+            .map(|k| ["TTIP_L", "TTIP_R"][k].to_string());
+        return Err(Error::non_finite("COM", Some(skip + f), joint));
+    }
+    let sg = SavGol::for_frame_time(dt, DEFAULT_ORDER)?;
     let deriv = |d: usize| -> Vec<V3> {
         let cols: [Vec<f64>; 3] = std::array::from_fn(|i| {
             sg.apply(&com_pos.iter().map(|c| c[i]).collect::<Vec<_>>(), d, dt)
@@ -256,6 +281,11 @@ pub(super) fn run(
     };
     let com_v = deriv(1);
     let com_a = deriv(2);
+    for (what, d) in [("COM velocity", &com_v), ("COM acceleration", &com_a)] {
+        if let Some(f) = first_non_finite(d) {
+            return Err(Error::non_finite(what, Some(skip + f), None));
+        }
+    }
     let frame: Vec<i64> = (0..n).map(|f| (skip + f) as i64).collect();
     let time_s: Vec<f64> = frame.iter().map(|&f| f as f64 * dt).collect();
 
@@ -473,6 +503,11 @@ pub(super) fn run(
         joints,
     };
     Ok((frames, runs_out))
+}
+
+/// Index of the first point with a NaN or infinite coordinate.
+fn first_non_finite(pts: &[V3]) -> Option<usize> {
+    pts.iter().position(|p| !p.iter().all(|v| v.is_finite()))
 }
 
 /// `sk-` + the first 12 hex digits of SHA-256 over one `<name>\t<parent index>\n` line per

@@ -163,7 +163,10 @@ pub enum ClipOutcome {
 ///
 /// # Errors
 /// A partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that
-/// names no joint, or offsets and angles so large that positions overflow f64.
+/// names no joint (`ErrorKind::Skeleton`); a frame time so short that the smoothing window
+/// exceeds `MAX_SAVGOL_WINDOW` (`ErrorKind::Smoothing`, checked before any per-frame
+/// work); offsets and angles so large that a leg length, a position, the COM or its
+/// derivatives overflow f64 (`ErrorKind::NonFinite`, naming the first bad frame and joint).
 pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
     let m = &bvh.motion;
     let mut summary = ClipSummary {
@@ -187,7 +190,8 @@ pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
     summary.leadin_dropped = (0..skip as i64).collect();
     summary.frames_kept = (m.n_frames() - skip) as i64;
     summary.skeleton = Some(lm.describe(&skel));
-    let w = crate::math::savgol::window_for_rate(1.0 / m.frame_time_s);
+    // Refused before any per-frame work when above MAX_SAVGOL_WINDOW.
+    let w = crate::math::savgol::window_for_frame_time(m.frame_time_s)?;
     if m.n_frames() - skip < w {
         let reason = format!(
             "too short: {} kept frames, fewer than the SG window of {w}",

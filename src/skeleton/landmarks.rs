@@ -24,7 +24,7 @@ use std::collections::BTreeMap;
 
 use super::model::Skeleton;
 use super::names::{normalise_all, NormName, Side};
-use crate::error::{Error, Result};
+use crate::error::{echo, Error, Result};
 
 /// An End Site shorter than this fraction of `L_leg` counts as absent (spec §4.2).
 pub const DEGENERATE_END_SITE_FRACTION: f64 = 0.02;
@@ -270,6 +270,8 @@ pub enum Mapping {
 struct Finder<'a> {
     skel: &'a Skeleton,
     names: Vec<NormName>,
+    /// Depth of each joint (root 1), computed once: parents come before children.
+    depths: Vec<usize>,
     overrides: &'a BTreeMap<String, String>,
 }
 
@@ -291,7 +293,7 @@ impl Finder<'_> {
     }
 
     fn depth(&self, j: usize) -> usize {
-        std::iter::successors(Some(j), |&k| self.skel.parents[k]).count()
+        self.depths[j]
     }
 
     fn overridden(&self, key: &str) -> Result<Option<usize>> {
@@ -301,7 +303,12 @@ impl Finder<'_> {
         (0..self.skel.n_points())
             .find(|&p| self.skel.point_name(p) == *name)
             .map(Some)
-            .ok_or_else(|| Error::skeleton(format!("[landmarks] {key} = '{name}': no such joint")))
+            .ok_or_else(|| {
+                Error::skeleton(format!(
+                    "[landmarks] {key} = '{}': no such joint",
+                    echo(name)
+                ))
+            })
     }
 
     fn sided(&self, side: Side, keys: &[&str]) -> Vec<usize> {
@@ -408,6 +415,22 @@ impl Finder<'_> {
     }
 }
 
+/// Joint names shown in a mapping error: at most this many, then a count of the rest.
+const MAX_LISTED_JOINTS: usize = 40;
+
+/// The joint names, escaped, the first [`MAX_LISTED_JOINTS`] of them and a count of the rest.
+fn joint_list(names: &[String]) -> String {
+    let mut shown: Vec<String> = names
+        .iter()
+        .take(MAX_LISTED_JOINTS)
+        .map(|n| echo(n))
+        .collect();
+    if names.len() > MAX_LISTED_JOINTS {
+        shown.push(format!("… and {} more", names.len() - MAX_LISTED_JOINTS));
+    }
+    shown.join(", ")
+}
+
 impl Finder<'_> {
     /// Without a head joint: the neck chain, from its base (CERV: the unsided joint keyed
     /// `neck*`, else `lowerneck`, nearest the root; a `[landmarks]` CERV wins) up through
@@ -464,9 +487,16 @@ pub fn map(
     rest: &[[f64; 3]],
     overrides: &BTreeMap<String, String>,
 ) -> Result<Mapping> {
+    let mut depths: Vec<usize> = Vec::with_capacity(skel.n_joints());
+    for p in &skel.parents {
+        // parents[j] < j (file order), so the parent's depth is known.
+        let d = p.and_then(|p| depths.get(p)).map_or(1, |d| d + 1);
+        depths.push(d);
+    }
     let f = Finder {
         skel,
         names: normalise_all(&skel.names),
+        depths,
         overrides,
     };
     let legs = [f.leg(Side::L, "L")?, f.leg(Side::R, "R")?];
@@ -495,7 +525,7 @@ pub fn map(
         return Err(Error::skeleton(format!(
             "could not map landmarks {} (joints tried: {})",
             missing.join(", "),
-            skel.names.join(", ")
+            joint_list(&skel.names)
         )));
     }
     let leg_idx = legs.map(|l| l.map(|v| v.unwrap_or(0)));

@@ -71,7 +71,9 @@ pub fn detect_unit(leg_file: f64) -> (Unit, Option<String>) {
         .copied()
         .unwrap_or(("m", 1.0));
     let ratio = best.1 * leg_file / NOMINAL_LEG_M;
-    if leg_file > 0.0 && (1.0 / UNIT_ACCEPT_FACTOR..=UNIT_ACCEPT_FACTOR).contains(&ratio) {
+    // A non-finite leg length (OFFSETs overflowing f64) fits no unit; callers refuse it.
+    let usable = leg_file > 0.0 && leg_file.is_finite();
+    if usable && (1.0 / UNIT_ACCEPT_FACTOR..=UNIT_ACCEPT_FACTOR).contains(&ratio) {
         (
             Unit {
                 scale: best.1,
@@ -80,7 +82,7 @@ pub fn detect_unit(leg_file: f64) -> (Unit, Option<String>) {
             None,
         )
     } else {
-        let scale = if leg_file > 0.0 {
+        let scale = if usable {
             NOMINAL_LEG_M / leg_file
         } else {
             1.0

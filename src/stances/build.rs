@@ -13,7 +13,7 @@ use crate::force_model::{
 };
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};
 use crate::math::polyfit::{fit as poly_fit, fit_fixed_curvature};
-use crate::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
+use crate::math::savgol::{SavGol, DEFAULT_ORDER};
 use crate::math::spline::NaturalSpline;
 use crate::math::stats::median;
 
@@ -257,6 +257,10 @@ impl From<String> for StanceNote {
 /// frame takes that run's sub-frame event time ([`ContactRun::td_time_s`],
 /// [`ContactRun::lo_time_s`]); other edges, and an empty slice, use the frame edges
 /// (half a frame outside the stance's first and last frame).
+///
+/// A clip whose smoothing filter cannot be built (a frame time beyond
+/// `MAX_SAVGOL_WINDOW`) or that is shorter than the window gives no stances and one
+/// failed note (an `errors.parquet` row), never nothing silently.
 pub fn build_clip(
     clip: &str,
     fr: &ClipFrames,
@@ -268,14 +272,26 @@ pub fn build_clip(
     let n = fr.frame.len();
     let dt = summary.frame_time_s;
     let mut warnings = Vec::new();
-    let Some(sg) = SavGol::new(window_for_rate(1.0 / dt), DEFAULT_ORDER) else {
-        return (Vec::new(), warnings);
+    let failed = |message: String| StanceNote {
+        message,
+        failed: true,
+    };
+    let sg = match SavGol::for_frame_time(dt, DEFAULT_ORDER) {
+        Ok(sg) => sg,
+        Err(e) => {
+            warnings.push(failed(format!("cannot build the smoothing filter: {e}")));
+            return (Vec::new(), warnings);
+        }
     };
     let smooth: Vec<V3> = {
         let cols: [Vec<f64>; 3] = std::array::from_fn(|i| {
             sg.apply(&fr.com.iter().map(|c| c[i]).collect::<Vec<_>>(), 0, dt)
         });
         if cols[0].len() != n {
+            warnings.push(failed(format!(
+                "{n} frames, fewer than the smoothing window of {} frames",
+                sg.window()
+            )));
             return (Vec::new(), warnings);
         }
         (0..n)
