@@ -178,3 +178,31 @@ pub fn file_sha256(path: &Path) -> Option<String> {
     std::io::copy(&mut f, &mut h).ok()?;
     Some(hex(&h.finalize()))
 }
+
+/// Worker threads allowed per core: `--threads` and the pipeline's `threads` are at most
+/// this many times `std::thread::available_parallelism()` (each worker holds one clip
+/// in memory; more threads than that only add memory and switching).
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// The largest accepted thread count: [`MAX_THREADS_PER_CORE`] × the cores available.
+pub fn max_threads() -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    MAX_THREADS_PER_CORE * cores
+}
+
+/// Checks a requested worker count (0 = all cores) against [`max_threads`].
+///
+/// # Errors
+/// [`ErrorKind::Limit`] naming `field`.
+pub fn check_threads(field: &str, threads: usize) -> Result<()> {
+    if threads > max_threads() {
+        return Err(Error::limit(
+            field,
+            "threads",
+            threads as f64,
+            max_threads(),
+            "MAX_THREADS_PER_CORE × cores",
+        ));
+    }
+    Ok(())
+}

@@ -87,6 +87,19 @@ pub const DEFAULT_MU: f64 = 0.7;
 /// `I_v² ≤ SINGULAR_REL · |I|²` roughly (no vertical impulse: `u*` is not determined).
 pub const SINGULAR_REL: f64 = 1e-12;
 
+/// Checks a friction limit given by the user (`--mu`, `[constraints] mu`): a positive
+/// finite number.
+///
+/// # Errors
+/// What is wrong with `mu`, as a message.
+pub fn check_mu(mu: f64) -> Result<f64, String> {
+    if mu.is_finite() && mu > 0.0 {
+        Ok(mu)
+    } else {
+        Err(format!("μ must be a positive finite number, found {mu}"))
+    }
+}
+
 /// The limits of eq 6–8 for one query (§7.5).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limits {
@@ -111,6 +124,14 @@ pub enum LimitForm {
 }
 
 impl LimitForm {
+    /// `absolute` or `relative`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LimitForm::Absolute => "absolute",
+            LimitForm::Relative => "relative",
+        }
+    }
+
     /// `absolute` or `relative`; `None` otherwise.
     pub fn parse(s: &str) -> Option<Self> {
         match s {

@@ -19,7 +19,7 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
     let body = a.body.body.as_deref().map(load_body).transpose()?;
     let opts = BuildOptions {
         ingest: resolve(body.as_ref(), None, &cli),
-        stances: resolve_fit(None, a.body.stage_b),
+        stances: resolve_fit(None, a.fit.stage_b),
     };
     execute(
         &discover(&a.inputs)?,

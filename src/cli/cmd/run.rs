@@ -33,7 +33,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
     };
     let opts = crate::pipeline::build::BuildOptions {
         ingest: opts,
-        stances: crate::pipeline::spec::resolve_fit(Some(&pipe), a.body.stage_b),
+        stances: crate::pipeline::spec::resolve_fit(Some(&pipe), a.fit.stage_b),
     };
     let lib = relative_to(&a.pipeline, &pipe.out);
     let outcome = super::build::execute(&files, &lib, &opts, threads, a.incremental)?;
