@@ -15,6 +15,9 @@
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 //! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
 //! - `stances_truth`: stances of the fixtures against the generator's truth; Parquet round trip.
+//! - `safety_limits`: issue 11 items 6, 10, 11, 12: every documented work limit refused
+//!   before work (exit 2, field and limit named), pipelines validated before the library
+//!   is touched, no option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `twopac`: `equilibrium` and `twopac` on `fixtures/twopac/`: reference margins, boundary
 //!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
 mod bad_input;
@@ -30,6 +33,7 @@ mod queries;
 mod readers;
 mod real_data;
 mod regression;
+mod safety_limits;
 mod stances;
 mod stances_truth;
 mod twopac;
