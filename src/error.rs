@@ -109,6 +109,29 @@ pub enum ErrorKind {
         #[source]
         source: Option<Box<dyn std::error::Error + Send + Sync>>,
     },
+    /// An option or value is malformed or out of its range.
+    #[error("{field}: {msg}")]
+    Invalid {
+        /// The option, key or path (`--speeds`, `mu`).
+        field: String,
+        /// What is wrong, with the value found.
+        msg: String,
+    },
+    /// An input asks for more work or memory than a documented limit allows; checked
+    /// before the work starts (README "Limits").
+    #[error("{field}: {found} {what}, more than the limit of {max} ({limit})")]
+    Limit {
+        /// The option, key or path that asks for it (`--speeds`, `[queries] map_heights`).
+        field: String,
+        /// What is counted (`grid values`, `rows`).
+        what: &'static str,
+        /// The amount asked for (formatted: it may not fit an integer).
+        found: String,
+        /// The limit.
+        max: usize,
+        /// The name of the constant that defines the limit (`MAX_AXIS_VALUES`).
+        limit: &'static str,
+    },
 }
 
 impl Error {
@@ -184,6 +207,34 @@ impl Error {
         .into()
     }
 
+    /// A malformed or out-of-range value of `field`.
+    pub fn invalid(field: impl Into<String>, msg: impl Into<String>) -> Self {
+        ErrorKind::Invalid {
+            field: field.into(),
+            msg: msg.into(),
+        }
+        .into()
+    }
+
+    /// A limit error: `found` of `what` asked for by `field`, above `max` (the constant
+    /// named `limit`).
+    pub fn limit(
+        field: impl Into<String>,
+        what: &'static str,
+        found: f64,
+        max: usize,
+        limit: &'static str,
+    ) -> Self {
+        ErrorKind::Limit {
+            field: field.into(),
+            what,
+            found: count_text(found),
+            max,
+            limit,
+        }
+        .into()
+    }
+
     /// Attach a file path to a BVH or configuration error that has none.
     pub fn with_path(mut self, p: &std::path::Path) -> Self {
         match &mut self.kind {
@@ -226,6 +277,15 @@ pub fn echo(raw: &str) -> String {
         }
     }
     out
+}
+
+/// A count for a message: an integer while it is one, else in scientific notation.
+pub fn count_text(n: f64) -> String {
+    if n.is_finite() && n.abs() < 1e15 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.3e}")
+    }
 }
 
 impl From<ErrorKind> for Error {

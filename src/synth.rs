@@ -80,6 +80,10 @@ pub const MIN_FRAME_RATE_HZ: f64 = 10.0;
 pub const MAX_FRAME_RATE_HZ: f64 = 1000.0;
 /// Longest duration, s; a clip has at least one frame.
 pub const MAX_DURATION_S: f64 = 60.0;
+/// Smallest file unit, metres per file unit; smaller units are clamped.
+pub const MIN_UNIT_M: f64 = 1e-6;
+/// Largest file unit, metres per file unit; larger units are clamped.
+pub const MAX_UNIT_M: f64 = 1e6;
 /// Gravity of the force model, m/s².
 pub const GRAVITY_MPS2: f64 = 9.81;
 /// Highest platform under the right foot's first running stance, m.
@@ -675,7 +679,7 @@ fn sanitize(opts: &SynthOptions) -> (f64, i64, f64) {
     let rate = rate.clamp(MIN_FRAME_RATE_HZ, MAX_FRAME_RATE_HZ);
     let dur = or(opts.duration_s, DEFAULT_DURATION_S).clamp(0.0, MAX_DURATION_S);
     let unit = Some(opts.unit_m).filter(|u| *u > 0.0 && u.is_finite());
-    let unit = unit.map_or(DEFAULT_UNIT_M, |u| u.clamp(1e-6, 1e6));
+    let unit = unit.map_or(DEFAULT_UNIT_M, |u| u.clamp(MIN_UNIT_M, MAX_UNIT_M));
     (rate, ((dur * rate).round() as i64).max(1), unit)
 }
 

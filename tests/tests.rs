@@ -22,6 +22,9 @@
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 //! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
 //! - `stances_truth`: stances of the fixtures against the generator's truth; Parquet round trip.
+//! - `safety_limits`: issue 11 items 6, 10, 11, 12: every documented work limit refused
+//!   before work (exit 2, field and limit named), pipelines validated before the library
+//!   is touched, no option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `twopac`: `equilibrium` and `twopac` on `fixtures/twopac/`: reference margins, boundary
 //!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
 mod bad_input;
@@ -39,6 +42,7 @@ mod readers;
 mod real_data;
 mod regression;
 mod safety_inputs;
+mod safety_limits;
 mod safety_outputs;
 mod stances;
 mod stances_truth;

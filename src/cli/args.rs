@@ -6,8 +6,9 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::pipeline::spec::Overrides;
-use crate::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
+use crate::query::feasibility::{check_mu, LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::map::Axis;
+use crate::query::run::check_speed;
 use crate::skeleton::units::{parse_unit, UpAxis};
 
 /// stancelib: physically grounded stance libraries from motion-capture clips.
@@ -58,23 +59,13 @@ pub enum MapCommand {
     Jumps(MapJumpsArgs),
 }
 
-/// Parses `start:stop:step` (inclusive) into an axis.
+/// Parses `start:stop:step` (inclusive) given as option `flag` into an axis.
 ///
 /// # Errors
-/// Not three numbers, a step ≤ 0 or stop < start.
+/// Not three finite numbers, a step ≤ 0, stop < start, or more values than
+/// [`MAX_AXIS_VALUES`](crate::query::map::MAX_AXIS_VALUES).
 pub fn parse_range(flag: &str, s: &str) -> anyhow::Result<Axis> {
-    let parts: Vec<&str> = s.split(':').collect();
-    let nums: Option<Vec<f64>> = parts.iter().map(|p| p.trim().parse().ok()).collect();
-    match nums.as_deref() {
-        Some(&[start, stop, step])
-            if [start, stop, step].iter().all(|v| v.is_finite()) && step > 0.0 && stop >= start =>
-        {
-            Ok(Axis { start, stop, step })
-        }
-        _ => anyhow::bail!(
-            "{flag}: expected start:stop:step with step > 0 and stop ≥ start, found '{s}'"
-        ),
-    }
+    Ok(Axis::parse(flag, s)?)
 }
 
 /// The limit options shared by the queries (§7.5).
@@ -83,7 +74,8 @@ pub struct LimitArgs {
     /// Limit form: absolute (per character) or relative (per stance) (§7.5).
     #[arg(long, value_parser = ["absolute", "relative"])]
     pub limits: Option<String>,
-    /// Friction limit μ of the absolute form (default 0.7).
+    /// Friction limit μ, under either form: it replaces the absolute 0.7 and the
+    /// relative 1.05 × the stance's own μ_req (force and extension limits keep the form).
     #[arg(long)]
     pub mu: Option<f64>,
     /// Active set of the friction check: where f_v ≥ FRACTION · max f_v (default 0.2, chosen
@@ -93,13 +85,13 @@ pub struct LimitArgs {
 }
 
 impl LimitArgs {
-    /// The limit form (`--limits`, else the query's `default`) and the absolute μ.
+    /// The limit form (`--limits`, else the query's `default`) and the given μ.
     ///
     /// # Errors
-    /// A μ that is negative or not finite.
+    /// A μ that is not a positive finite number.
     pub fn form(&self, default: LimitForm) -> anyhow::Result<(LimitForm, Option<f64>)> {
         if let Some(m) = self.mu {
-            anyhow::ensure!(m.is_finite() && m >= 0.0, "--mu must be ≥ 0, found {m}");
+            check_mu(m).map_err(|msg| crate::error::Error::invalid("--mu", msg))?;
         }
         let form = self.limits.as_deref().and_then(LimitForm::parse);
         Ok((form.unwrap_or(default), self.mu))
@@ -152,13 +144,13 @@ impl RunQueryArgs {
     /// # Errors
     /// Neither option, a bad range, or a negative or non-finite speed.
     pub fn speeds(&self) -> anyhow::Result<Vec<f64>> {
-        let v = match (&self.speeds, self.speed) {
-            (Some(r), _) => parse_range("--speeds", r)?.values(),
-            (None, Some(v)) => vec![v],
+        let (flag, v) = match (&self.speeds, self.speed) {
+            (Some(r), _) => ("--speeds", parse_range("--speeds", r)?.values()),
+            (None, Some(v)) => ("--speed", vec![v]),
             (None, None) => anyhow::bail!("give --speed V or --speeds start:stop:step"),
         };
-        if let Some(bad) = v.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-            anyhow::bail!("speeds must be finite and ≥ 0 m/s, found {bad}");
+        for s in &v {
+            check_speed(flag, *s)?;
         }
         Ok(v)
     }
@@ -255,20 +247,27 @@ pub struct BodyArgs {
     /// Also write joints.parquet (every joint's world position).
     #[arg(long)]
     pub joints: bool,
+    /// Worker threads (0 = all cores; at most 4 × the cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+/// Options of the stance stage (`build`, `run`; `frames` fits no force model).
+#[derive(Debug, Args, Clone, Default)]
+pub struct FitArgs {
     /// Stance force model: `ratio` (default; friction-faithful) or `fourier` (the paper's).
     #[arg(long = "force-model", value_parser = parse_force_model)]
     pub force_model: Option<ForceModelKind>,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
 }
 
 impl BodyArgs {
     /// Validate into overrides.
     ///
     /// # Errors
-    /// A mass, unit or up axis that does not parse.
+    /// A mass, unit or up axis that does not parse; more threads than
+    /// [`max_threads`](crate::pipeline::batch::max_threads).
     pub fn overrides(&self) -> anyhow::Result<Overrides> {
+        crate::pipeline::batch::check_threads("--threads", self.threads)?;
         let mass_kg = match self.mass {
             Some(m) if !(m.is_finite() && m > 0.0) => {
                 anyhow::bail!("--mass must be a positive number of kg, found {m}")
@@ -332,6 +331,9 @@ pub struct BuildArgs {
     /// Body and contact options.
     #[command(flatten)]
     pub body: BodyArgs,
+    /// Stance-stage options.
+    #[command(flatten)]
+    pub fit: FitArgs,
 }
 
 /// `stancelib run`.
@@ -349,6 +351,9 @@ pub struct RunArgs {
     /// Body and contact options (override the pipeline file).
     #[command(flatten)]
     pub body: BodyArgs,
+    /// Stance-stage options (override the pipeline file's `[fit]`).
+    #[command(flatten)]
+    pub fit: FitArgs,
 }
 
 /// `stancelib synth`.
@@ -403,8 +408,8 @@ pub struct TwopacArgs {
     /// Library folder with `kinematics.parquet` (for named kinematic polytopes).
     #[arg(long)]
     pub lib: Option<PathBuf>,
-    /// Character of the library's polytopes (default: the only one).
-    #[arg(long)]
+    /// Character of the library's polytopes (default: the only one; needs `--lib`).
+    #[arg(long, requires = "lib")]
     pub character: Option<String>,
     /// Transition QP form: `eq13` (equality form, default) or `eq6` (H-representation).
     #[arg(long, default_value = "eq13")]

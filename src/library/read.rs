@@ -26,6 +26,17 @@ pub fn read_parquet(path: &Path) -> Result<DataFrame> {
         .map_err(|e| Error::io(path, "cannot read parquet", e))
 }
 
+/// The number of rows of a Parquet file, from its footer (nothing else is read).
+///
+/// # Errors
+/// The file cannot be opened or is not valid Parquet.
+pub fn parquet_rows(path: &Path) -> Result<usize> {
+    let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
+    ParquetReader::new(f)
+        .num_rows()
+        .map_err(|e| Error::io(path, "cannot read parquet", e))
+}
+
 /// A table read from a file: typed column access whose errors name the file and column.
 pub struct Table {
     /// The file it came from.

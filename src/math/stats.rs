@@ -40,7 +40,8 @@ pub fn median(v: &[f64]) -> Option<f64> {
 pub fn running_percentile(v: &[f64], half: usize, p: f64) -> Vec<f64> {
     let n = v.len();
     let mut out = Vec::with_capacity(n);
-    let mut win: Vec<f64> = Vec::with_capacity(2 * half + 1);
+    // The window never holds more than the whole series (`half` may be huge).
+    let mut win: Vec<f64> = Vec::with_capacity(half.saturating_mul(2).saturating_add(1).min(n));
     let (mut lo, mut hi) = (0usize, 0usize); // window holds v[lo..hi]
     for i in 0..n {
         let want_hi = (i + half + 1).min(n);
@@ -86,5 +87,14 @@ mod tests {
             let hi = (i + 14).min(v.len());
             assert_eq!(*ri, percentile(&v[lo..hi], 5.0).unwrap());
         }
+    }
+
+    // See: issue 11 item 6 — a huge floor window (`floor_window_s = 1e9`) made this
+    // reserve 2·half + 1 values before looking at the series.
+    #[test]
+    fn running_percentile_with_a_huge_window_is_the_whole_series() {
+        let v = [3.0, 1.0, 2.0];
+        let r = running_percentile(&v, usize::MAX / 2, 50.0);
+        assert_eq!(r, vec![2.0; 3]);
     }
 }

@@ -12,7 +12,7 @@ use sha2::{Digest, Sha256};
 use super::inputs::open_input;
 pub use super::inputs::{check_input, discover, none_readable, InputProblem, MAX_BVH_BYTES};
 use super::names::clip_names;
-use crate::error::{Error, ErrorKind};
+use crate::error::{Error, ErrorKind, Result};
 use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions};
 use crate::library::{ClipRecord, Status};
 
@@ -153,4 +153,32 @@ pub fn file_sha256(path: &Path) -> Option<String> {
     let mut h = Sha256::new();
     let n = std::io::copy(&mut f.take(MAX_BVH_BYTES + 1), &mut h).ok()?;
     (n <= MAX_BVH_BYTES).then(|| hex(&h.finalize()))
+}
+
+/// Worker threads allowed per core: `--threads` and the pipeline's `threads` are at most
+/// this many times `std::thread::available_parallelism()` (each worker holds one clip
+/// in memory; more threads than that only add memory and switching).
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// The largest accepted thread count: [`MAX_THREADS_PER_CORE`] × the cores available.
+pub fn max_threads() -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    MAX_THREADS_PER_CORE * cores
+}
+
+/// Checks a requested worker count (0 = all cores) against [`max_threads`].
+///
+/// # Errors
+/// [`ErrorKind::Limit`] naming `field`.
+pub fn check_threads(field: &str, threads: usize) -> Result<()> {
+    if threads > max_threads() {
+        return Err(Error::limit(
+            field,
+            "threads",
+            threads as f64,
+            max_threads(),
+            "MAX_THREADS_PER_CORE × cores",
+        ));
+    }
+    Ok(())
 }

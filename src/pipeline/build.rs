@@ -25,12 +25,14 @@ use crate::ingest::IngestOptions;
 use crate::library::kinematics::kinematics_tables;
 use crate::library::read::read_parquet;
 use crate::library::schema::{
-    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, KINEMATICS_FILE, KINEMATICS_POINTS_FILE,
-    MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
+    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, KINEMATICS_FILE,
+    KINEMATICS_POINTS_FILE, MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
-use crate::library::write::{clips_table, contacts_table, frames_table, write_atomic};
+use crate::library::write::{
+    clips_table, contacts_table, frames_table, joints_table, write_atomic,
+};
 use crate::library::{ClipRecord, Status};
 use crate::stances::build::StanceNote;
 use crate::stances::limits::{limits, ClipFacts, Limits, StanceFacts};
@@ -130,13 +132,14 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport 
     }
 }
 
-/// The five tables of a library, in memory.
+/// The tables of a library, in memory: five always, `joints.parquet` with `--joints`.
 struct Tables {
     frames: DataFrame,
     contacts: DataFrame,
     clips: DataFrame,
     stances: DataFrame,
     errors: DataFrame,
+    joints: Option<DataFrame>,
 }
 
 fn pe(name: &str, e: PolarsError) -> Error {
@@ -144,31 +147,41 @@ fn pe(name: &str, e: PolarsError) -> Error {
 }
 
 impl Tables {
-    fn from_report(r: &BuildReport) -> Result<Tables> {
+    /// The tables of a build; `joints.parquet` too when the ingest kept joint positions
+    /// (`--joints`: the same table as `frames --joints` writes).
+    fn from_report(r: &BuildReport, joints: bool) -> Result<Tables> {
         Ok(Tables {
             frames: frames_table(&r.records).map_err(|e| pe(FRAMES_FILE, e))?,
             contacts: contacts_table(&r.records).map_err(|e| pe(CONTACTS_FILE, e))?,
             clips: clips_table(&r.records).map_err(|e| pe(CLIPS_FILE, e))?,
             stances: stances_table(&r.stances).map_err(|e| pe(STANCES_FILE, e))?,
             errors: errors_table(&r.errors).map_err(|e| pe(ERRORS_FILE, e))?,
+            joints: joints
+                .then(|| joints_table(&r.records).map_err(|e| pe(JOINTS_FILE, e)))
+                .transpose()?,
         })
     }
 
-    fn named(&mut self) -> [(&'static str, &mut DataFrame); 5] {
-        [
+    fn named(&mut self) -> Vec<(&'static str, &mut DataFrame)> {
+        let mut v = vec![
             (FRAMES_FILE, &mut self.frames),
             (CONTACTS_FILE, &mut self.contacts),
             (CLIPS_FILE, &mut self.clips),
             (STANCES_FILE, &mut self.stances),
             (ERRORS_FILE, &mut self.errors),
-        ]
+        ];
+        if let Some(j) = &mut self.joints {
+            v.push((JOINTS_FILE, j));
+        }
+        v
     }
 }
 
 /// Sort keys per table (the order a full build writes).
 fn sort_keys(name: &str) -> &'static [&'static str] {
     match name {
-        FRAMES_FILE => &["clip", "frame"],
+        // Joint rows keep the skeleton's order within a frame (the sort is stable).
+        FRAMES_FILE | JOINTS_FILE => &["clip", "frame"],
         CONTACTS_FILE => &["clip", "effector", "first_frame"],
         CLIPS_FILE => &["clip"],
         STANCES_FILE => &["clip", "first_frame", "label"],
@@ -360,7 +373,7 @@ pub fn build_into(
         .cloned()
         .collect();
     let report = build_named(&todo, opts);
-    let mut tables = Tables::from_report(&report)?;
+    let mut tables = Tables::from_report(&report, opts.ingest.joints)?;
     if !reuse.is_empty() {
         for (name, df) in tables.named() {
             let old = previous_rows(out, name, &reuse, df)?;
@@ -384,7 +397,7 @@ pub fn write_library(out: &Path, report: &BuildReport, opts: &BuildOptions) -> R
         .map(|r| PathBuf::from(&r.path))
         .collect();
     let _claim = claim(out, &files, &OutputRules::default())?;
-    let mut tables = Tables::from_report(report)?;
+    let mut tables = Tables::from_report(report, opts.ingest.joints)?;
     let lim = limits_of(&tables);
     replace_library(out, &mut tables, &lim, &opts.fingerprint(), Instant::now())
 }

@@ -14,8 +14,14 @@ use serde::Deserialize;
 
 use crate::contacts::ContactOptions;
 use crate::error::{Error, Result};
+use crate::force_model::fit::{MAX_SAMPLES, MIN_SAMPLES};
 use crate::ingest::{IngestOptions, DEFAULT_MASS_KG};
+use crate::pipeline::batch::check_threads;
+use crate::query::feasibility::check_mu;
+use crate::query::map::{check_grid, Axis, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};
+use crate::query::run::{check_scale, check_speed};
 use crate::skeleton::com::Sex;
+use crate::skeleton::landmarks::LANDMARK_KEYS;
 use crate::skeleton::units::{parse_unit, UpAxis};
 use crate::stances::StanceOptions;
 
@@ -176,6 +182,22 @@ fn read(path: &Path) -> Result<String> {
 pub fn parse_body(path: &Path, text: &str) -> Result<BodyFile> {
     let b: BodyFile = parse_toml(path, text)?;
     check_common(path, text, b.mass_kg, b.unit.as_ref(), b.up_axis.as_deref())?;
+    if let Some(k) = b
+        .landmarks
+        .iter()
+        .flat_map(|m| m.keys())
+        .find(|k| !LANDMARK_KEYS.contains(&k.as_str()))
+    {
+        let msg = format!(
+            "[landmarks] {k}: not a landmark (one of {})",
+            LANDMARK_KEYS.join(", ")
+        );
+        return Err(Error::config(
+            Some(path.to_path_buf()),
+            key_line(text, k),
+            msg,
+        ));
+    }
     if let Some(s) = &b.sex {
         if Sex::parse(s).is_none() {
             let msg = format!("sex must be male, female or average, found '{s}'");
@@ -292,8 +314,13 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
         if f.energy.is_some_and(|e| !(0.0..=1.0).contains(&e)) {
             return Err(bad("energy", "energy must lie in [0, 1]".into()));
         }
-        if f.samples.is_some_and(|n| !(2..=1 << 20).contains(&n)) {
-            return Err(bad("samples", "samples must lie in [2, 1048576]".into()));
+        if f.samples
+            .is_some_and(|n| !(MIN_SAMPLES..=MAX_SAMPLES).contains(&(n as usize)))
+        {
+            return Err(bad(
+                "samples",
+                format!("samples must lie in [{MIN_SAMPLES}, {MAX_SAMPLES}] (MAX_SAMPLES)"),
+            ));
         }
         if f.max_harmonics == Some(0) {
             return Err(bad(
@@ -310,7 +337,103 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
             ));
         }
     }
+    check_values(&p).map_err(|(key, e)| bad(key, e.to_string()))?;
     Ok(p)
+}
+
+/// Range checks of every value the serde types let through (issue 11 item 10): the whole
+/// file is valid before any work starts. On failure: the key (for its line) and why.
+fn check_values(p: &PipelineFile) -> std::result::Result<(), (&'static str, Error)> {
+    let at = |key: &'static str| move |e: Error| (key, e);
+    if let Some(t) = p.threads {
+        check_threads("threads", t).map_err(at("threads"))?;
+    }
+    if let Some(c) = &p.contacts {
+        for (key, v, positive) in [
+            ("foot_h_on", c.foot_h_on, false),
+            ("foot_h_off", c.foot_h_off, false),
+            ("foot_v_on", c.foot_v_on, false),
+            ("foot_v_off", c.foot_v_off, false),
+            ("hand_h_on", c.hand_h_on, false),
+            ("hand_h_off", c.hand_h_off, false),
+            ("hand_v_on", c.hand_v_on, false),
+            ("hand_v_off", c.hand_v_off, false),
+            ("min_on_s", c.min_on_s, false),
+            ("min_gap_s", c.min_gap_s, false),
+            ("floor_window_s", c.floor_window_s, true),
+        ] {
+            let Some(v) = v else { continue };
+            if !(v.is_finite() && (v > 0.0 || (!positive && v == 0.0))) {
+                let want = if positive { "> 0" } else { "≥ 0" };
+                let msg = format!("must be a finite number {want}, found {v}");
+                return Err((key, Error::invalid(format!("[contacts] {key}"), msg)));
+            }
+        }
+    }
+    let has_queries = p
+        .queries
+        .as_ref()
+        .is_some_and(|q| q.run_speeds.is_some() || q.jump_map == Some(true));
+    if let Some(c) = &p.constraints {
+        if let Some(mu) = c.mu {
+            check_mu(mu).map_err(|m| ("mu", Error::invalid("[constraints] mu", m)))?;
+        }
+        if !has_queries && (c.mu.is_some() || c.limits.is_some()) {
+            let key = if c.mu.is_some() { "mu" } else { "limits" };
+            let msg = "has no effect: no [queries] stage runs (give run_speeds or jump_map = true)";
+            return Err((key, Error::invalid(format!("[constraints] {key}"), msg)));
+        }
+    }
+    if let Some(q) = &p.queries {
+        check_queries(q)?;
+    }
+    Ok(())
+}
+
+/// `[queries]`: ranges within the grid limits, positive scales, no key without its stage.
+fn check_queries(q: &QueriesTable) -> std::result::Result<(), (&'static str, Error)> {
+    let unused = |key: &'static str, stage: &str| {
+        let msg = format!("has no effect without {stage}");
+        Err((key, Error::invalid(format!("[queries] {key}"), msg)))
+    };
+    match &q.run_speeds {
+        Some(r) => {
+            let axis = Axis::parse("[queries] run_speeds", r).map_err(|e| ("run_speeds", e))?;
+            check_speed("[queries] run_speeds", axis.start).map_err(|e| ("run_speeds", e))?;
+        }
+        None if q.length_scale.is_some() => return unused("length_scale", "run_speeds"),
+        None if q.mass_scale.is_some() => return unused("mass_scale", "run_speeds"),
+        None => {}
+    }
+    for (key, v) in [
+        ("length_scale", q.length_scale),
+        ("mass_scale", q.mass_scale),
+    ] {
+        if let Some(v) = v {
+            check_scale(&format!("[queries] {key}"), v).map_err(|e| (key, e))?;
+        }
+    }
+    if q.jump_map != Some(true) {
+        if q.map_heights.is_some() {
+            return unused("map_heights", "jump_map = true");
+        }
+        if q.map_speeds.is_some() {
+            return unused("map_speeds", "jump_map = true");
+        }
+        return Ok(());
+    }
+    let axis = |key: &'static str, v: &Option<String>, default: Axis| match v {
+        Some(r) => Axis::parse(&format!("[queries] {key}"), r).map_err(|e| (key, e)),
+        None => Ok(default),
+    };
+    let h = axis("map_heights", &q.map_heights, DEFAULT_HEIGHTS)?;
+    let u = axis("map_speeds", &q.map_speeds, DEFAULT_SPEEDS)?;
+    let key = if q.map_speeds.is_some() {
+        "map_speeds"
+    } else {
+        "map_heights"
+    };
+    check_grid("[queries] map_heights × map_speeds", h.len(), u.len()).map_err(|e| (key, e))
 }
 
 /// Read and parse a pipeline file.
@@ -487,6 +610,95 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("x.toml:2:"), "{e}");
+    }
+
+    fn pipeline_error(extra: &str) -> String {
+        let text = format!("inputs = [\"a\"]\nout = \"o\"\n{extra}");
+        parse_pipeline(Path::new("x.toml"), &text)
+            .unwrap_err()
+            .to_string()
+    }
+
+    // See: issue 11 item 10 — every value range-checked (`[constraints] mu = -1` was
+    // accepted) and keys without effect refused, each at its line.
+    #[test]
+    fn values_are_range_checked_at_their_line() {
+        let q = "[queries]\nrun_speeds = \"0:6:0.5\"\n";
+        for (extra, line, needle) in [
+            (
+                format!("[constraints]\nmu = -1\n{q}"),
+                4,
+                "[constraints] mu",
+            ),
+            (
+                format!("[constraints]\nmu = nan\n{q}"),
+                4,
+                "[constraints] mu",
+            ),
+            (
+                "[constraints]\nmu = 0.5\n".to_string(),
+                4,
+                "no [queries] stage",
+            ),
+            ("threads = 1000000\n".to_string(), 3, "MAX_THREADS_PER_CORE"),
+            (
+                "[contacts]\nfloor_window_s = 0\n".to_string(),
+                4,
+                "floor_window_s",
+            ),
+            ("[contacts]\nfoot_v_off = -2\n".to_string(), 4, "foot_v_off"),
+            (
+                "[queries]\nrun_speeds = \"0:6:0\"\n".to_string(),
+                4,
+                "run_speeds",
+            ),
+            ("[queries]\nrun_speeds = \"-1:6:1\"\n".to_string(), 4, "≥ 0"),
+            (format!("{q}mass_scale = 0\n"), 5, "mass_scale"),
+            (
+                "[queries]\nmass_scale = 2\n".to_string(),
+                4,
+                "without run_speeds",
+            ),
+            (
+                "[queries]\njump_map = true\nmap_heights = \"0:1:1e-9\"\n".to_string(),
+                5,
+                "MAX_AXIS_VALUES",
+            ),
+            (
+                "[queries]\njump_map = false\nmap_heights = \"0:1:0.1\"\n".to_string(),
+                5,
+                "jump_map = true",
+            ),
+            ("[fit]\nsamples = 1\n".to_string(), 4, "MAX_SAMPLES"),
+        ] {
+            let e = pipeline_error(&extra);
+            assert!(e.starts_with(&format!("x.toml:{line}: ")), "{extra}: {e}");
+            assert!(e.contains(needle), "{extra}: {e}");
+        }
+        let p = Path::new("x.toml");
+        let good =
+            "inputs = [\"a\"]\nout = \"o\"\n[constraints]\nmu = 0.3\n[queries]\njump_map = true\n";
+        assert_eq!(
+            parse_pipeline(p, good).unwrap().constraints.unwrap().mu,
+            Some(0.3)
+        );
+    }
+
+    // See: issue 11 item 12 — duplicate TOML keys: the toml crate refuses them.
+    #[test]
+    fn duplicate_keys_are_refused_at_their_line() {
+        let e = pipeline_error("threads = 1\nthreads = 2\n");
+        assert!(
+            e.starts_with("x.toml:4: ") && e.contains("duplicate key"),
+            "{e}"
+        );
+        let e = parse_body(Path::new("b.toml"), "mass_kg = 70\nmass_kg = 80\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("b.toml:2: ") && e.contains("duplicate key"),
+            "{e}"
+        );
     }
 
     #[test]

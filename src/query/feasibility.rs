@@ -95,6 +95,19 @@ pub const SINGULAR_REL: f64 = 1e-12;
 /// stay at the paper's [`crate::constraints::ACTIVE_FRACTION`].
 pub const DEFAULT_QUERY_ACTIVE_FRACTION: f64 = 0.2;
 
+/// Checks a friction limit given by the user (`--mu`, `[constraints] mu`): a positive
+/// finite number.
+///
+/// # Errors
+/// What is wrong with `mu`, as a message.
+pub fn check_mu(mu: f64) -> Result<f64, String> {
+    if mu.is_finite() && mu > 0.0 {
+        Ok(mu)
+    } else {
+        Err(format!("μ must be a positive finite number, found {mu}"))
+    }
+}
+
 /// The limits of eq 6–8 for one query (§7.5).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limits {
@@ -119,6 +132,14 @@ pub enum LimitForm {
 }
 
 impl LimitForm {
+    /// `absolute` or `relative`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LimitForm::Absolute => "absolute",
+            LimitForm::Relative => "relative",
+        }
+    }
+
     /// `absolute` or `relative`; `None` otherwise.
     pub fn parse(s: &str) -> Option<Self> {
         match s {

@@ -20,6 +20,8 @@
 
 use rayon::prelude::*;
 
+use crate::error::{Error, Result};
+
 use super::feasibility::{relative_limits, Limits};
 use super::jump::Side;
 use super::jump::{
@@ -27,6 +29,16 @@ use super::jump::{
 };
 use super::pool::Prepared;
 use super::run::verdicts;
+
+/// Most values on one grid axis: `query run --speeds`, `map jumps --heights` and
+/// `--speeds`, and the pipeline's `run_speeds`, `map_heights`, `map_speeds` (count).
+pub const MAX_AXIS_VALUES: usize = 10_000;
+/// Most cells of a jump-map grid, heights × speeds (count).
+pub const MAX_GRID_CELLS: usize = 1_000_000;
+/// Most verdict cells of a whole jump map: grid cells × (pairs + stance grids), count.
+/// Each pair cell is one row of `jump_map.parquet`: about 80 bytes at the peak while the
+/// table is built (measured), so 1.6 GB at the limit.
+pub const MAX_MAP_CELLS: usize = 20_000_000;
 
 /// An inclusive grid `start, start + step, …, ≤ stop` (with a 1e-9·step slack on `stop`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,19 +52,94 @@ pub struct Axis {
 }
 
 impl Axis {
-    /// The values of the axis.
-    pub fn values(&self) -> Vec<f64> {
+    /// Parses `start:stop:step` (inclusive) given as `field` (an option or key name).
+    ///
+    /// # Errors
+    /// [`ErrorKind::Invalid`](crate::error::ErrorKind::Invalid): not three finite numbers,
+    /// a step ≤ 0 or stop < start; [`ErrorKind::Limit`](crate::error::ErrorKind::Limit):
+    /// more than [`MAX_AXIS_VALUES`] values.
+    pub fn parse(field: &str, s: &str) -> Result<Axis> {
+        let nums: Option<Vec<f64>> = s.split(':').map(|p| p.trim().parse().ok()).collect();
+        let axis = match nums.as_deref() {
+            Some(&[start, stop, step])
+                if [start, stop, step].iter().all(|v| v.is_finite())
+                    && step > 0.0
+                    && stop >= start =>
+            {
+                Axis { start, stop, step }
+            }
+            _ => {
+                return Err(Error::invalid(
+                    field,
+                    format!(
+                        "expected start:stop:step (finite numbers, step > 0, stop ≥ start), \
+                         found '{s}'"
+                    ),
+                ))
+            }
+        };
+        let n = axis.count_f64();
+        if n > MAX_AXIS_VALUES as f64 {
+            return Err(Error::limit(
+                field,
+                "grid values",
+                n,
+                MAX_AXIS_VALUES,
+                "MAX_AXIS_VALUES",
+            ));
+        }
+        Ok(axis)
+    }
+
+    /// Number of values, as a float (no overflow for any step; 0 for an invalid axis).
+    fn count_f64(&self) -> f64 {
         if !(self.step > 0.0 && self.start.is_finite() && self.stop.is_finite()) {
-            return Vec::new();
+            return 0.0;
         }
         let n = ((self.stop - self.start) / self.step + 1e-9).floor();
         if n < 0.0 {
-            return Vec::new();
+            0.0
+        } else {
+            n + 1.0
         }
-        (0..=n as usize)
+    }
+
+    /// Number of values, at most [`MAX_AXIS_VALUES`] + 1 (an axis beyond the limit
+    /// reports one more than it, so that checks against the limit fail).
+    pub fn len(&self) -> usize {
+        self.count_f64().min(MAX_AXIS_VALUES as f64 + 1.0) as usize
+    }
+
+    /// True when the axis has no value.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The values of the axis, at most [`MAX_AXIS_VALUES`] + 1 of them (see
+    /// [`Axis::parse`], which refuses longer axes).
+    pub fn values(&self) -> Vec<f64> {
+        (0..self.len())
             .map(|i| self.start + i as f64 * self.step)
             .collect()
     }
+}
+
+/// Checks a grid of `n_heights × n_speeds` cells against [`MAX_GRID_CELLS`].
+///
+/// # Errors
+/// [`ErrorKind::Limit`](crate::error::ErrorKind::Limit) naming `field`.
+pub fn check_grid(field: &str, n_heights: usize, n_speeds: usize) -> Result<()> {
+    let n = n_heights as f64 * n_speeds as f64;
+    if n > MAX_GRID_CELLS as f64 {
+        return Err(Error::limit(
+            field,
+            "grid cells (heights × speeds)",
+            n,
+            MAX_GRID_CELLS,
+            "MAX_GRID_CELLS",
+        ));
+    }
+    Ok(())
 }
 
 /// Default rows: apex height 0.60 to 1.60 m in 0.02 m steps (§6.10).
@@ -241,12 +328,18 @@ fn pair_map(
 ///
 /// Landings whose contact height differs from their liftoff's get their own grid per
 /// distinct height offset (level ground, the common case, shares one grid per stance).
+///
+/// # Errors
+/// [`ErrorKind::Limit`](crate::error::ErrorKind::Limit) before any work when the grid
+/// has more than [`MAX_GRID_CELLS`] cells or the map more than [`MAX_MAP_CELLS`]
+/// (cells × (pairs + stance grids)).
 pub fn jump_map(
     pool: &[Prepared],
     heights: &[f64],
     speeds: &[f64],
     limits: &(dyn Fn(&Prepared) -> Limits + Sync),
-) -> JumpMap {
+) -> Result<JumpMap> {
+    check_grid("jump map grid", heights.len(), speeds.len())?;
     let liftoffs: Vec<usize> = (0..pool.len())
         .filter(|&i| is_liftoff(&pool[i].stance))
         .collect();
@@ -272,6 +365,23 @@ pub fn jump_map(
         .collect();
     keys.sort_unstable();
     keys.dedup();
+    let cells = heights.len() as f64 * speeds.len() as f64;
+    let n = cells * (pair_list.len() + liftoffs.len() + keys.len()) as f64;
+    if n > MAX_MAP_CELLS as f64 {
+        return Err(Error::limit(
+            format!(
+                "jump map ({} pairs and {} stance grids of {} × {} cells)",
+                pair_list.len(),
+                liftoffs.len() + keys.len(),
+                heights.len(),
+                speeds.len()
+            ),
+            "verdict cells",
+            n,
+            MAX_MAP_CELLS,
+            "MAX_MAP_CELLS",
+        ));
+    }
     let down: Vec<StanceGrid> = keys
         .par_iter()
         .map(|&(b, bits)| {
@@ -301,14 +411,14 @@ pub fn jump_map(
     for p in &pairs {
         agreement.add(&p.agreement);
     }
-    JumpMap {
+    Ok(JumpMap {
         heights: heights.to_vec(),
         speeds: speeds.to_vec(),
         liftoffs,
         landings,
         pairs,
         agreement,
-    }
+    })
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@
 //! # References
 //! spec stance-model §6.8, §7.5, §8.3, §9; CORRECTIONS Issue 4 items 4–7.
 
+use crate::error::Error;
 use crate::force_model::GRAVITY;
 use crate::stances::segment::Boundary;
 
@@ -33,6 +34,52 @@ use super::solve::{solve, Refs, Request, Solution};
 pub const CHAIN_SPEED_FRACTION: f64 = 0.05;
 /// Chaining tolerance on the flight's apex height (absolute heights), m.
 pub const CHAIN_HEIGHT_M: f64 = 0.02;
+
+/// Most rows of one run sweep (`query run`, `[queries] run_speeds`): cycles × speeds,
+/// count. A row holds two stances' lists: about 1.3 kB at the peak while the table is
+/// built (measured), so 1.3 GB at the limit.
+pub const MAX_RUN_ROWS: usize = 1_000_000;
+
+/// Checks a sweep of `n_cycles` cycles at `n_speeds` speeds against [`MAX_RUN_ROWS`].
+///
+/// # Errors
+/// [`ErrorKind::Limit`](crate::error::ErrorKind::Limit) naming `field`.
+pub fn check_sweep(field: &str, n_cycles: usize, n_speeds: usize) -> Result<(), Error> {
+    let n = n_cycles as f64 * n_speeds as f64;
+    if n > MAX_RUN_ROWS as f64 {
+        let what = "rows (run cycles × speeds)";
+        return Err(Error::limit(field, what, n, MAX_RUN_ROWS, "MAX_RUN_ROWS"));
+    }
+    Ok(())
+}
+
+/// Checks a target speed of `field`: finite and ≥ 0 m/s.
+///
+/// # Errors
+/// [`ErrorKind::Invalid`](crate::error::ErrorKind::Invalid) naming `field`.
+pub fn check_speed(field: &str, v: f64) -> Result<f64, Error> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        let msg = format!("speeds must be finite and ≥ 0 m/s, found {v}");
+        Err(Error::invalid(field, msg))
+    }
+}
+
+/// Checks a §9 scale of `field` (length or mass ratio): positive and finite.
+///
+/// # Errors
+/// [`ErrorKind::Invalid`](crate::error::ErrorKind::Invalid) naming `field`.
+pub fn check_scale(field: &str, v: f64) -> Result<f64, Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::invalid(
+            field,
+            format!("must be a positive number, found {v}"),
+        ))
+    }
+}
 
 /// A recorded run cycle: two chained stances of one clip.
 #[derive(Debug, Clone, Copy, PartialEq)]

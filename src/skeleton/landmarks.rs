@@ -26,6 +26,13 @@ use super::model::Skeleton;
 use super::names::{normalise_all, NormName, Side};
 use crate::error::{echo, Error, Result};
 
+/// The landmark names a body file's `[landmarks]` table may map (README "Configuration
+/// files"); any other key would be ignored, so the body file refuses it.
+pub const LANDMARK_KEYS: [&str; 19] = [
+    "AJC_L", "AJC_R", "KJC_L", "KJC_R", "HJC_L", "HJC_R", "toe_L", "toe_R", "WJC_L", "WJC_R",
+    "EJC_L", "EJC_R", "SJC_L", "SJC_R", "MET3_L", "MET3_R", "head", "VERT", "CERV",
+];
+
 /// An End Site shorter than this fraction of `L_leg` counts as absent (spec §4.2).
 pub const DEGENERATE_END_SITE_FRACTION: f64 = 0.02;
 /// An End Site longer than this fraction of `L_leg` counts as absent too: no hand, toe or

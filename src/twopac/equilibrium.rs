@@ -45,6 +45,14 @@ pub const RANK_TOL_REL: f64 = 1e-9;
 pub const RANGE_TOL_REL: f64 = 1e-9;
 /// Collinearity tolerance of §4 for `degenerate_contacts`, m.
 pub const DEGENERATE_TOL_M: f64 = 1e-3;
+/// Most contacts of one contact set: a phase of `twopac --phases` or the file of
+/// `equilibrium --contacts` (count). The margin LP is dense in the 16 rays of a
+/// rectangle's corners: its memory grows with the square of the contacts.
+pub const MAX_CONTACTS: usize = 64;
+/// Most contact points of one contact set: [`MAX_CONTACTS`] rectangles of 4 corners.
+pub const MAX_CONTACT_POINTS: usize = 4 * MAX_CONTACTS;
+/// Most COM states of one `equilibrium --points` table (rows), one LP each.
+pub const MAX_COM_STATES: usize = 1_000_000;
 /// Force closure is declared when `max t s.t. G V β = 0, β ≥ t, t ≤ 1` exceeds this.
 pub const FORCE_CLOSURE_T: f64 = 0.5;
 
@@ -130,7 +138,7 @@ impl EqualityForm {
     ///
     /// # Errors
     ///
-    /// [`TwopacError::InvalidMass`] for a non-positive or non-finite mass.
+    /// As [`EqualityForm::from_points`].
     pub fn new(contacts: &[Contact], mass_kg: f64) -> Result<EqualityForm, TwopacError> {
         let points: Vec<ContactPoint> = contacts.iter().flat_map(Contact::points).collect();
         EqualityForm::from_points(points, mass_kg)
@@ -140,13 +148,22 @@ impl EqualityForm {
     ///
     /// # Errors
     ///
-    /// [`TwopacError::InvalidMass`] for a non-positive or non-finite mass.
+    /// [`TwopacError::InvalidMass`] for a non-positive or non-finite mass;
+    /// [`TwopacError::Limit`] for more than [`MAX_CONTACT_POINTS`] points.
     pub fn from_points(
         points: Vec<ContactPoint>,
         mass_kg: f64,
     ) -> Result<EqualityForm, TwopacError> {
         if !(mass_kg.is_finite() && mass_kg > 0.0) {
             return Err(TwopacError::InvalidMass { mass_kg });
+        }
+        if points.len() > MAX_CONTACT_POINTS {
+            return Err(TwopacError::Limit {
+                what: "contact points in one contact set",
+                found: points.len().to_string(),
+                max: MAX_CONTACT_POINTS,
+                limit: "MAX_CONTACT_POINTS",
+            });
         }
         let generators = generators(&points);
         let mu = min_mu(&points).unwrap_or(0.0);

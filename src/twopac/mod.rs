@@ -57,6 +57,7 @@ pub mod region;
 mod simplex;
 pub mod trajectory;
 pub mod transition;
+mod unique_keys;
 mod v3;
 pub mod validate;
 
@@ -115,6 +116,19 @@ pub enum TwopacError {
         n_points: usize,
         /// What is wrong.
         msg: String,
+    },
+    /// An input asks for more work than a documented limit allows (checked before the
+    /// work starts; README "Limits").
+    #[error("{found} {what}, more than the limit of {max} ({limit})")]
+    Limit {
+        /// What is counted (`contact points`, `validation samples`).
+        what: &'static str,
+        /// The amount asked for (formatted: it may not fit an integer).
+        found: String,
+        /// The limit.
+        max: usize,
+        /// The name of the constant that defines it (`MAX_SAMPLES`).
+        limit: &'static str,
     },
     /// A Bezier curve cannot be built from its inputs.
     #[error("bezier: {msg}")]

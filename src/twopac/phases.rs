@@ -14,7 +14,7 @@
 //!                 world rows K_w = K_e Rᵀ, k_w = k_e + K_e Rᵀ p
 //! ```
 //!
-//! Unknown keys are errors; consecutive phases differ by exactly one contact (§1: same
+//! Unknown and duplicate keys are errors; consecutive phases differ by exactly one contact (§1: same
 //! effector within [`SAME_CONTACT_TOL_M`]). Every error names its JSON path
 //! (`phases[3].contacts[1].normal: zero length`) and, when serde can tell, the line and
 //! column. This module takes text, never a file: the CLI reads the file and names it.
@@ -52,9 +52,11 @@ use serde_json::Value;
 
 use super::bezier::ComState;
 use super::contact::{Contact, ContactShape, DEFAULT_MU};
-use super::polytope::Polytope;
-use super::trajectory::{Phase, SAME_CONTACT_TOL_M};
+use super::equilibrium::MAX_CONTACTS;
+use super::polytope::{Polytope, MAX_ROWS};
+use super::trajectory::{Phase, MAX_PHASES, SAME_CONTACT_TOL_M};
 use super::v3::{norm, sub};
+use super::validate::{sample_count, DEFAULT_STEP_S, MAX_SAMPLES};
 
 /// The `schema` value of a phases file (§1.1).
 pub const PHASES_SCHEMA: &str = "stancelib.twopac.phases/1";
@@ -83,6 +85,29 @@ fn fail<T>(path: &str, msg: impl Into<String>) -> Result<T, JsonError> {
         msg: msg.into(),
         at: None,
     })
+}
+
+/// `Err` at `path` when `found` exceeds `max` (the constant named `limit`): checked
+/// before the work the count stands for.
+fn check_limit(
+    path: &str,
+    what: &str,
+    found: f64,
+    max: usize,
+    limit: &str,
+) -> Result<(), JsonError> {
+    if found <= max as f64 {
+        return Ok(());
+    }
+    let found = if found < 1e15 {
+        format!("{found:.0}")
+    } else {
+        format!("{found:.3e}")
+    };
+    fail(
+        path,
+        format!("{found} {what}, more than the limit of {max} ({limit})"),
+    )
 }
 
 // Each level is generic in its children: with `Value` children it locates an error by
@@ -221,10 +246,11 @@ fn faulty_field<T: DeserializeOwned>(v: &Value) -> Option<String> {
         .map(|(k, _, _)| (*k).clone())
 }
 
-/// Parse `text` as JSON (syntax errors carry line and column).
+/// Parse `text` as JSON (syntax errors carry line and column). A key twice in one
+/// object is an error at the duplicate's JSON path (serde_json would keep the last).
 fn parse_value(text: &str) -> Result<Value, JsonError> {
-    serde_json::from_str(text).map_err(|e| JsonError {
-        path: String::new(),
+    super::unique_keys::from_str(text).map_err(|(path, e)| JsonError {
+        path: path.unwrap_or_default(),
         msg: bare(&e),
         at: Some((e.line(), e.column())),
     })
@@ -303,6 +329,8 @@ fn contact(v: &Value, path: &str) -> Result<Contact, JsonError> {
 }
 
 fn contacts(list: &[Value], path: &str) -> Result<Vec<Contact>, JsonError> {
+    let n = list.len() as f64;
+    check_limit(path, "contacts", n, MAX_CONTACTS, "MAX_CONTACTS")?;
     list.iter()
         .enumerate()
         .map(|(k, v)| contact(v, &format!("{path}[{k}]")))
@@ -394,6 +422,8 @@ fn kinematics(v: &Value, path: &str) -> Result<KinematicsRef, JsonError> {
             if k.a.is_empty() {
                 return fail(&format!("{path}.A"), "no rows");
             }
+            let n = k.a.len() as f64;
+            check_limit(&format!("{path}.A"), "rows", n, MAX_ROWS, "MAX_ROWS")?;
             if let Some(i) = k.a.iter().position(|r| norm(*r) == 0.0) {
                 return fail(&format!("{path}.A[{i}]"), "zero row");
             }
@@ -437,7 +467,10 @@ pub fn parse_phases(text: &str) -> Result<PhasesFile, JsonError> {
     if raw.phases.is_empty() {
         return fail("phases", "empty: give at least one phase");
     }
+    let n = raw.phases.len() as f64;
+    check_limit("phases", "phases", n, MAX_PHASES, "MAX_PHASES")?;
     let mut phases: Vec<PhaseSpec> = Vec::with_capacity(raw.phases.len());
+    let mut total_s = 0.0;
     for (j, p) in raw.phases.iter().enumerate() {
         let path = format!("phases[{j}]");
         let p: RawPhase<Value> = at(p, &path).map_err(loc)?;
@@ -447,6 +480,14 @@ pub fn parse_phases(text: &str) -> Result<PhasesFile, JsonError> {
                 format!("must be ≥ 0, found {d}"),
             );
         }
+        total_s += p.duration_s.unwrap_or(0.0);
+        check_limit(
+            &format!("{path}.duration_s"),
+            &format!("validation samples (the phases up to here last {total_s} s, one sample every {DEFAULT_STEP_S} s)"),
+            sample_count(0.0, total_s, DEFAULT_STEP_S),
+            MAX_SAMPLES,
+            "MAX_SAMPLES",
+        )?;
         if j == 0 && p.com.is_none() {
             return fail(
                 &format!("{path}.com"),
@@ -649,5 +690,51 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(e.path, "schema");
+    }
+
+    // See: issue 11 item 12 — duplicate JSON keys were accepted (last wins).
+    #[test]
+    fn duplicate_keys_are_refused_at_their_path() {
+        let c =
+            r#"{"effector": "e", "position": [0, 0, 0], "normal": [0, 0, 1], "normal": [1, 0, 0]}"#;
+        let e = parse_phases(&one_phase(c, BOX)).unwrap_err();
+        assert_eq!(e.path, "phases[0].contacts[0].normal", "{e}");
+        assert!(e.msg.contains("duplicate key"), "{e}");
+        assert_eq!(e.at.map(|a| a.0), Some(2), "{e}");
+        let e = parse_contacts(
+            r#"{"schema": "stancelib.twopac.contacts/1", "schema": "x", "mass_kg": 1, "contacts": []}"#,
+        )
+        .unwrap_err();
+        assert_eq!(e.path, "schema");
+        // Equal keys in different objects are fine, and values keep their types.
+        let ok = parse_phases(&one_phase(
+            r#"{"effector": "e", "position": [0, 0, 0], "normal": [0, 0, 1], "friction": 0.5}"#,
+            BOX,
+        ))
+        .unwrap();
+        assert_eq!(ok.phases[0].contacts[0].mu, 0.5);
+        assert_eq!(ok.mass_kg, 60.0);
+    }
+
+    // See: issue 11 item 6 — phases, contacts and the total duration are bounded.
+    #[test]
+    fn counts_beyond_the_limits_are_refused_at_their_path() {
+        let c = r#"{"effector": "e", "position": [0, 0, 0], "normal": [0, 0, 1]}"#;
+        let text = one_phase(c, BOX).replace(r#"{"com""#, r#"{"duration_s": 1e9, "com""#);
+        let e = parse_phases(&text).unwrap_err();
+        assert_eq!(e.path, "phases[0].duration_s");
+        assert!(e.msg.contains("MAX_SAMPLES"), "{e}");
+        let many = vec![c; MAX_CONTACTS + 1].join(", ");
+        let e = parse_phases(&one_phase(&many, BOX)).unwrap_err();
+        assert_eq!(e.path, "phases[0].contacts");
+        assert!(e.msg.contains("MAX_CONTACTS"), "{e}");
+        let phase = format!(r#"{{"com": [0, 0, 1], "contacts": [{c}]}}"#);
+        let text = format!(
+            r#"{{{HEAD} "effectors": {{"e": {{"kinematics": {BOX}}}}}, "phases": [{}]}}"#,
+            vec![phase.as_str(); MAX_PHASES + 1].join(",")
+        );
+        let e = parse_phases(&text).unwrap_err();
+        assert_eq!(e.path, "phases");
+        assert!(e.msg.contains("MAX_PHASES"), "{e}");
     }
 }

@@ -19,6 +19,10 @@
 
 use super::v3::{dot, norm, scale};
 
+/// Most rows of one inline kinematic polytope of a phases file (count); a phase stacks
+/// those of its contacts into each transition QP.
+pub const MAX_ROWS: usize = 1_024;
+
 /// A convex polytope `{c : a[i]·c ≤ b[i]}`; an empty row list is all of `ℝ³`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Polytope {

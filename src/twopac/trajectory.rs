@@ -39,6 +39,9 @@ use super::transition::{
 use super::v3::{norm, scale, sub};
 use super::TwopacError;
 
+/// Most phases of one sequence (count). `twopac` plans it 31 times and solves each
+/// transition QP 2,000 times for `timings.json`, so its time grows with the phases.
+pub const MAX_PHASES: usize = 1_000;
 /// Step of the switch-parameter scan (§6 step 4).
 pub const U_STEP: f64 = 0.01;
 /// Speed of the polyline rule for `T_w` without durations, m/s (§6 step 2).
@@ -239,6 +242,14 @@ pub fn plan(
     };
     if n == 0 {
         return Err(bad(0, "no phases"));
+    }
+    if n > MAX_PHASES {
+        return Err(TwopacError::Limit {
+            what: "phases",
+            found: n.to_string(),
+            max: MAX_PHASES,
+            limit: "MAX_PHASES",
+        });
     }
     for (j, p) in phases.iter().enumerate() {
         if p.kinematics.len() != p.contacts.len() {

@@ -24,9 +24,14 @@
 
 use super::equilibrium::{EqualityForm, GRAVITY};
 use super::trajectory::ComTrajectory;
+use super::TwopacError;
 
 /// Sampling step `Δ`, s.
 pub const DEFAULT_STEP_S: f64 = 0.01;
+/// Most samples of one validated trajectory (count): its span ÷ the step, plus one.
+/// Each sample is one LP, solved five times by `twopac` (2PAC and quasi-static curves,
+/// three timed repeats): 100,000 samples are 1,000 s of motion at [`DEFAULT_STEP_S`].
+pub const MAX_SAMPLES: usize = 100_000;
 /// A sample is valid when `s* ≤ VALID_SLACK_REL · m g`.
 pub const VALID_SLACK_REL: f64 = 1e-6;
 
@@ -56,6 +61,39 @@ pub struct Validation {
     pub max_slack_n: f64,
     /// Time of the largest `s*`, s.
     pub worst_t_s: f64,
+}
+
+/// The number of §7 samples of a span `[t0, t1]` at `step_s` (a float: it may be huge;
+/// `+∞` for a span or step that is not a number).
+pub fn sample_count(t0: f64, t1: f64, step_s: f64) -> f64 {
+    let steps = (t1 - t0) / step_s;
+    if steps.is_nan() {
+        f64::INFINITY
+    } else {
+        steps.max(0.0).ceil() + 1.0
+    }
+}
+
+/// Checks the samples of a span `[t0, t1]` at `step_s` against [`MAX_SAMPLES`].
+///
+/// # Errors
+/// [`TwopacError::Limit`] (a span that is not finite counts as too long).
+pub fn check_span(t0: f64, t1: f64, step_s: f64) -> Result<(), TwopacError> {
+    let n = sample_count(t0, t1, step_s);
+    if n > MAX_SAMPLES as f64 {
+        let found = if n.is_finite() && n < 1e15 {
+            format!("{n:.0}")
+        } else {
+            format!("{n:.3e}")
+        };
+        return Err(TwopacError::Limit {
+            what: "validation samples",
+            found: format!("{found} (span {:.6e} s at {step_s} s)", t1 - t0),
+            max: MAX_SAMPLES,
+            limit: "MAX_SAMPLES",
+        });
+    }
+    Ok(())
 }
 
 /// The sample times of §7: every `step_s` from the start, plus the end point.
@@ -118,4 +156,27 @@ pub fn summarise(runs: &[Validation]) -> (f64, f64) {
         runs.iter().map(|r| r.point_valid_rate).sum::<f64>() / n,
         runs.iter().filter(|r| r.trajectory_valid).count() as f64 / n,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // See: issue 11 item 6 — the samples of a span are counted before any is made.
+    #[test]
+    fn spans_beyond_max_samples_are_refused() {
+        let step = DEFAULT_STEP_S;
+        // [0, 1] s at 0.01 s: 100 steps and the end point.
+        assert_eq!(
+            sample_count(0.0, 1.0, step),
+            sample_times(0.0, 1.0, step).len() as f64
+        );
+        let max_span = (MAX_SAMPLES - 1) as f64 * step;
+        assert!(check_span(0.0, max_span * (1.0 - 1e-12), step).is_ok());
+        assert!(check_span(0.0, 1.01 * max_span, step).is_err());
+        for t1 in [1e9, f64::INFINITY, f64::NAN] {
+            let e = check_span(0.0, t1, step).unwrap_err();
+            assert!(e.to_string().contains("MAX_SAMPLES"), "{e}");
+        }
+    }
 }

@@ -114,7 +114,8 @@ fn jump_map_200(c: &mut Criterion) {
     }
     .values();
     assert_eq!((heights.len(), speeds.len()), (200, 200));
-    let map = jump_map(&pool, &heights, &speeds, &stance_relative_limits);
+    let map =
+        jump_map(&pool, &heights, &speeds, &stance_relative_limits).expect("within the map limits");
     eprintln!(
         "jump_map_200: {} pairs × 40,000 cells, IoU {:.4}",
         map.pairs.len(),
@@ -124,7 +125,11 @@ fn jump_map_200(c: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(15));
     g.throughput(Throughput::Elements((map.pairs.len() * 40_000) as u64));
     g.bench_function("pairs_cells_exact", |b| {
-        b.iter(|| black_box(jump_map(&pool, &heights, &speeds, &stance_relative_limits).agreement))
+        b.iter(|| {
+            black_box(
+                jump_map(&pool, &heights, &speeds, &stance_relative_limits).map(|m| m.agreement),
+            )
+        })
     });
     g.finish();
 }

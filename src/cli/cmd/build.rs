@@ -20,7 +20,7 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
     let body = a.body.body.as_deref().map(load_body).transpose()?;
     let opts = BuildOptions {
         ingest: resolve(body.as_ref(), None, &cli),
-        stances: resolve_fit(None, a.body.force_model),
+        stances: resolve_fit(None, a.fit.force_model),
     };
     let rules = OutputRules {
         inputs: a.inputs.clone(),

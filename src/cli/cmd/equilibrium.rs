@@ -9,11 +9,12 @@ use rayon::prelude::*;
 
 use super::super::args::EquilibriumArgs;
 use super::super::Outcome;
-use crate::library::read::Table;
+use crate::error::Error;
+use crate::library::read::{parquet_rows, Table};
 use crate::library::twopac::equilibrium_table;
 use crate::library::write::write_atomic;
 use crate::twopac::contact::{contact_points, min_mu};
-use crate::twopac::equilibrium::{EqualityForm, Status, Verdict};
+use crate::twopac::equilibrium::{EqualityForm, Status, Verdict, MAX_COM_STATES};
 use crate::twopac::phases::parse_contacts;
 
 /// Reads a UTF-8 text file, naming it on failure.
@@ -26,6 +27,17 @@ type ComStates = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 
 /// The COM positions and accelerations of `P.parquet` (`ax`, `ay`, `az` default 0).
 fn read_points(path: &Path) -> anyhow::Result<ComStates> {
+    let rows = parquet_rows(path)?;
+    if rows > MAX_COM_STATES {
+        let e = Error::limit(
+            "--points",
+            "rows",
+            rows as f64,
+            MAX_COM_STATES,
+            "MAX_COM_STATES",
+        );
+        return Err(anyhow::Error::from(e).context(path.display().to_string()));
+    }
     let t = Table::open(path)?;
     let xyz = |names: [&str; 3], optional: bool| -> anyhow::Result<Vec<[f64; 3]>> {
         let mut cols = Vec::with_capacity(3);

@@ -13,7 +13,7 @@ use crate::library::queries::{jump_map_table, jump_pairs_table};
 use crate::library::write::write_atomic;
 use crate::plot::jump_map_png;
 use crate::query::feasibility::LimitForm;
-use crate::query::map::jump_map;
+use crate::query::map::{check_grid, jump_map};
 use crate::query::pool::Prepared;
 
 /// Draws the PNG under a temporary name, then renames it into place.
@@ -39,13 +39,15 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         !heights.is_empty() && !speeds.is_empty(),
         "the grid is empty: check --heights and --speeds"
     );
+    check_grid("--heights × --speeds", heights.len(), speeds.len())?;
     let (form, mu) = a.lim.form(LimitForm::Relative)?;
     let active = a.lim.active_fraction()?;
     let (lib, pool) = load_pool(&a.lib, active)?;
     let absolute = absolute_limits(&lib);
     let limits = |p: &Prepared| stance_limits(p, form, &absolute, mu);
     let t0 = Instant::now();
-    let map = jump_map(&pool, &heights, &speeds, &limits);
+    let map = jump_map(&pool, &heights, &speeds, &limits)
+        .context("--heights × --speeds on this library")?;
     let elapsed = t0.elapsed().as_secs_f64();
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))?;
@@ -56,7 +58,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         "liftoffs": map.liftoffs.len(), "landings": map.landings.len(), "pairs": map.pairs.len(),
         "cells_approx": map.agreement.approx, "cells_exact": map.agreement.exact,
         "cells_both": map.agreement.both, "iou": iou,
-        "limits": format!("{form:?}").to_lowercase(), "active_set": active,
+        "limits": form.name(), "mu": mu, "active_set": active,
     });
     let kv = query_kv(summary.clone());
     write_atomic(

@@ -16,7 +16,9 @@ use crate::library::write::write_atomic;
 use crate::query::feasibility::{relative_limits, LimitForm, Limits};
 use crate::query::jump::{is_landing, is_liftoff, jump};
 use crate::query::pool::Prepared;
-use crate::query::run::{run_at_speed, run_cycles, scale_limits, RunCycle};
+use crate::query::run::{
+    check_scale, check_sweep, run_at_speed, run_cycles, scale_limits, RunCycle,
+};
 use crate::stances::limits::{limits, ClipFacts, StanceFacts, S_EFF_RANGE};
 
 /// Opens a library and prepares every stance (tables built in parallel), the friction
@@ -79,26 +81,25 @@ pub fn absolute_limits(lib: &StanceLibrary) -> BTreeMap<String, Limits> {
         .collect()
 }
 
-/// A stance's limits under `form`: its character's absolute ones (μ replaced by `mu`
-/// when given) or its own relative ones.
+/// A stance's limits under `form`: its character's absolute ones or its own relative
+/// ones, with μ replaced by `mu` when given (`--mu` acts under both forms, §7.5: "each
+/// limit takes either form").
 pub fn stance_limits(
     p: &Prepared,
     form: LimitForm,
     absolute: &BTreeMap<String, Limits>,
     mu: Option<f64>,
 ) -> Limits {
-    match form {
+    let l = match form {
         LimitForm::Relative => relative_limits(&p.stance.coef),
-        LimitForm::Absolute => {
-            let l = absolute
-                .get(&p.stance.character_id)
-                .copied()
-                .unwrap_or_else(|| relative_limits(&p.stance.coef));
-            Limits {
-                mu: mu.unwrap_or(l.mu),
-                ..l
-            }
-        }
+        LimitForm::Absolute => absolute
+            .get(&p.stance.character_id)
+            .copied()
+            .unwrap_or_else(|| relative_limits(&p.stance.coef)),
+    };
+    Limits {
+        mu: mu.unwrap_or(l.mu),
+        ..l
     }
 }
 
@@ -146,12 +147,9 @@ fn time_scaled(lib: &StanceLibrary, clip: &str) -> bool {
 pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
     let speeds = a.speeds()?;
     let (length, mass) = (a.length_scale, a.mass_scale);
-    for (n, v) in [("--length-scale", length), ("--mass-scale", mass)] {
-        anyhow::ensure!(
-            v.is_finite() && v > 0.0,
-            "{n} must be a positive number, found {v}"
-        );
-    }
+    check_scale("--length-scale", length)?;
+    check_scale("--mass-scale", mass)?;
+    let (form, mu) = a.lim.form(LimitForm::Absolute)?;
     let active = a.lim.active_fraction()?;
     let (lib, pool) = load_pool(&a.lib, active)?;
     let all = run_cycles(&lib.stances);
@@ -166,7 +164,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
             S_EFF_RANGE.1
         );
     }
-    let (form, mu) = a.lim.form(LimitForm::Absolute)?;
+    check_sweep("--speeds", cycles.len(), speeds.len())?;
     // Absolute limits of the target character: the source character's, scaled by §9.
     let limits: BTreeMap<String, Limits> = absolute_limits(&lib)
         .into_iter()
@@ -199,7 +197,8 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
     let mut df = run_table(&rows)?;
     let kv = query_kv(serde_json::json!({
         "query": "run", "lib": a.lib, "speeds_mps": speeds,
-        "length_scale": length, "mass_scale": mass, "active_set": active,
+        "length_scale": length, "mass_scale": mass,
+        "limits": form.name(), "mu": mu, "active_set": active,
     }));
     write_table(&a.out, &mut df, &kv)?;
     print_run(&rows);
@@ -294,7 +293,8 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
     });
     let mut df = jump_table(&rows)?;
     let kv = query_kv(serde_json::json!({
-        "query": "jump", "lib": a.lib, "height_m": a.height, "distance_m": a.distance, "active_set": active,
+        "query": "jump", "lib": a.lib, "height_m": a.height, "distance_m": a.distance,
+        "limits": form.name(), "mu": mu, "active_set": active,
     }));
     write_table(&a.out, &mut df, &kv)?;
     println!(

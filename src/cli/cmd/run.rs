@@ -34,7 +34,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
     };
     let opts = crate::pipeline::build::BuildOptions {
         ingest: opts,
-        stances: crate::pipeline::spec::resolve_fit(Some(&pipe), a.body.force_model),
+        stances: crate::pipeline::spec::resolve_fit(Some(&pipe), a.fit.force_model),
     };
     let lib = relative_to(&a.pipeline, &pipe.out);
     let rules = crate::pipeline::output::OutputRules {

@@ -7,7 +7,10 @@ use anyhow::Context;
 use super::super::args::SynthArgs;
 use super::super::Outcome;
 use crate::skeleton::units::parse_unit;
-use crate::synth::{generate, SynthMotion, SynthOptions, SynthUp};
+use crate::synth::{
+    generate, SynthMotion, SynthOptions, SynthUp, MAX_DURATION_S, MAX_FRAME_RATE_HZ, MAX_UNIT_M,
+    MIN_FRAME_RATE_HZ, MIN_UNIT_M,
+};
 
 /// Write `<out>` (BVH) and `<out stem>.truth.csv` (frame, time_s, com_x/y/z in metres Z up,
 /// contact_left_foot, contact_right_foot, force per kg x/y/z).
@@ -27,6 +30,21 @@ pub fn run(a: SynthArgs) -> anyhow::Result<Outcome> {
     };
     let unit_m =
         parse_unit(&a.unit).ok_or_else(|| anyhow::anyhow!("--unit: '{}' is not a unit", a.unit))?;
+    // The generator clamps these; the command refuses them instead of writing another clip.
+    anyhow::ensure!(
+        (MIN_FRAME_RATE_HZ..=MAX_FRAME_RATE_HZ).contains(&a.rate),
+        "--rate: must lie in [{MIN_FRAME_RATE_HZ}, {MAX_FRAME_RATE_HZ}] Hz (MAX_FRAME_RATE_HZ), found {}",
+        a.rate
+    );
+    anyhow::ensure!(
+        a.duration > 0.0 && a.duration <= MAX_DURATION_S,
+        "--duration: must lie in (0, {MAX_DURATION_S}] s (MAX_DURATION_S), found {}",
+        a.duration
+    );
+    anyhow::ensure!(
+        (MIN_UNIT_M..=MAX_UNIT_M).contains(&unit_m),
+        "--unit: must lie in [{MIN_UNIT_M}, {MAX_UNIT_M}] m per unit, found {unit_m}"
+    );
     let opts = SynthOptions {
         motion,
         frame_rate_hz: a.rate,

@@ -31,7 +31,7 @@ use crate::twopac::trajectory::{
     phase_diagnostics, plan, ComTrajectory, Phase, Plan, PlanOptions, QuasiStatic,
 };
 use crate::twopac::transition::{transition_eq13, transition_eq6, QpForm};
-use crate::twopac::validate::{sample_times, validate, Validation, DEFAULT_STEP_S};
+use crate::twopac::validate::{check_span, sample_times, validate, Validation, DEFAULT_STEP_S};
 
 /// Repetitions of each phase's H-representation build (§8.1 target 1).
 pub const REPEATS_BUILD: usize = 100;
@@ -92,6 +92,14 @@ pub(crate) fn character_polytopes(
 fn resolve(file: &PhasesFile, path: &Path, a: &TwopacArgs) -> anyhow::Result<Vec<Phase>> {
     let named = file.named_kinematics();
     let library = if named.is_empty() {
+        if let Some(lib) = &a.lib {
+            anyhow::bail!(
+                "--lib {}: {} uses no library polytope (every effector's kinematics is inline): \
+                 drop --lib, or name a polytope (\"kinematics\": \"left_foot\")",
+                lib.display(),
+                path.display()
+            );
+        }
         BTreeMap::new()
     } else {
         let lib = a.lib.as_ref().with_context(|| {
@@ -391,9 +399,21 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
     let p = plan(&phases, file.mass_kg, &file.start, &opts)
         .with_context(|| format!("{}: cannot plan the trajectory", path.display()))?;
     let plan_s = t0.elapsed().as_secs_f64();
+    let qs = QuasiStatic::from_plan(&p);
+    for (what, (t0, t1)) in [
+        ("2PAC trajectory", p.span_s()),
+        ("quasi-static", qs.span_s()),
+    ] {
+        check_span(t0, t1, DEFAULT_STEP_S).with_context(|| {
+            format!(
+                "{}: phases: the planned {what} (durations, or COM distances at {} m/s)",
+                path.display(),
+                crate::twopac::trajectory::POLYLINE_SPEED_MPS
+            )
+        })?;
+    }
     let diags = phase_diagnostics(&p, &phases);
     let v_curve = validate(&p, &p.forms, DEFAULT_STEP_S);
-    let qs = QuasiStatic::from_plan(&p);
     let v_qs = validate(&qs, &p.forms, DEFAULT_STEP_S);
     let curve_rows = rows(&p, &p, &v_curve);
     let qs_rows = rows(&qs, &p, &v_qs);

@@ -30,7 +30,8 @@ fn cells_agree_with_direct_jump_solves() {
         step: 0.25,
     }
     .values();
-    let map = jump_map(&pool, &heights, &speeds, &stance_relative_limits);
+    let map =
+        jump_map(&pool, &heights, &speeds, &stance_relative_limits).expect("within the map limits");
     assert_eq!(
         (map.liftoffs.len(), map.landings.len(), map.pairs.len()),
         (3, 4, 9)
@@ -111,4 +112,53 @@ fn axis_values_are_inclusive_and_reject_bad_steps() {
     .values()
     .is_empty());
     assert_eq!(Agreement::default().iou(), 1.0);
+}
+
+// See: issue 11 item 6 — ranges parsed by hand: step ≤ 0, NaN, ∞ and a count beyond
+// MAX_AXIS_VALUES are refused before any allocation.
+#[test]
+fn axis_parse_refuses_bad_and_huge_ranges() {
+    use crate::error::ErrorKind;
+    let a = Axis::parse("--x", "0:1:0.25").unwrap();
+    assert_eq!(a.values(), vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+    for bad in [
+        "0:1:0",
+        "0:1:-1",
+        "nan:1:0.1",
+        "0:inf:0.1",
+        "1:0:0.1",
+        "0:1",
+        "a:b:c",
+    ] {
+        let e = Axis::parse("--x", bad).unwrap_err();
+        assert!(matches!(e.kind, ErrorKind::Invalid { .. }), "{bad}: {e}");
+        assert!(e.to_string().starts_with("--x: "), "{e}");
+    }
+    let e = Axis::parse("--x", "0:1e9:0.001").unwrap_err();
+    assert!(
+        matches!(
+            e.kind,
+            ErrorKind::Limit {
+                max: MAX_AXIS_VALUES,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // Exactly MAX_AXIS_VALUES values pass; one more does not.
+    let n = MAX_AXIS_VALUES as f64;
+    assert_eq!(
+        Axis::parse("--x", &format!("1:{n}:1")).unwrap().len(),
+        MAX_AXIS_VALUES
+    );
+    assert!(Axis::parse("--x", &format!("0:{n}:1")).is_err());
+    // An over-long axis built by hand never yields more than the limit + 1 values.
+    let huge = Axis {
+        start: 0.0,
+        stop: 1e12,
+        step: 1.0,
+    };
+    assert_eq!(huge.values().len(), MAX_AXIS_VALUES + 1);
+    assert!(check_grid("g", 1000, 1000).is_ok());
+    assert!(check_grid("g", 1001, 1000).is_err());
 }

@@ -173,3 +173,15 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
     // Both verdicts occur, so the invariance is not vacuous.
     assert!(outcomes[0] > 10 && outcomes[1] > 10, "{outcomes:?}");
 }
+
+// See: issue 11 item 6 — run sweeps are bounded by MAX_RUN_ROWS (cycles × speeds).
+#[test]
+fn run_sweeps_beyond_max_run_rows_are_refused() {
+    assert!(check_sweep("--speeds", 100, MAX_RUN_ROWS / 100).is_ok());
+    let e = check_sweep("--speeds", 101, MAX_RUN_ROWS / 100).unwrap_err();
+    assert!(e.to_string().starts_with("--speeds: "), "{e}");
+    assert!(e.to_string().contains("MAX_RUN_ROWS"), "{e}");
+    assert!(check_speed("--speed", -1.0).is_err() && check_speed("--speed", f64::NAN).is_err());
+    assert!(check_scale("--mass-scale", 0.0).is_err());
+    assert_eq!(check_scale("--mass-scale", 2.0).unwrap(), 2.0);
+}
