@@ -695,16 +695,20 @@ fn build_joints_writes_joints_parquet_with_the_rows_of_frames_joints() {
     assert!(plain.join("stances.parquet").is_file());
 }
 
-// See: issue 11 item 11 — `frames --stage-b` was accepted and changed nothing.
+// See: issue 11 item 11 — `frames --stage-b` was accepted and changed nothing. Stage B is
+// gone (issue 12); the stance-stage option that replaced it is refused by `frames` too.
 #[test]
-fn frames_refuses_stage_b() {
+fn frames_refuses_stance_stage_options() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("frames");
     let clips = fixture_clips();
-    refused(
-        &["frames", &clips[0], "--out", &s(&out), "--stage-b"],
-        &["--stage-b"],
-    );
+    for opt in [&["--stage-b"][..], &["--force-model", "ratio"][..]] {
+        let mut args = vec!["frames", clips[0].as_str(), "--out"];
+        let o = s(&out);
+        args.push(&o);
+        args.extend_from_slice(opt);
+        refused(&args, &[opt[0]]);
+    }
     assert!(!out.exists());
 }
 

@@ -392,9 +392,7 @@ mod tests {
     fn negative_samples_are_clipped_to_a_non_negative_force() {
         // A pulling dip in the data (kinematic noise at the edges): the model stays ≥ 0.
         let mut s = bell_samples(64, 60.0);
-        for j in 0..6 {
-            s[2][j] = -150.0;
-        }
+        s[2][..6].fill(-150.0);
         let fit = fit_ratio(&s, 20, 60.0, 0.3, None, &RatioOptions::default()).unwrap();
         assert!(fit.model.min_f_v(&fit.model.grid()) >= -1e-6);
         assert!(fit.model.support_ok());
