@@ -4,6 +4,8 @@
 //! - `bvh_oracle`: differential test of the BVH reader against the `bvh_anim` crate on every
 //!   shared clip it reads (f32 precision), and a write-and-reread round trip.
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
+//! - `force_export`: `forces` (the model on its grid, impulse, norms) and `plot stance` (PNG,
+//!   plates of the treadmill run); unknown stances exit 2 and write nothing.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
 //! - `regression`: one test per review finding, named after it.
 //! - `stances`: stances of real clips: flights on both sides, impulse–momentum, walks, running forces.
@@ -21,6 +23,7 @@ mod bad_input;
 mod bvh_oracle;
 mod cli;
 mod fixtures;
+mod force_export;
 mod forceplate;
 mod forceplate_stances;
 mod kinematics;

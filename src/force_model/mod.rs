@@ -43,6 +43,7 @@
 //! ```
 
 pub mod basis;
+pub mod export;
 pub mod fit;
 pub mod model;
 pub mod stage_b;
