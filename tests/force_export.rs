@@ -98,7 +98,11 @@ fn force_export_is_the_model_on_its_grid_and_integrates_to_the_impulse() {
     let out = dir.path().join("f.parquet");
     ok(&["forces", "--lib", &s(lib), "--out", &s(&out)]);
     let t = Table::open(&out).unwrap();
-    let names: Vec<String> = t.df.get_column_names().iter().map(|n| n.to_string()).collect();
+    let names: Vec<String> =
+        t.df.get_column_names()
+            .iter()
+            .map(|n| n.to_string())
+            .collect();
     assert_eq!(names, FORCES_COLUMNS);
     let ids = t.strings("stance_id").unwrap();
     let col = |n: &str| t.f64s(n).unwrap();
@@ -139,9 +143,9 @@ fn force_export_is_the_model_on_its_grid_and_integrates_to_the_impulse() {
         for (r, &g) in rows.clone().zip(&grid) {
             assert_eq!(tau[r], g);
             assert_eq!(time[r], td_clip_s + g * dt_s);
-            for a in 0..3 {
+            for (a, (col, axis)) in f_st.iter().zip(&m.axes).enumerate() {
                 // The export is the model's own evaluation, bit for bit.
-                assert_eq!(f_st[a][r], m.axes[a].eval(g), "{} axis {a}", ids[r]);
+                assert_eq!(col[r], axis.eval(g), "{} axis {a}", ids[r]);
             }
             let (fh, fp, fv) = (f_st[0][r], f_st[1][r], f_st[2][r]);
             let w = [f_w[0][r], f_w[1][r], f_w[2][r]];
@@ -199,7 +203,16 @@ fn force_export_of_named_stances_holds_only_those() {
     let out = dir.path().join("sub/two.parquet");
     // Given out of order and one twice: each once, sorted by id.
     ok(&[
-        "forces", "--lib", &s(lib), "--stance", a, "--stance", b, "--stance", a, "--out",
+        "forces",
+        "--lib",
+        &s(lib),
+        "--stance",
+        a,
+        "--stance",
+        b,
+        "--stance",
+        a,
+        "--out",
         &s(&out),
     ]);
     let t = Table::open(&out).unwrap();
@@ -226,19 +239,41 @@ fn an_unknown_stance_id_exits_2_and_writes_nothing() {
         .clone();
     let out = dir.path().join("f.parquet");
     let (code, _, err) = stancelib(&[
-        "forces", "--lib", &s(lib), "--stance", &good, "--stance", "nosuch:L:7", "--out",
+        "forces",
+        "--lib",
+        &s(lib),
+        "--stance",
+        &good,
+        "--stance",
+        "nosuch:L:7",
+        "--out",
         &s(&out),
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("nosuch:L:7"), "{err}");
     let png = dir.path().join("p.png");
     let (code, _, err) = stancelib(&[
-        "plot", "stance", "--lib", &s(lib), "--stance", "nosuch:R:3", "--out", &s(&png),
+        "plot",
+        "stance",
+        "--lib",
+        &s(lib),
+        "--stance",
+        "nosuch:R:3",
+        "--out",
+        &s(&png),
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("nosuch:R:3"), "{err}");
     let (code, _, err) = stancelib(&[
-        "plot", "stance", "--lib", &s(lib), "--stance", &good, "--active-set", "1.5", "--out",
+        "plot",
+        "stance",
+        "--lib",
+        &s(lib),
+        "--stance",
+        &good,
+        "--active-set",
+        "1.5",
+        "--out",
         &s(&png),
     ]);
     assert_eq!(code, 2, "{err}");
@@ -250,7 +285,12 @@ fn an_unknown_stance_id_exits_2_and_writes_nothing() {
 /// Width and height from a PNG's signature and IHDR chunk.
 fn png_size(path: &Path) -> (u32, u32) {
     let b = std::fs::read(path).unwrap();
-    assert!(b.len() > 10_000, "{}: only {} bytes", path.display(), b.len());
+    assert!(
+        b.len() > 10_000,
+        "{}: only {} bytes",
+        path.display(),
+        b.len()
+    );
     assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
     assert_eq!(&b[12..16], b"IHDR");
     let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);

@@ -88,7 +88,11 @@ pub fn kinematic_force(mass_kg: f64, a_world: [f64; 3]) -> [f64; 3] {
 
 /// The model's force at every point of its evaluation grid ([`ForceModel::grid`]), in
 /// grid order (τ increasing from 0 to 1).
-pub fn sample_forces(model: &ForceModel, times: StanceTimes, heading: &Heading) -> Vec<ForceSample> {
+pub fn sample_forces(
+    model: &ForceModel,
+    times: StanceTimes,
+    heading: &Heading,
+) -> Vec<ForceSample> {
     model
         .grid()
         .into_iter()
@@ -117,7 +121,7 @@ mod tests {
 
     #[test]
     fn world_and_stance_agree_both_ways_on_random_headings() {
-        let mut rng = Rng::new(0xf0ce_e4);
+        let mut rng = Rng::new(0x00f0_cee4);
         for _ in 0..200 {
             let psi = rng.uniform(0.0, std::f64::consts::TAU);
             let h = Heading {
@@ -184,8 +188,8 @@ mod tests {
             // e_h = (0.6, −0.8), e_p = (0.8, 0.6): f_x = 0.6 f_h + 0.8 f_p, f_y = −0.8 f_h + 0.6 f_p.
             let [fh, fp, fv] = r.f_stance;
             let want = [0.6 * fh + 0.8 * fp, -0.8 * fh + 0.6 * fp, fv];
-            for k in 0..3 {
-                assert!((r.f_world[k] - want[k]).abs() < 1e-12 * (1.0 + want[k].abs()));
+            for (got, want) in r.f_world.iter().zip(want) {
+                assert!((got - want).abs() < 1e-12 * (1.0 + want.abs()));
             }
         }
         assert_eq!((rows[0].tau, rows[rows.len() - 1].tau), (0.0, 1.0));

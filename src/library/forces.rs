@@ -79,7 +79,12 @@ pub fn read_force_stances(path: &Path) -> Result<Vec<ForceStance>> {
         .enumerate()
         .map(|(i, stance)| {
             if ids.get(i) != Some(&stance.stance_id) {
-                return Err(Error::column(path, "stance_id", Some(i), "rows out of step"));
+                return Err(Error::column(
+                    path,
+                    "stance_id",
+                    Some(i),
+                    "rows out of step",
+                ));
             }
             let from = HEADING_SOURCES
                 .into_iter()
@@ -125,7 +130,10 @@ pub fn select_stances<'a>(
                 .iter()
                 .find(|s| s.stance.stance_id == id)
                 .ok_or_else(|| {
-                    let msg = format!("no stance '{id}' in this library");
+                    let n = stances.len();
+                    let first = stances.first().map_or("", |s| s.stance.stance_id.as_str());
+                    let msg =
+                        format!("no stance '{id}' in this library ({n} stances, e.g. '{first}')");
                     Error::column(path, "stance_id", None, msg)
                 })?;
             found.push(s);
@@ -196,16 +204,16 @@ pub fn read_clip_accelerations(
     let io = |e: PolarsError| Error::io(path, "cannot read parquet", e);
     let source = PlRefPath::try_from_path(path).map_err(io)?;
     let df = LazyFrame::scan_parquet(source, ScanArgsParquet::default())
-    .map_err(io)?
-    .select(names.map(polars::prelude::col))
-    .filter(
-        polars::prelude::col("clip")
-            .eq(lit(clip))
-            .and(polars::prelude::col("time_s").gt_eq(lit(t0)))
-            .and(polars::prelude::col("time_s").lt_eq(lit(t1))),
-    )
-    .collect()
-    .map_err(io)?;
+        .map_err(io)?
+        .select(names.map(polars::prelude::col))
+        .filter(
+            polars::prelude::col("clip")
+                .eq(lit(clip))
+                .and(polars::prelude::col("time_s").gt_eq(lit(t0)))
+                .and(polars::prelude::col("time_s").lt_eq(lit(t1))),
+        )
+        .collect()
+        .map_err(io)?;
     let t = Table {
         path: path.to_path_buf(),
         df,
@@ -228,11 +236,10 @@ pub fn read_up_axis(path: &Path, clip: &str) -> Result<UpAxis> {
         .iter()
         .position(|c| c == clip)
         .ok_or_else(|| Error::column(path, "clip", None, format!("no clip '{clip}'")))?;
-    let value = t
-        .df
-        .column("up_axis")
-        .ok()
-        .and_then(|c| c.str().ok().and_then(|s| s.get(row).map(str::to_string)));
+    let value =
+        t.df.column("up_axis")
+            .ok()
+            .and_then(|c| c.str().ok().and_then(|s| s.get(row).map(str::to_string)));
     value.as_deref().and_then(UpAxis::parse).ok_or_else(|| {
         let found = value.unwrap_or_else(|| "null".into());
         let msg = format!("expected +X … −Z, found '{found}'");

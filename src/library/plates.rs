@@ -119,7 +119,10 @@ pub fn parse_plates(text: &str, foot: PlateFoot, up: UpAxis) -> Result<Vec<Plate
         }
         if let Some(prev) = out.last() {
             if v[0] <= prev.time_s {
-                let msg = format!("time_s {} does not increase (previous {})", v[0], prev.time_s);
+                let msg = format!(
+                    "time_s {} does not increase (previous {})",
+                    v[0], prev.time_s
+                );
                 return Err(bad(line, msg));
             }
         }
@@ -179,8 +182,14 @@ right_fx_n,right_fy_n,right_fz_n\n\
         assert!(parse_plates(&gap, PlateFoot::Left, UpAxis::PosY).is_ok());
         let back = CSV.replace("0.01,", "0.0,");
         assert!(msg(&back, PlateFoot::Left).starts_with("grf.csv:3: time_s 0 does not increase"));
-        assert_eq!(msg("", PlateFoot::Left), "grf.csv:1: empty file: expected a header line");
+        assert_eq!(
+            msg("", PlateFoot::Left),
+            "grf.csv:1: empty file: expected a header line"
+        );
         let short = format!("{CSV}0.02,1,2\n");
-        assert_eq!(msg(&short, PlateFoot::Left), "grf.csv:4: 3 cells, the header has 11");
+        assert_eq!(
+            msg(&short, PlateFoot::Left),
+            "grf.csv:4: 3 cells, the header has 11"
+        );
     }
 }

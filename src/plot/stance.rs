@@ -133,7 +133,6 @@ impl StancePlot {
         }
         out
     }
-
 }
 
 /// The plot's time axis for a stance from `td` to `lo` (s): [`TIME_PAD_FRACTION`] of `Δt`
@@ -146,16 +145,14 @@ pub fn time_window(td: f64, lo: f64) -> (f64, f64) {
 type Chart<'a, 'b> = ChartContext<
     'a,
     BitMapBackend<'b>,
-    Cartesian2d<
-        plotters::coord::types::RangedCoordf64,
-        plotters::coord::types::RangedCoordf64,
-    >,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
 >;
 
+/// One panel over clip time; `y_decimals` digits on the y labels.
 fn panel<'a, 'b>(
     area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
     path: &Path,
-    (caption, y_desc): (&str, &str),
+    (caption, y_desc, y_decimals): (&str, &str, usize),
     (x, y): ((f64, f64), (f64, f64)),
 ) -> Result<Chart<'a, 'b>, PlotError> {
     let mut chart = ChartBuilder::on(area)
@@ -169,6 +166,9 @@ fn panel<'a, 'b>(
         .configure_mesh()
         .x_desc("clip time t (s)")
         .y_desc(y_desc)
+        .y_label_formatter(&|v| format!("{v:.y_decimals$}"))
+        .bold_line_style(RGBColor(200, 200, 200))
+        .light_line_style(RGBColor(242, 242, 242))
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(|e| err(path, e))?;
@@ -290,10 +290,7 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
     register_font();
     let root = BitMapBackend::new(path, STANCE_PLOT_PX).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let title = format!(
-        "Stance {}   ·   model μ_req = {:.3}",
-        d.stance_id, d.mu_req
-    );
+    let title = format!("Stance {}   ·   model μ_req = {:.3}", d.stance_id, d.mu_req);
     let root = root
         .titled(&title, ("sans-serif", 22))
         .map_err(|e| err(path, e))?;
@@ -309,13 +306,13 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
     let mut a = panel(
         &panels[0],
         path,
-        ("(a) vertical force f_v", "f_v (N)"),
+        ("(a) vertical force f_v", "f_v (N)", 0),
         (x, force_range(all(2).into_iter())),
     )?;
     let mut b = panel(
         &panels[1],
         path,
-        ("(b) heading force f_h (+ forward)", "f_h (N)"),
+        ("(b) heading force f_h (+ forward)", "f_h (N)", 0),
         (x, force_range(all(0).into_iter())),
     )?;
     let ratio = |f: &[f64; 3]| traction_ratio(*f);
@@ -332,7 +329,7 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
     let mut c = panel(
         &panels[2],
         path,
-        (&caption, "|f_t| / f_v (–)"),
+        (&caption, "|f_t| / f_v (–)", 1),
         (x, (0.0, RATIO_AXIS_MAX * 1.02)),
     )?;
     let active = active_intervals(&d.model, d.active_fraction);
@@ -370,10 +367,7 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
     let notes = vec![
         format!("touchdown {td:.3} s, liftoff {lo:.3} s"),
         format!("Δt = {:.3} s", lo - td),
-        format!(
-            "active set: f_v ≥ {} · max f_v",
-            d.active_fraction
-        ),
+        format!("active set: f_v ≥ {} · max f_v", d.active_fraction),
         "  of the model".to_string(),
         format!("model max |f_t|/f_v there: {max_active:.3}"),
         "forces: applied on the body,".to_string(),

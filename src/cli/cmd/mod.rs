@@ -32,9 +32,9 @@ pub fn write_png(
         .with_context(|| format!("{}: not a file name", path.display()))?;
     // The backend picks the image format from the extension: keep `.png` last.
     let tmp = path.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
-    let drawn = draw(&tmp)
-        .map_err(anyhow::Error::from)
-        .and_then(|()| std::fs::rename(&tmp, path).with_context(|| format!("cannot rename {name}")));
+    let drawn = draw(&tmp).map_err(anyhow::Error::from).and_then(|()| {
+        std::fs::rename(&tmp, path).with_context(|| format!("cannot rename {name}"))
+    });
     if drawn.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

@@ -28,7 +28,11 @@ pub fn run_stance(a: PlotStanceArgs) -> anyhow::Result<Outcome> {
     let lib = |name: &str| a.lib.join(name);
     let stances = read_force_stances(&lib(STANCES_FILE))
         .with_context(|| format!("library {}", a.lib.display()))?;
-    let s = select_stances(&lib(STANCES_FILE), &stances, std::slice::from_ref(&a.stance))?[0];
+    let s = select_stances(
+        &lib(STANCES_FILE),
+        &stances,
+        std::slice::from_ref(&a.stance),
+    )?[0];
     let (td, lo) = (s.times.td_clip_s, s.lo_clip_s);
     let (t0, t1) = time_window(td, lo);
     let clip = &s.stance.clip;

@@ -444,7 +444,9 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
         &(serde_json::to_string_pretty(&timings)? + "\n"),
     )?;
     let data = plot_data(&phases, &p, &curve_rows, &qs);
-    super::write_png(&a.out.join("trajectory.png"), |path| trajectory_png(path, &data))?;
+    super::write_png(&a.out.join("trajectory.png"), |path| {
+        trajectory_png(path, &data)
+    })?;
     if let Some(rec) = &recorded {
         let planned: Vec<(f64, [f64; 3])> =
             curve_rows.iter().map(|r| (r.t_s, r.state.pos)).collect();
