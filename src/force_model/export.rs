@@ -155,7 +155,7 @@ mod tests {
                     harmonics: vec![1],
                     amps: vec![150.0],
                     phases: vec![1.2],
-                    fit_rms: 0.0,
+                    ..Default::default()
                 },
                 AxisModel::constant(-5.0),
                 AxisModel {
@@ -163,7 +163,7 @@ mod tests {
                     harmonics: vec![1, 20],
                     amps: vec![700.0, 3.0],
                     phases: vec![std::f64::consts::PI, 0.0],
-                    fit_rms: 0.0,
+                    ..Default::default()
                 },
             ],
         };
