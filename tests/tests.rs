@@ -6,6 +6,8 @@
 //! - `contacts_physics`: sub-frame contact events against the plates, no non-ballistic
 //!   no-contact interval on real clips, a stance on a platform, a skeleton without a head.
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
+//! - `force_export`: `forces` (the model on its grid, impulse, norms) and `plot stance` (PNG,
+//!   plates of the treadmill run); unknown stances exit 2 and write nothing.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
 //! - `regression`: one test per review finding, named after it.
 //! - `safety_outputs`: issue 11 — `--out` never destroys what the tool did not write; input
@@ -32,6 +34,7 @@ mod bvh_oracle;
 mod cli;
 mod contacts_physics;
 mod fixtures;
+mod force_export;
 mod forceplate;
 mod forceplate_stances;
 mod kinematics;

@@ -41,6 +41,18 @@ pub enum Command {
     Equilibrium(EquilibriumArgs),
     /// 2PAC multi-contact COM trajectory of a contact phase sequence.
     Twopac(TwopacArgs),
+    /// Every stance's model force on its evaluation grid (stance and world axes), as Parquet.
+    Forces(ForcesArgs),
+    /// Plots of a library's stances.
+    #[command(subcommand)]
+    Plot(PlotCommand),
+}
+
+/// `stancelib plot …`.
+#[derive(Debug, Subcommand)]
+pub enum PlotCommand {
+    /// One stance: model force against the kinematic (and plate) force, friction ratio.
+    Stance(PlotStanceArgs),
 }
 
 /// `stancelib query …`.
@@ -415,6 +427,41 @@ pub struct TwopacArgs {
     #[arg(long, default_value = "eq13")]
     pub form: String,
     /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `stancelib forces`.
+#[derive(Debug, Args)]
+pub struct ForcesArgs {
+    /// Library folder.
+    #[arg(long)]
+    pub lib: PathBuf,
+    /// A stance id (`<clip>:<label>:<first frame>`); repeat for several (default: all).
+    #[arg(long = "stance")]
+    pub stances: Vec<String>,
+    /// Output Parquet file.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `stancelib plot stance`.
+#[derive(Debug, Args)]
+pub struct PlotStanceArgs {
+    /// Library folder.
+    #[arg(long)]
+    pub lib: PathBuf,
+    /// The stance id (`<clip>:<label>:<first frame>`).
+    #[arg(long)]
+    pub stance: String,
+    /// Force-plate CSV of the stance's clip (`time_s`, `left_f{x,y,z}_n`, `right_…`,
+    /// `f{x,y,z}_n`; N, the BVH file's axes).
+    #[arg(long)]
+    pub plates: Option<PathBuf>,
+    /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1].
+    #[arg(long = "active-set", default_value_t = crate::constraints::ACTIVE_FRACTION)]
+    pub active_set: f64,
+    /// Output PNG file.
     #[arg(long)]
     pub out: PathBuf,
 }

@@ -3,7 +3,7 @@
 pub mod args;
 pub mod cmd;
 
-use args::{Cli, Command, MapCommand, QueryCommand};
+use args::{Cli, Command, MapCommand, PlotCommand, QueryCommand};
 
 /// How a command finished (fatal errors are `Err`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,5 +31,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Map(MapCommand::Jumps(a)) => cmd::map::run(a),
         Command::Equilibrium(a) => cmd::equilibrium::run(a),
         Command::Twopac(a) => cmd::twopac::run(a),
+        Command::Forces(a) => cmd::forces::run(a),
+        Command::Plot(PlotCommand::Stance(a)) => cmd::plot::run_stance(a),
     }
 }

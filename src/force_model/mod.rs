@@ -42,6 +42,7 @@
 //! ```
 
 pub mod basis;
+pub mod export;
 pub mod fit;
 pub mod model;
 pub mod ratio;

@@ -6,7 +6,9 @@
 //! spec com-from-bvh §8 (column tables); STYLE.md §5.6 (deterministic files).
 
 mod columns;
+pub mod forces;
 pub mod kinematics;
+pub mod plates;
 pub mod queries;
 pub mod read;
 pub mod schema;

@@ -13,6 +13,7 @@ use plotters::style::FontStyle;
 
 use crate::query::map::JumpMap;
 
+pub mod stance;
 pub mod trajectory;
 
 /// DejaVu Sans, registered as the `sans-serif` family on first use.

@@ -1,7 +1,6 @@
 //! `stancelib map jumps`: the jump feasibility map of a library (spec stance-model §6.10)
 //! as `jump_map.parquet`, `jump_map_pairs.parquet`, `jump_map.json` and `jump_map.png`.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -15,19 +14,6 @@ use crate::plot::jump_map_png;
 use crate::query::feasibility::LimitForm;
 use crate::query::map::{check_grid, jump_map};
 use crate::query::pool::Prepared;
-
-/// Draws the PNG under a temporary name, then renames it into place.
-fn write_png(dir: &Path, map: &crate::query::map::JumpMap) -> anyhow::Result<()> {
-    let path = dir.join("jump_map.png");
-    let tmp = dir.join(format!(".jump_map.png.tmp-{}.png", std::process::id()));
-    let drawn = jump_map_png(&tmp, map)
-        .map_err(anyhow::Error::from)
-        .and_then(|()| std::fs::rename(&tmp, &path).context("cannot rename jump_map.png"));
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn
-}
 
 /// Run `map jumps`.
 ///
@@ -80,7 +66,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         .with_context(|| format!("cannot write {}", json_tmp.display()))?;
     std::fs::rename(&json_tmp, a.out.join("jump_map.json"))
         .context("cannot write jump_map.json")?;
-    write_png(&a.out, &map)?;
+    super::write_png(&a.out.join("jump_map.png"), |p| jump_map_png(p, &map))?;
     println!(
         "map jumps: {} liftoff(s) × {} landing(s) → {} pair(s) of one character, {} × {} cells",
         map.liftoffs.len(),

@@ -255,19 +255,6 @@ fn write_text(dir: &Path, name: &str, text: &str) -> anyhow::Result<()> {
     std::fs::rename(&tmp, dir.join(name)).with_context(|| format!("cannot write {name}"))
 }
 
-/// Draws the PNG under a temporary name, then renames it into place.
-fn write_png(dir: &Path, data: &TrajectoryPlot) -> anyhow::Result<()> {
-    let path = dir.join("trajectory.png");
-    let tmp = dir.join(format!(".trajectory.png.tmp-{}.png", std::process::id()));
-    let drawn = trajectory_png(&tmp, data)
-        .map_err(anyhow::Error::from)
-        .and_then(|()| std::fs::rename(&tmp, &path).context("cannot rename trajectory.png"));
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn
-}
-
 fn plot_data(
     phases: &[Phase],
     p: &Plan,
@@ -476,7 +463,10 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
         "timings.json",
         &(serde_json::to_string_pretty(&timings)? + "\n"),
     )?;
-    write_png(&a.out, &plot_data(&phases, &p, &curve_rows, &qs))?;
+    let data = plot_data(&phases, &p, &curve_rows, &qs);
+    super::write_png(&a.out.join("trajectory.png"), |path| {
+        trajectory_png(path, &data)
+    })?;
     if let Some(rec) = &recorded {
         let planned: Vec<(f64, [f64; 3])> =
             curve_rows.iter().map(|r| (r.t_s, r.state.pos)).collect();
