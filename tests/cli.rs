@@ -2,26 +2,11 @@
 //! not stop a batch, deterministic and atomic outputs, clip-name collisions, pipelines.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use stancelib::library::read::read_parquet;
 use stancelib::library::schema::{CLIPS_COLUMNS, CONTACTS_COLUMNS};
 
-pub(super) fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-pub(super) fn stancelib(args: &[&str]) -> (i32, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_stancelib"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stdout).into(),
-        String::from_utf8_lossy(&o.stderr).into(),
-    )
-}
+pub(super) use crate::util::{root, stancelib};
 
 pub(super) fn fixture(name: &str) -> String {
     root().join("fixtures/bvh").join(name).display().to_string()

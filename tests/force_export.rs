@@ -3,8 +3,8 @@
 //! frames; unknown stances exit 2 and write nothing; the stance plot is a real PNG, with
 //! and without the plates of the shared treadmill run.
 
+use crate::util::{ok, root, stancelib};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use stancelib::force_model::export::StanceTimes;
@@ -13,28 +13,6 @@ use stancelib::library::plates::{read_plates, PlateFoot};
 use stancelib::library::read::Table;
 use stancelib::plot::stance::STANCE_PLOT_PX;
 use stancelib::skeleton::units::UpAxis;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn stancelib(args: &[&str]) -> (i32, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_stancelib"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stdout).into(),
-        String::from_utf8_lossy(&o.stderr).into(),
-    )
-}
-
-fn ok(args: &[&str]) -> String {
-    let (code, out, err) = stancelib(args);
-    assert_eq!(code, 0, "stancelib {args:?}:\n{out}\n{err}");
-    out
-}
 
 fn s(p: &Path) -> String {
     p.display().to_string()

@@ -5,37 +5,13 @@
 //!
 //! Everything runs on the committed fixtures (`fixtures/bvh`, `fixtures/twopac`).
 
+use crate::util::{ok, root, stancelib};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use polars::prelude::*;
 use stancelib::library::read::read_parquet;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Runs the binary: `(exit code, stdout, stderr)`.
-fn stancelib(args: &[&str]) -> (i32, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_stancelib"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stdout).into(),
-        String::from_utf8_lossy(&o.stderr).into(),
-    )
-}
-
-/// Runs a command that must succeed; returns stdout.
-fn ok(args: &[&str]) -> String {
-    let (code, out, err) = stancelib(args);
-    assert_eq!(code, 0, "stancelib {args:?}:\n{out}\n{err}");
-    out
-}
 
 /// Runs a command that must exit 2 with every one of `needles` in its stderr; returns it.
 fn refused(args: &[&str], needles: &[&str]) -> String {

@@ -209,3 +209,28 @@ pub fn ingest_fixture(
         }
     }
 }
+
+/// The checkout's root (the crate folder).
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs the binary: `(exit code, stdout, stderr)`.
+pub fn stancelib(args: &[&str]) -> (i32, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_stancelib"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+/// Runs a command that must succeed; returns stdout.
+pub fn ok(args: &[&str]) -> String {
+    let (code, out, err) = stancelib(args);
+    assert_eq!(code, 0, "stancelib {args:?}:\n{out}\n{err}");
+    out
+}
