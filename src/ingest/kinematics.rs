@@ -451,13 +451,9 @@ pub(super) fn run(
                 }
             }
             if !found.is_empty() {
-                summary.warnings.push(format!(
-                    "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; speed-led contacts: {}",
-                    f.first_frame,
-                    f.last_frame,
-                    f.events_duration_s.unwrap_or(f.duration_s),
-                    f.a_z_all.unwrap_or(f64::NAN),
-                    found.join(", ")
+                summary.warnings.push(missed_support_warning(
+                    &f,
+                    &format!("speed-led contacts: {}", found.join(", ")),
                 ));
             }
         }
@@ -471,12 +467,9 @@ pub(super) fn run(
     summary.flights = flights_of(&contact, &runs_out);
     if c.support_check {
         for f in summary.flights.iter().filter(|f| is_missed_support(f)) {
-            summary.warnings.push(format!(
-                "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; no support found (no foot or hand slow enough)",
-                f.first_frame,
-                f.last_frame,
-                f.events_duration_s.unwrap_or(f.duration_s),
-                f.a_z_all.unwrap_or(f64::NAN),
+            summary.warnings.push(missed_support_warning(
+                f,
+                "no support found (no foot or hand slow enough)",
             ));
         }
     }
@@ -541,4 +534,16 @@ fn handedness(frames: &[&[V3]], lm: &Landmarks, toe: &[Vec<V3>; 2]) -> bool {
     }
     let side = [-fw[1], fw[0], 0.0]; // e_z × forward
     dot(hip, side) > 0.0
+}
+
+/// The clip warning for a no-contact interval whose COM is not ballistic; `outcome` says
+/// what the speed-led rule found.
+fn missed_support_warning(f: &crate::contacts::flight::Flight, outcome: &str) -> String {
+    format!(
+        "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; {outcome}",
+        f.first_frame,
+        f.last_frame,
+        f.events_duration_s.unwrap_or(f.duration_s),
+        f.a_z_all.unwrap_or(f64::NAN),
+    )
 }
