@@ -480,3 +480,38 @@ fn consecutive_stances_describe_the_same_flight() {
     assert!(mz <= 0.005, "apex height median {mz} m");
     assert!(mv <= 0.02, "apex velocity median {mv} m/s");
 }
+
+#[test]
+fn running_stances_are_feasible_as_recorded() {
+    // See: issue 12 targets — every single-foot running stance with a flight on both
+    // sides, asked for its own speed (the run policy at k = 1: the identity), passes the
+    // exact check at μ = 0.7 with its character's absolute limits and the queries' default
+    // active set; target ≥ 85 % (54 % with the Fourier model).
+    use stancelib::cli::cmd::query::{absolute_limits, load_pool, stance_limits};
+    use stancelib::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
+    use stancelib::query::run::{policy_request, scale_and_check};
+    use stancelib::stances::segment::Boundary;
+    let Some(lib) = nightly_library() else { return };
+    let (library, pool) = load_pool(lib, DEFAULT_QUERY_ACTIVE_FRACTION).unwrap();
+    let limits = absolute_limits(&library);
+    let (mut n, mut ok) = (0usize, 0usize);
+    let mut why: std::collections::BTreeMap<String, usize> = Default::default();
+    for p in &pool {
+        let s = &p.stance;
+        let flights = s.boundary_start == Boundary::Flight && s.boundary_end == Boundary::Flight;
+        if !flights || !(s.label == "L" || s.label == "R") {
+            continue;
+        }
+        n += 1;
+        let lim = stance_limits(p, LimitForm::Absolute, &limits, Some(0.7));
+        match scale_and_check(p, &policy_request(&p.stance, 1.0), &lim) {
+            Ok(c) if c.verdict.feasible => ok += 1,
+            Ok(c) => *why.entry(format!("{:?}", c.verdict.violated)).or_default() += 1,
+            Err(e) => *why.entry(format!("unsolved: {e:?}")).or_default() += 1,
+        }
+    }
+    let share = 100.0 * ok as f64 / n.max(1) as f64;
+    eprintln!("{n} single-foot running stances: {ok} ({share:.0} %) feasible as recorded at μ = 0.7; the others: {why:?}");
+    assert!(n >= 20, "only {n} running stances");
+    assert!(share >= 85.0, "{share:.0} % feasible as recorded");
+}

@@ -83,6 +83,9 @@ pub struct Flight {
     /// touchdown that closes it ([`crate::contacts::timing`]), s; `None` when either is
     /// unknown.
     pub events_duration_s: Option<f64>,
+    /// The sub-frame liftoff and touchdown `(t_LO, t_TD)` that bound the run (clip time,
+    /// s), when both are known: the frames strictly between them are certainly airborne.
+    pub events_s: Option<(f64, f64)>,
     /// Mean SG vertical acceleration across an untested run, m/s².
     pub a_z_mean: Option<f64>,
     /// Passes the ballistic test.
@@ -127,6 +130,7 @@ pub fn fit_run(
         s_eff: None,
         a_z_all: None,
         events_duration_s: None,
+        events_s: None,
         a_z_mean: None,
         ballistic: false,
         tested: n_int >= 4,

@@ -413,6 +413,7 @@ pub(super) fn run(
                     f.a_z_all =
                         curvature_inside(&com_pos, &time_s, a, b, Some((lo, td))).or(f.a_z_all);
                     f.events_duration_s = Some(td - lo);
+                    f.events_s = Some((lo, td));
                 }
                 f
             })

@@ -6,6 +6,7 @@ use super::{FlightRef, Stance};
 use crate::constraints::{precompute, StanceContext};
 use crate::contacts::flight::Flight;
 use crate::contacts::flight::FlightFit;
+use crate::contacts::timing::EVENT_MAX_SHIFT_S;
 use crate::contacts::EFFECTORS;
 use crate::force_model::{
     fit_stance, EdgeTargets, FitOptions, FitWorkspace, ForceModelKind, StanceFit, StanceForce,
@@ -144,7 +145,8 @@ enum Edge {
 /// The sub-frame time of a stance edge: over the supporting effectors' runs that start
 /// (touchdown) or end (liftoff) on the stance's first or last frame, the earliest
 /// touchdown or the latest liftoff; `None` when no run edge is there. A time must lie
-/// within one frame of the frame edge and keep the stance inside its frames ± 1.
+/// within [`EVENT_MAX_SHIFT_S`] + one frame of the frame edge (the event search's own
+/// reach): at 60 Hz a running touchdown is often 1.5 frames before the detector's frame.
 fn event_time(contacts: &[ContactRun], seg: &Segment, fr: &ClipFrames, edge: Edge) -> Option<f64> {
     let support = supporting(seg, &fr.contact);
     let dt = fr
@@ -170,7 +172,7 @@ fn event_time(contacts: &[ContactRun], seg: &Segment, fr: &ClipFrames, edge: Edg
         Edge::Touchdown => times.fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t)))),
         Edge::Liftoff => times.fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t)))),
     }?;
-    (t.is_finite() && (t - edge_t).abs() <= dt).then_some(t)
+    (t.is_finite() && (t - edge_t).abs() <= EVENT_MAX_SHIFT_S + dt).then_some(t)
 }
 
 /// Frames dropped at each end of a flight before its ballistic fit: the contact edges are
@@ -185,10 +187,13 @@ fn flight_ending_at(summary: &ClipSummary, last_frame: i64) -> Option<&Flight> {
 }
 
 /// The ballistic fit of a flight that a stance takes its edge state from: the flight's own
-/// free fit when it has one (≥ 4 interior frames), else the raw COM over the flight's frames
-/// less [`BALLISTIC_EDGE_FRAMES`] at each end with `x(t)`, `y(t)` lines and `z(t)` a
-/// parabola of curvature −g. Both stances beside one flight use the same parabola, so they
-/// agree on its state. `None` for a non-ballistic flight or too few frames.
+/// free fit when it has one (≥ 4 interior frames), else the raw COM with `x(t)`, `y(t)`
+/// lines and `z(t)` a parabola of curvature −g over the frames strictly between the
+/// flight's sub-frame liftoff and touchdown ([`Flight::events_s`]; every such frame is
+/// airborne, and a 60 Hz running flight keeps 4–5 of its frames), or, without events, over
+/// the flight's frames less [`BALLISTIC_EDGE_FRAMES`] at each end. Both stances beside one
+/// flight use the same parabola, so they agree on its state. `None` for a non-ballistic
+/// flight or fewer than [`BALLISTIC_MIN_FRAMES`] frames.
 fn ballistic_fit(fr: &ClipFrames, f: &Flight) -> Option<FlightFit> {
     if !f.ballistic {
         return None;
@@ -199,20 +204,32 @@ fn ballistic_fit(fr: &ClipFrames, f: &Flight) -> Option<FlightFit> {
         return f.fit.clone();
     }
     let frame0 = fr.frame[0];
-    let a = usize::try_from(f.first_frame - frame0).ok()? + BALLISTIC_EDGE_FRAMES;
-    let b = usize::try_from(f.last_frame - frame0)
-        .ok()?
-        .checked_sub(BALLISTIC_EDGE_FRAMES)?;
-    if b < a || b + 1 - a < BALLISTIC_MIN_FRAMES || b >= fr.com.len() {
+    let (first, last) = (
+        usize::try_from(f.first_frame - frame0).ok()?,
+        usize::try_from(f.last_frame - frame0).ok()?,
+    );
+    if last >= fr.com.len() {
         return None;
     }
-    let t = &fr.time_s[a..=b];
-    let axis = |i: usize| -> Vec<f64> { fr.com[a..=b].iter().map(|c| c[i]).collect() };
+    let ks: Vec<usize> = match f.events_s {
+        Some((lo, td)) => (first.saturating_sub(BALLISTIC_EDGE_FRAMES)
+            ..=(last + BALLISTIC_EDGE_FRAMES).min(fr.com.len() - 1))
+            .filter(|&k| fr.time_s[k] > lo && fr.time_s[k] < td)
+            .collect(),
+        None => {
+            (first + BALLISTIC_EDGE_FRAMES..=last.saturating_sub(BALLISTIC_EDGE_FRAMES)).collect()
+        }
+    };
+    if ks.len() < BALLISTIC_MIN_FRAMES {
+        return None;
+    }
+    let t: Vec<f64> = ks.iter().map(|&k| fr.time_s[k]).collect();
+    let axis = |i: usize| -> Vec<f64> { ks.iter().map(|&k| fr.com[k][i]).collect() };
     Some(FlightFit {
         axes: [
-            poly_fit(t, &axis(0), 1)?,
-            poly_fit(t, &axis(1), 1)?,
-            fit_fixed_curvature(t, &axis(2), -GRAVITY)?,
+            poly_fit(&t, &axis(0), 1)?,
+            poly_fit(&t, &axis(1), 1)?,
+            fit_fixed_curvature(&t, &axis(2), -GRAVITY)?,
         ],
     })
 }
