@@ -15,7 +15,19 @@
 //! β_h2 = (ve2 − u_apex)/J_h2,  β_v2 = g T2/J_v2,  β_p2 = 1   (vps2 = 0, vp2 = J_p2)
 //! flight time = (T1 − τ1 − Δt1) + t_TD2, each part ≥ 0;  d_flight = u_apex · flight time
 //! ```
-//! `J_p ≈ 0` (the ε_J test of §6.4) keeps `β_p1 = 1`. Where `−vps1/J_p1 < 0` the recorded
+//! `J_p ≈ 0` (the ε_J test of §6.4) keeps `β_p1 = 1`.
+//!
+//! **Near-vertical jumps** (§6.4 ii made practical): a stance whose heading impulse
+//! `|J_h|` is below [`J_H_DEGENERATE_MPS`] cannot set the apex speed — `β_h = Δu/J_h`
+//! turns a 0.05 m/s error into Δβ_h ≈ 0.3–0.7, and `s̄_h = K_h/J_h` makes `D(h)` meaningless.
+//! Such a stance keeps its recorded heading force (`β_h = 1`):
+//! ```text
+//! liftoff degenerate:  u_apex = vs1 + J_h1            (landing degenerate too: ve2 = u_apex + J_h2)
+//! landing degenerate:  u_apex = ve2 − J_h2
+//! ```
+//! and the jump's distance is then what A4 gives at that `u_apex`, not a free input: a
+//! request whose `d_jump` differs from it by more than [`DEGENERATE_DISTANCE_TOL_M`] fails
+//! with [`JumpFailure::DistanceFixed`]. The recorded vertical jump is found at β = 1. Where `−vps1/J_p1 < 0` the recorded
 //! perpendicular force pushes along the start drift and no `β_p ≥ 0` stops it: the spec's
 //! straight jump is then unreachable, so the perpendicular force is dropped and the small
 //! drift `vps1` kept (a stance from rest has `|vps1| < 0.2` m/s). The landing keeps its own
@@ -34,6 +46,14 @@ use super::pool::{PoolStance, Prepared};
 use super::run::{check_solution, ScaledStance};
 use super::solve::{admissible, Branch, Candidate, Infeasible, Request, Solution, StanceShape};
 use super::solve::{DEFAULT_ADMISSIBLE_TOL, DEFAULT_EPS_J};
+
+/// `|J_h|` below which a jump stance keeps its recorded heading force (β_h = 1) instead of
+/// setting the apex speed, m/s (module docs). Real near-vertical jumps have 0.07–0.18 m/s;
+/// running and forward-jump stances ≥ 0.5 m/s.
+pub const J_H_DEGENERATE_MPS: f64 = 0.3;
+/// How far a near-vertical jump's requested distance may lie from the distance its
+/// recorded heading force gives, m.
+pub const DEGENERATE_DISTANCE_TOL_M: f64 = 0.02;
 
 /// A liftoff stance: (`rest` or `clip_edge`, `flight`) (§6.10, CORRECTIONS Issue 4 item 1).
 pub fn is_liftoff(s: &PoolStance) -> bool {
@@ -56,6 +76,9 @@ pub enum JumpFailure {
     Degenerate,
     /// `D(h) ≤ 0`: the distance does not determine `u_apex`.
     NoDistanceMap,
+    /// A near-vertical jump (`|J_h| < J_H_DEGENERATE_MPS`): its distance is fixed by the
+    /// recorded heading force and the request asks for another.
+    DistanceFixed,
     /// A rule of §6.5 (sign, centroid, flight) fails for one stance.
     Rule(Infeasible),
 }
@@ -66,6 +89,9 @@ impl std::fmt::Display for JumpFailure {
             JumpFailure::Unreachable => f.write_str("apex height unreachable"),
             JumpFailure::Degenerate => f.write_str("no net horizontal or vertical impulse"),
             JumpFailure::NoDistanceMap => f.write_str("distance does not determine u_apex"),
+            JumpFailure::DistanceFixed => f.write_str(
+                "near-vertical jump: its distance is fixed by the recorded heading force",
+            ),
             JumpFailure::Rule(r) => write!(f, "{r}"),
         }
     }
@@ -296,18 +322,32 @@ pub fn jump(
 ) -> Result<Jump, JumpFailure> {
     let s1 = liftoff_side(p1, h)?;
     let h2 = h + p1.stance.z_c - p2.stance.z_c;
-    let s2 = landing_side(p2, h2)?;
-    let (d, c) = distance_map(p1, &s1, p2, &s2);
-    if d.is_nan() || d <= 0.0 {
-        return Err(JumpFailure::NoDistanceMap);
+    let mut s2 = landing_side(p2, h2)?;
+    let degenerate = [p1, p2].map(|p| p.shape.j[0].abs() < J_H_DEGENERATE_MPS);
+    let u_apex = match degenerate {
+        [false, false] => {
+            let (d, c) = distance_map(p1, &s1, p2, &s2);
+            if d.is_nan() || d <= 0.0 {
+                return Err(JumpFailure::NoDistanceMap);
+            }
+            (d_jump - c) / d
+        }
+        [true, _] => s1.vs + p1.shape.j[0],
+        [false, true] => s2.ve - p2.shape.j[0],
+    };
+    if degenerate == [true, true] {
+        s2.ve = u_apex + p2.shape.j[0];
     }
-    let u_apex = (d_jump - c) / d;
     let lim = limits.unwrap_or([
         relative_limits(&p1.stance.coef),
         relative_limits(&p2.stance.coef),
     ]);
     let (r1, sol1) = side_solution(p1, &s1, true, u_apex).map_err(JumpFailure::Rule)?;
     let (r2, sol2) = side_solution(p2, &s2, false, u_apex).map_err(JumpFailure::Rule)?;
+    let fixed = degenerate.contains(&true);
+    if fixed && (r1.x + r2.x - d_jump).abs() > DEGENERATE_DISTANCE_TOL_M {
+        return Err(JumpFailure::DistanceFixed);
+    }
     let flight_time = s1.flight_part + s2.flight_part;
     Ok(Jump {
         u_apex,

@@ -97,3 +97,59 @@ fn unreachable_heights_and_flight_rules_are_reasons_not_nan() {
         assert!(jump(&p1, &p2, h, bad, None).is_err());
     }
 }
+
+#[test]
+fn near_vertical_jumps_keep_their_heading_force() {
+    // See: issue 12 item 3 — |J_h| below J_H_DEGENERATE_MPS is §6.4's degenerate case: the
+    // recorded vertical jump is found at β = 1 (it failed with "distance does not determine
+    // u_apex" before), and another distance is refused with its reason, not a huge β_h.
+    use crate::query::testkit::{jump_model, pool_stance};
+    use crate::stances::segment::Boundary;
+    let mut rng = Lcg(0x5eed_0504);
+    let mut checked = 0;
+    for _ in 0..50 {
+        let up = pool_stance(
+            "up",
+            jump_model(&mut rng, 0.01),
+            [0.0, 0.0, -0.1],
+            0.9,
+            (Boundary::Rest, Boundary::Flight),
+            "LR",
+            [0.0, 0.0],
+        );
+        if up.params.t_e < up.params.t_lo {
+            continue;
+        }
+        let q1 = up.params;
+        let t_td2 = 0.3;
+        let down = pool_stance(
+            "down",
+            jump_model(&mut rng, -0.01),
+            [q1.ve, q1.vp, -GRAVITY * t_td2],
+            q1.ze - 0.5 * GRAVITY * t_td2 * t_td2,
+            (Boundary::Flight, Boundary::Rest),
+            "LR",
+            [0.0, 0.0],
+        );
+        let (p1, p2) = (Prepared::new(up), Prepared::new(down));
+        assert!(
+            p1.shape.j[0].abs() < J_H_DEGENERATE_MPS && p2.shape.j[0].abs() < J_H_DEGENERATE_MPS
+        );
+        let (h, d) = recorded_jump(&p1.stance, &p2.stance);
+        let j = jump(&p1, &p2, h, d, None).expect("the recorded vertical jump");
+        for (_, s) in &j.sides {
+            assert!(
+                s.solution.beta.iter().all(|b| (b - 1.0).abs() < 1e-6),
+                "β {:?}",
+                s.solution.beta
+            );
+        }
+        // Farther than the recorded heading force carries: refused with the reason.
+        assert_eq!(
+            jump(&p1, &p2, h, d + 0.5, None).err(),
+            Some(JumpFailure::DistanceFixed)
+        );
+        checked += 1;
+    }
+    assert!(checked >= 25, "only {checked} pairs");
+}
