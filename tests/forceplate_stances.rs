@@ -429,6 +429,7 @@ fn stance_friction_demand_matches_the_force_plates() {
         let (m20, p20) = (mu_req(&model, 0.2), mu_req(&plate, 0.2));
         // The stored μ_req is the same function of the model on its grid.
         assert!((m5 - mu_req(&model, 0.05)).abs() < 1e-9, "{}", s.stance_id);
+        assert!((s.coef.mu_req_robust - m20).abs() < 1e-9, "{}", s.stance_id);
         outln!(
             out,
             "  {:<30} μ5 {m5:.3} | {p5:.3}   μ20 {m20:.3} | {p20:.3}   unilateral {}",

@@ -46,7 +46,7 @@ lib = {lib:?}
 t = pq.read_table(lib + "/stances.parquet")
 assert t.num_rows == {n_stances}, t.num_rows
 meta = pq.ParquetFile(lib + "/stances.parquet").metadata.metadata
-assert meta[b"stancelib.schema_version"] == b"2", meta
+assert meta[b"stancelib.schema_version"] == b"3", meta
 row = t.slice(0, 1).to_pylist()[0]
 assert row["stance_id"] == {sid:?}, row["stance_id"]
 assert abs(row["dt_s"] - {dt}) < 1e-12, row["dt_s"]

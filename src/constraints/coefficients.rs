@@ -34,7 +34,7 @@
 //! Pollard & Behmaram-Mosavat 2000, eq 9–12; spec stance-model §7.1 (active set).
 
 use super::tables::SampledTables;
-use super::ACTIVE_FRACTION;
+use super::{ACTIVE_FRACTION, ROBUST_ACTIVE_FRACTION};
 use crate::force_model::UNILATERAL_FRACTION;
 
 /// The β-independent force quantities of one stance (eq 9, eq 11, §4.3, §7.1).
@@ -54,6 +54,8 @@ pub struct ForceCoefficients {
     pub f_peak: f64,
     /// `max over T_act of |f_t|/f_v`, dimensionless.
     pub mu_req: f64,
+    /// The same over `f_v ≥ ROBUST_ACTIVE_FRACTION · max f_v`, dimensionless.
+    pub mu_req_robust: f64,
 }
 
 /// Eq 9 and eq 11 coefficients, `F_peak`, `μ_req` and the unilateral test from the tables.
@@ -82,6 +84,7 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
     let unilateral_ok = fv.iter().all(|&v| v >= unilateral_floor);
 
     let (a_mu, mu_req) = friction_demand(tables, max_f_v, ACTIVE_FRACTION);
+    let (_, mu_req_robust) = friction_demand(tables, max_f_v, ROBUST_ACTIVE_FRACTION);
 
     ForceCoefficients {
         a_f,
@@ -91,6 +94,7 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
         unilateral_ok,
         f_peak: f_peak.sqrt(),
         mu_req,
+        mu_req_robust,
     }
 }
 

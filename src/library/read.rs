@@ -304,8 +304,28 @@ pub fn read_stances(path: &Path) -> Result<Vec<PoolStance>> {
     let (b0, b1) = (s("boundary_start")?, s("boundary_end")?);
     let first = t.i64s("first_frame")?;
     let names = [
-        "z_c", "zs", "vs", "ze", "ve", "vp", "vps", "x", "z_td", "z_lo", "t_td_s", "t_lo_s",
-        "t_e_s", "dt_s", "mass_kg", "cp_h", "cp_p", "min_f_v", "f_peak", "mu_req", "ext_min",
+        "z_c",
+        "zs",
+        "vs",
+        "ze",
+        "ve",
+        "vp",
+        "vps",
+        "x",
+        "z_td",
+        "z_lo",
+        "t_td_s",
+        "t_lo_s",
+        "t_e_s",
+        "dt_s",
+        "mass_kg",
+        "cp_h",
+        "cp_p",
+        "min_f_v",
+        "f_peak",
+        "mu_req",
+        "mu_req_robust",
+        "ext_min",
         "ext_max",
     ];
     let cols: BTreeMap<&str, Vec<f64>> = names
@@ -381,6 +401,7 @@ pub fn read_stances(path: &Path) -> Result<Vec<PoolStance>> {
                     support_ok: support[i],
                     f_peak: v("f_peak", i),
                     mu_req: v("mu_req", i),
+                    mu_req_robust: v("mu_req_robust", i),
                     ext_min: v("ext_min", i),
                     ext_max: v("ext_max", i),
                     ang_impulse: fixed(&ang[i]),

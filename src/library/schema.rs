@@ -9,7 +9,7 @@
 //! `joint`, `x`, `y`, `z`.
 
 /// Version of the table layout; bumped on any column change.
-pub const SCHEMA_VERSION: &str = "2";
+pub const SCHEMA_VERSION: &str = "3";
 /// Per-frame table.
 pub const FRAMES_FILE: &str = "frames.parquet";
 /// Per-clip table.

@@ -235,6 +235,7 @@ pub fn stances_table(rows: &[Stance]) -> PolarsResult<DataFrame> {
     )?);
     cols.push(col("f_peak", f(&|r| r.coef.f_peak)));
     cols.push(col("mu_req", f(&|r| r.coef.mu_req)));
+    cols.push(col("mu_req_robust", f(&|r| r.coef.mu_req_robust)));
     cols.push(col("ext_min", f(&|r| r.coef.ext_min)));
     cols.push(col("ext_max", f(&|r| r.coef.ext_max)));
     cols.push(col("cp_h", f(&|r| r.cp[0])));

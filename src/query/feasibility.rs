@@ -88,12 +88,13 @@ pub const DEFAULT_MU: f64 = 0.7;
 pub const SINGULAR_REL: f64 = 1e-12;
 
 /// Default active fraction `λ_act` of the queries' friction check (`--active-set`,
-/// pipeline `[constraints] active_set`): `f_v ≥ 0.2 · max f_v`. On the force plates of a
-/// treadmill run the stance models' `μ_req` agree with the plates' to 0.07 (median) at 0.2,
-/// and to 0.19 at the paper's 0.05, where the ratio is decided by the last frames of
+/// pipeline `[constraints] active_set`): the robust `f_v ≥ 0.2 · max f_v` of the stored
+/// `mu_req_robust` ([`crate::constraints::ROBUST_ACTIVE_FRACTION`]). On the force plates of
+/// a treadmill run the stance models' `μ_req` agree with the plates' to 0.05 (median) at
+/// 0.2, and to 0.17 at the paper's 0.05, where the ratio is decided by the last frames of
 /// contact and the kinematic force is least accurate. The stored `mu_req`, `a_mu` columns
 /// stay at the paper's [`crate::constraints::ACTIVE_FRACTION`].
-pub const DEFAULT_QUERY_ACTIVE_FRACTION: f64 = 0.2;
+pub const DEFAULT_QUERY_ACTIVE_FRACTION: f64 = crate::constraints::ROBUST_ACTIVE_FRACTION;
 
 /// Checks a friction limit given by the user (`--mu`, `[constraints] mu`): a positive
 /// finite number.
