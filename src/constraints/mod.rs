@@ -88,7 +88,7 @@ pub const ACTIVE_FRACTION: f64 = 0.05;
 /// The robust active fraction: `f_v ≥ 0.2 · max f_v`, of the stored `mu_req_robust` column
 /// and the queries' default friction check. Against force plates the 5 % figure is decided
 /// by the last frame or two of contact, where the kinematic force is least accurate; at 20 %
-/// the model's `μ_req` agrees with the plates' to 0.05 (median) on a treadmill run.
+/// the model's `μ_req` agrees with the plates' to 0.04 (median) on a treadmill run.
 pub const ROBUST_ACTIVE_FRACTION: f64 = 0.2;
 /// Upper end of the β domain the Appendix B boxes are clipped to (§7.3).
 pub const DEFAULT_BETA_MAX: f64 = 3.0;

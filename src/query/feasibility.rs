@@ -90,8 +90,8 @@ pub const SINGULAR_REL: f64 = 1e-12;
 /// Default active fraction `λ_act` of the queries' friction check (`--active-set`,
 /// pipeline `[constraints] active_set`): the robust `f_v ≥ 0.2 · max f_v` of the stored
 /// `mu_req_robust` ([`crate::constraints::ROBUST_ACTIVE_FRACTION`]). On the force plates of
-/// a treadmill run the stance models' `μ_req` agree with the plates' to 0.05 (median) at
-/// 0.2, and to 0.17 at the paper's 0.05, where the ratio is decided by the last frames of
+/// a treadmill run the stance models' `μ_req` agree with the plates' to 0.04 (median) at
+/// 0.2, and to 0.12 at the paper's 0.05, where the ratio is decided by the last frames of
 /// contact and the kinematic force is least accurate. The stored `mu_req`, `a_mu` columns
 /// stay at the paper's [`crate::constraints::ACTIVE_FRACTION`].
 pub const DEFAULT_QUERY_ACTIVE_FRACTION: f64 = crate::constraints::ROBUST_ACTIVE_FRACTION;
