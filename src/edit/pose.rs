@@ -224,6 +224,7 @@ pub struct PoseWorkspace {
     pts: Vec<V3>,
     knee_axis: [Option<V3>; 2],
     prev_angles: Option<Vec<f64>>,
+    free_q: Vec<Quat>,
 }
 
 impl PoseWorkspace {
@@ -243,6 +244,7 @@ impl PoseWorkspace {
             pts: vec![[0.0; 3]; sk.n_points()],
             knee_axis: [None; 2],
             prev_angles: None,
+            free_q: vec![rot::QUAT_IDENTITY; sk.n_joints()],
         }
     }
 }
@@ -282,7 +284,7 @@ fn turn_world(r: &Reference, pose: &mut Pose, wq: &[Quat], j: usize, delta: Quat
 /// One output frame's outcome.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FramePose {
-    /// Output time (s from the plan's start).
+    /// Output time (s from the first output frame).
     pub time_s: f64,
     /// The phase.
     pub phase: Phase,
@@ -292,6 +294,8 @@ pub struct FramePose {
     pub com_pose: V3,
     /// Planned contact point, in stance (m).
     pub contact: Option<V3>,
+    /// Planned touchdown and liftoff of the stance, in stance (s, output time).
+    pub window: Option<(f64, f64)>,
     /// Support ankle (left when both), in stance (m).
     pub foot: Option<V3>,
     /// Largest distance of a support ankle from its target (m).
@@ -326,7 +330,58 @@ fn wrap_pi(a: f64) -> f64 {
     a - t * (a / t).round()
 }
 
+/// The anchored targets of stance `k`'s feet from the reference pose now in `ws.pose`
+/// (before the yaw): ankle position (file) and world orientation, weighted by `w`.
+fn anchors(
+    r: &Reference,
+    path: &ComPath,
+    s: &StanceSource,
+    k: usize,
+    yaw: f64,
+    w: f64,
+    ws: &mut PoseWorkspace,
+    out: &mut Vec<Target>,
+) {
+    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+    let body = &r.body;
+    let c_plan = path.stances[k].contact_point();
+    let yaw_int = rot::axis_angle([0.0, 0.0, 1.0], yaw);
+    let q_yaw = rot::axis_angle(up_file(body), yaw);
+    for side in 0..2 {
+        if s.feet[side] {
+            let ankle = r.legs[side][2];
+            let rel = rot::rotate(yaw_int, sub(ws.pts[ankle], s.anchor));
+            out.push(Target {
+                side,
+                pos: body.to_file(add(c_plan, rel)),
+                orient: rot::mul(q_yaw, ws.world_q[ankle]),
+                weight: w,
+            });
+        }
+    }
+}
+
+/// A foot target: where the ankle goes (file frame), its world orientation, and how much
+/// of it is taken (1 in stance; the smooth flight weight next to a stance).
+#[derive(Debug, Clone, Copy)]
+struct Target {
+    side: usize,
+    pos: V3,
+    orient: Quat,
+    weight: f64,
+}
+
+fn up_file(body: &BodyModel) -> V3 {
+    let u = body.to_file([0.0, 0.0, 1.0]);
+    let n = norm(u);
+    u.map(|v| v / n)
+}
+
 /// Poses one output time into `ws.pose`; returns the frame's outcome.
+///
+/// In a flight the feet of the stance before keep following their anchored reference with
+/// weight `1 − w`, and those of the stance after with weight `w`, so a foot reaches and
+/// leaves the floor as the source foot does and never jumps at a contact edge.
 pub fn pose_frame(
     r: &Reference,
     path: &ComPath,
@@ -339,13 +394,15 @@ pub fn pose_frame(
     let st = &path.stances;
     let src_of = |k: usize| &src[st[k].source];
     let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src_of(k).heading_rad);
-    // 1. Reference pose and yaw.
+    let mut targets: Vec<Target> = Vec::with_capacity(4);
+    // 1. Reference pose, foot anchors and yaw.
     let (yaw, stance) = match phase {
         Phase::Stance(k) => {
             let (td, lo) = st[k].contact_window();
             let s = src_of(k);
             let u = if lo > td { (t - td) / (lo - td) } else { 0.0 };
             r.sample(s.td_clip_s + u * (s.lo_clip_s - s.td_clip_s), &mut ws.pose);
+            anchors(r, path, s, k, yaw_of(k), 1.0, ws, &mut targets);
             (yaw_of(k), Some(k))
         }
         Phase::Flight { before, after } => {
@@ -366,23 +423,28 @@ pub fn pose_frame(
             match (side_a, side_b, before, after) {
                 (Some((lo, ta)), Some((td, tb)), Some(b), Some(a)) => {
                     let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
+                    let (ya, yb) = (yaw_of(b), yaw_of(a));
+                    r.sample(tb, &mut ws.pose);
+                    anchors(r, path, src_of(a), a, yb, w, ws, &mut targets);
+                    std::mem::swap(&mut ws.pose, &mut ws.other);
                     r.sample(ta, &mut ws.pose);
-                    r.sample(tb, &mut ws.other);
+                    anchors(r, path, src_of(b), b, ya, 1.0 - w, ws, &mut targets);
                     for (qa, qb) in ws.pose.q.iter_mut().zip(&ws.other.q) {
                         *qa = rot::slerp(*qa, *qb, w);
                     }
                     for (va, vb) in ws.pose.row.iter_mut().zip(&ws.other.row) {
                         *va += w * (vb - *va);
                     }
-                    let (ya, yb) = (yaw_of(b), yaw_of(a));
                     (ya + w * wrap_pi(yb - ya), None)
                 }
                 (Some((_, ta)), _, Some(b), _) => {
                     r.sample(ta, &mut ws.pose);
+                    anchors(r, path, src_of(b), b, yaw_of(b), 1.0, ws, &mut targets);
                     (yaw_of(b), None)
                 }
                 (_, Some((_, tb)), _, Some(a)) => {
                     r.sample(tb, &mut ws.pose);
+                    anchors(r, path, src_of(a), a, yaw_of(a), 1.0, ws, &mut targets);
                     (yaw_of(a), None)
                 }
                 _ => {
@@ -393,58 +455,57 @@ pub fn pose_frame(
         }
     };
     let body = &r.body;
-    let up_file = {
-        let u = body.to_file([0.0, 0.0, 1.0]);
-        let n = norm(u);
-        u.map(|v| v / n)
-    };
-    let q_yaw = rot::axis_angle(up_file, yaw);
+    let q_yaw = rot::axis_angle(up_file(body), yaw);
     let (com_plan, _) = path.com(t);
-    // 2. Targets of the support feet from the reference (before the yaw).
-    let mut targets: Vec<(usize, V3, Quat)> = Vec::new();
-    let mut contact = None;
-    if let Some(k) = stance {
-        forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-        let s = src_of(k);
-        let c_plan = st[k].contact_point();
-        contact = Some(c_plan);
-        let yaw_int = rot::axis_angle([0.0, 0.0, 1.0], yaw);
-        for side in 0..2 {
-            if s.feet[side] {
-                let ankle = r.legs[side][2];
-                let rel = rot::rotate(yaw_int, sub(ws.pts[ankle], s.anchor));
-                let target = body.to_file(add(c_plan, rel));
-                let orient = rot::mul(q_yaw, ws.world_q[ankle]);
-                targets.push((side, target, orient));
-            }
-        }
-    }
+    let contact = stance.map(|k| st[k].contact_point());
     ws.pose.q[r.root] = rot::mul(q_yaw, ws.pose.q[r.root]);
+    ws.free_q.clone_from(&ws.pose.q);
     let root_ch = body.skeleton.channels[r.root].translations;
-    // 3. Root and IK until the COM is on the plan.
+    // 2. Root and IK until the COM is on the plan.
     let mut iterations = 0;
     let (mut err_m, mut foot_err) = (f64::INFINITY, 0.0);
     let mut com_pose = [0.0; 3];
+    let mut goal: [Option<(V3, Quat)>; 2] = [None; 2];
     while iterations < opts.max_iterations {
         iterations += 1;
+        ws.pose.q.copy_from_slice(&ws.free_q);
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
         if !targets.is_empty() {
-            for &(side, target, _) in &targets {
-                two_bone(r, ws, side, target, opts.max_reach);
-                forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-            }
-            for &(side, _, orient) in &targets {
+            // Each foot: free position plus the weighted pulls of its anchors.
+            goal = [None; 2];
+            for side in 0..2 {
                 let ankle = r.legs[side][2];
-                let parent = body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
-                ws.pose.q[ankle] = rot::normalize(rot::mul(rot::conj(parent), orient));
+                let (free_p, free_o) = (ws.file[ankle], ws.world_q[ankle]);
+                let (mut p, mut o, mut any) = (free_p, free_o, false);
+                let mut w_sum = 0.0;
+                for tg in targets.iter().filter(|tg| tg.side == side && tg.weight > 0.0) {
+                    any = true;
+                    p = add(p, sub(tg.pos, free_p).map(|v| v * tg.weight));
+                    w_sum += tg.weight;
+                    o = rot::slerp(o, tg.orient, tg.weight / w_sum);
+                }
+                if any {
+                    goal[side] = Some((p, o));
+                }
+            }
+            for side in 0..2 {
+                if let Some((p, _)) = goal[side] {
+                    two_bone(r, ws, side, p, opts.max_reach);
+                    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+                }
+            }
+            for side in 0..2 {
+                if let Some((_, o)) = goal[side] {
+                    let ankle = r.legs[side][2];
+                    let parent = body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
+                    ws.pose.q[ankle] = rot::normalize(rot::mul(rot::conj(parent), o));
+                }
             }
             forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-            foot_err = targets
-                .iter()
-                .map(|&(side, target, _)| {
-                    norm(sub(ws.file[r.legs[side][2]], target)) * body.unit_m
-                })
-                .fold(0.0, f64::max);
+            foot_err = (0..2)
+                .filter_map(|side| goal[side].map(|(p, _)| norm(sub(ws.file[r.legs[side][2]], p))))
+                .fold(0.0, f64::max)
+                * body.unit_m;
         }
         com_pose = body.com(&ws.pts);
         let e = sub(com_plan, com_pose);
@@ -465,13 +526,18 @@ pub fn pose_frame(
         com_pose = body.com(&ws.pts);
         err_m = norm(sub(com_plan, com_pose));
     }
-    let foot = targets.first().map(|&(side, _, _)| ws.pts[r.legs[side][2]]);
+    let support = stance.and_then(|k| src_of(k).feet.iter().position(|&f| f));
+    let foot = support.map(|side| ws.pts[r.legs[side][2]]);
     FramePose {
         time_s: t,
         phase,
         com_plan,
         com_pose,
         contact,
+        window: stance.map(|k| {
+            let (td, lo) = st[k].contact_window();
+            (td - path.t_start, lo - path.t_start)
+        }),
         foot,
         foot_error_m: foot_err,
         iterations,
@@ -546,7 +612,8 @@ pub fn pose_motion(
     let mut ws = PoseWorkspace::new(r);
     for i in 0..n {
         let t = path.t_start + i as f64 / fps;
-        let f = pose_frame(r, path, src, opts, t, &mut ws);
+        let mut f = pose_frame(r, path, src, opts, t, &mut ws);
+        f.time_s = i as f64 / fps;
         write_angles(r, &mut ws);
         values.extend_from_slice(&ws.pose.row);
         frames.push(f);
