@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use stancelib::bvh::parse_file;
-use stancelib::edit::rotation::{angle_deg, from_euler, slerp, Quat};
+use stancelib::edit::rotation::{angle_deg, from_euler, Quat};
 use stancelib::ingest::{ingest, ClipFrames, ClipOutcome, ClipSummary, ContactRun, IngestOptions};
 use stancelib::library::read::{open_library, read_parquet};
 use stancelib::query::run::run_cycles;
@@ -46,7 +46,6 @@ fn cycle_of(lib: &Path, clip: &str) -> (String, f64) {
 /// The plan sidecar, by column.
 struct Plan {
     time: Vec<f64>,
-    phase: Vec<String>,
     com: Vec<[f64; 3]>,
     pose_com: Vec<[f64; 3]>,
     window: Vec<Option<(f64, f64)>>,
@@ -67,7 +66,6 @@ fn read_plan(out: &Path) -> Plan {
     let (td, lo) = (f("stance_td_s"), f("stance_lo_s"));
     Plan {
         time: f("time_s").into_iter().map(Option::unwrap).collect(),
-        phase: s("phase").into_iter().map(Option::unwrap).collect(),
         com: v3("com"),
         pose_com: v3("pose_com"),
         window: td.iter().zip(&lo).map(|(a, b)| a.zip(*b)).collect(),
@@ -150,19 +148,30 @@ fn measure(out: &Path) -> Figures {
                     fig.event_err_frames = fig.event_err_frames.max((t - lo).abs() / dt);
                 }
             }
-            // Slide: the foot point that stays put (heel = ankle, or toe tip) during the
-            // planned stance, horizontal distance from its position at mid-stance.
+            // Slide: a foot point (ankle = heel, or toe tip) resting on the floor (within
+            // 5 mm of its lowest height in the stance) must not move; a point still landing
+            // or already rolling off is not a contact point. Horizontal distance from the
+            // point's median position over its resting frames; the better-resting point.
             let ankle = frames.effector_pos[k].as_ref().unwrap();
             let idx: Vec<usize> = (0..plan.time.len())
                 .filter(|&i| plan.time[i] >= *td && plan.time[i] <= *lo)
                 .collect();
-            let mid = idx[idx.len() / 2];
-            let hor = |p: &[[f64; 3]]| {
-                idx.iter()
-                    .map(|&i| (p[i][0] - p[mid][0]).hypot(p[i][1] - p[mid][1]))
-                    .fold(0.0, f64::max)
+            let rest = |p: &[[f64; 3]]| {
+                let zmin = idx.iter().map(|&i| p[i][2]).fold(f64::INFINITY, f64::min);
+                let on: Vec<usize> = idx.iter().copied().filter(|&i| p[i][2] <= zmin + 0.005).collect();
+                let med = |a: usize| {
+                    let mut v: Vec<f64> = on.iter().map(|&i| p[i][a]).collect();
+                    v.sort_by(f64::total_cmp);
+                    v[v.len() / 2]
+                };
+                let (mx, my) = (med(0), med(1));
+                let slide = on.iter().map(|&i| (p[i][0] - mx).hypot(p[i][1] - my)).fold(0.0, f64::max);
+                (on.len(), slide)
             };
-            let slide = hor(ankle).min(hor(&frames.toe[k]));
+            let (na, sa) = rest(ankle);
+            let (nt, st) = rest(&frames.toe[k]);
+            assert!(na.max(nt) * 2 >= idx.len(), "{id}: a foot point rests for half the stance");
+            let slide = if na >= nt { sa } else { st };
             fig.slide_max_m = fig.slide_max_m.max(slide);
         }
     }
@@ -238,5 +247,149 @@ fn edited_runs_round_trip_within_the_issue_bounds() {
         let speed = rebuilt_speed(sub.path(), &out);
         eprintln!("run at {v} m/s (recorded {v0:.3}): rebuilt {speed:.4} m/s");
         assert!((speed - v).abs() <= 0.02 * v, "rebuilt speed {speed} vs {v}");
+    }
+}
+
+/// Index of a stance id in a library's file order.
+fn stance_index(lib: &Path, id: &str) -> usize {
+    open_library(lib).unwrap().stances.iter().position(|s| s.stance_id == id).unwrap()
+}
+
+/// Joint-angle RMS (degrees) and largest root distance (m) of the first `span_s` of an
+/// edited clip against the source clip from `src_t0` on (identity requests).
+fn against_source(out: &Path, source: &Path, unit_m: f64, t_out0: f64, src_t0: f64, span_s: f64) -> (f64, f64) {
+    let (o, s) = (parse_file(out).unwrap(), parse_file(source).unwrap());
+    let (qo, qs) = (local_quats(&o), local_quats(&s));
+    let nj = o.hierarchy.joints.len();
+    let sk = Skeleton::from_bvh(&s);
+    let root_t = |b: &stancelib::bvh::Bvh, f: usize| -> [f64; 3] {
+        let row = b.motion.row(f);
+        sk.channels[0].translations.map(|c| row[c.unwrap()] * unit_m)
+    };
+    let (dt_o, dt_s) = (o.motion.frame_time_s, s.motion.frame_time_s);
+    let (mut sum, mut n, mut root_max) = (0.0, 0usize, 0.0f64);
+    for f in 0..o.motion.n_frames() {
+        let t = f as f64 * dt_o;
+        if t < t_out0 || t > t_out0 + span_s {
+            continue;
+        }
+        let x = (src_t0 + t - t_out0) / dt_s;
+        let (f0, w) = (x.floor() as usize, x - x.floor());
+        if f0 + 1 >= s.motion.n_frames() {
+            continue;
+        }
+        for j in 0..nj {
+            let q = stancelib::edit::rotation::slerp(qs[f0 * nj + j], qs[(f0 + 1) * nj + j], w);
+            let a = angle_deg(qo[f * nj + j], q);
+            sum += a * a;
+            n += 1;
+        }
+        let (r0, r1, ro) = (root_t(&s, f0), root_t(&s, f0 + 1), root_t(&o, f));
+        let rs: [f64; 3] = std::array::from_fn(|i| r0[i] + w * (r1[i] - r0[i]));
+        root_max = root_max.max(dist(ro, rs));
+    }
+    assert!(n > 0, "frames compared");
+    ((sum / n as f64).sqrt(), root_max)
+}
+
+/// The first planned stance window of an edit (output time).
+fn first_window(out: &Path) -> (f64, f64, String) {
+    let plan = read_plan(out);
+    let i = plan.window.iter().position(Option::is_some).unwrap();
+    let w = plan.window[i].unwrap();
+    (w.0, w.1, plan.stance[i].clone().unwrap())
+}
+
+#[test]
+fn identity_run_reproduces_the_recorded_motion() {
+    let dir = tmp();
+    let src = fixture("run_120hz_m_yup");
+    let lib = library(dir.path(), &[src.clone()]);
+    let (id, v0) = cycle_of(&lib, "run_120hz_m_yup");
+    let out = dir.path().join("identity.bvh");
+    ok(&["edit", "run", "--lib", lib.to_str().unwrap(), "--speed", &v0.to_string(), "--stance", &id, "--cycles", "1", "--out", out.to_str().unwrap()]);
+    assert_bounds(&measure(&out));
+    let (td, _, first) = first_window(&out);
+    let t = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+    let td_clip = t[stance_index(&lib, &first)].td_clip_s;
+    let (rms, root) = against_source(&out, &src, 1.0, 0.0, td_clip - td, 10.0);
+    eprintln!("identity run: joint-angle RMS {rms:.3}°, root path {root:.4} m");
+    assert!(rms <= 3.0, "joint-angle RMS {rms}° > 3°");
+    assert!(root <= 0.02, "root path {root} m > 2 cm");
+}
+
+#[test]
+fn infeasible_run_is_refused_naming_the_constraint_and_writes_nothing() {
+    let dir = tmp();
+    let lib = library(dir.path(), &[fixture("run_120hz_m_yup")]);
+    let out = dir.path().join("fast.bvh");
+    let (code, _, err) = stancelib(&["edit", "run", "--lib", lib.to_str().unwrap(), "--speed", "9", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("infeasible request") && (err.contains("force") || err.contains("friction") || err.contains("extension")), "{err}");
+    for p in [out.clone(), out.with_extension("plan.parquet"), out.with_extension("png")] {
+        assert!(!p.exists(), "{} written", p.display());
+    }
+    // --allow-infeasible writes it, and the sidecar names the constraint per stance frame.
+    ok(&["edit", "run", "--lib", lib.to_str().unwrap(), "--speed", "9", "--out", out.to_str().unwrap(), "--allow-infeasible"]);
+    let df = read_parquet(&out.with_extension("plan.parquet")).unwrap();
+    let v = df.column("violated").unwrap().str().unwrap().iter().flatten().count();
+    assert!(v > 0, "violated column names the failing constraint");
+}
+
+#[test]
+fn edited_jumps_reach_the_requested_apex_and_round_trip() {
+    let dir = tmp();
+    let src = fixture("jump_120hz_cmu_yup");
+    let lib = library(dir.path(), &[src.clone()]);
+    let l = open_library(&lib).unwrap();
+    let s = &l.stances;
+    let (i, j) = (1..s.len())
+        .find_map(|i| {
+            (stancelib::query::jump::is_liftoff(&s[i - 1]) && stancelib::query::jump::is_landing(&s[i])).then_some((i - 1, i))
+        })
+        .expect("a recorded jump");
+    let (h0, d0) = stancelib::query::jump::recorded_jump(&s[i], &s[j]);
+    for scale in [1.0, 1.2] {
+        let out = dir.path().join(format!("jump_{scale}.bvh"));
+        ok(&["edit", "jump", "--lib", lib.to_str().unwrap(), "--height-scale", &scale.to_string(), "--out", out.to_str().unwrap(), "--allow-infeasible"]);
+        let f = measure(&out);
+        assert_bounds(&f);
+        let sub = tempfile::tempdir_in(dir.path()).unwrap();
+        let rl = library(sub.path(), &[out.clone()]);
+        let r = open_library(&rl).unwrap();
+        let rs = &r.stances;
+        let (a, b) = (1..rs.len())
+            .find_map(|k| {
+                (stancelib::query::jump::is_liftoff(&rs[k - 1]) && stancelib::query::jump::is_landing(&rs[k])).then_some((k - 1, k))
+            })
+            .expect("the rebuilt clip has a jump");
+        let (h, d) = stancelib::query::jump::recorded_jump(&rs[a], &rs[b]);
+        eprintln!("jump ×{scale}: apex {h:.4} m (asked {:.4}), distance {d:.4} m (asked {d0:.4})", h0 * scale);
+        assert!((h - h0 * scale).abs() <= 0.02, "apex {h} vs {}", h0 * scale);
+        assert!((d - d0).abs() <= 0.02, "distance {d} vs {d0}");
+        if scale == 1.0 {
+            let (td, _, _) = first_window(&out);
+            let tm = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+            let (rms, root) = against_source(&out, &src, 0.056444, 0.0, tm[i].td_clip_s - td, 10.0);
+            eprintln!("identity jump: joint-angle RMS {rms:.3}°, root path {root:.4} m");
+            assert!(rms <= 3.0 && root <= 0.02, "identity jump: RMS {rms}°, root {root} m");
+        }
+    }
+}
+
+#[test]
+fn edited_run_of_a_real_cmu_clip_round_trips() {
+    let Some(data) = shared_or_skip("edited_run_of_a_real_cmu_clip_round_trips") else {
+        return;
+    };
+    let dir = tmp();
+    let src = data.join("bvh/run/cmu_09_01_run_mb.bvh");
+    let lib = library(dir.path(), &[src]);
+    let (id, v0) = cycle_of(&lib, "cmu_09_01_run_mb");
+    for v in [v0, 1.1 * v0] {
+        let out = dir.path().join(format!("cmu_{v:.2}.bvh"));
+        ok(&["edit", "run", "--lib", lib.to_str().unwrap(), "--speed", &v.to_string(), "--stance", &id, "--out", out.to_str().unwrap(), "--allow-infeasible"]);
+        let f = measure(&out);
+        assert_bounds(&f);
     }
 }

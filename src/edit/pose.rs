@@ -92,6 +92,8 @@ pub struct Reference {
     pub root: usize,
     /// Source COM per frame (m, Z up).
     pub com: Vec<V3>,
+    /// Source ankles per frame (left, right): position (m, Z up), world rotation (file).
+    pub feet: Vec<[(V3, Quat); 2]>,
 }
 
 impl Reference {
@@ -148,6 +150,7 @@ impl Reference {
         let n = motion.n_frames();
         let mut quats = Vec::with_capacity(n * nj);
         let mut com = Vec::with_capacity(n);
+        let mut feet = Vec::with_capacity(n);
         let mut ws = crate::skeleton::fk::FkWorkspace::new(sk);
         let np = sk.n_points();
         let (mut file, mut pts) = (vec![[0.0; 3]; np], vec![[0.0; 3]; np]);
@@ -159,6 +162,8 @@ impl Reference {
             }
             body.points(&mut ws, row, &mut file, &mut pts);
             com.push(body.com(&pts));
+            let wq = world_quats(sk, &quats[f * nj..(f + 1) * nj]);
+            feet.push([0, 1].map(|k| (pts[legs[k][2]], wq[legs[k][2]])));
         }
         Ok(Reference {
             body,
@@ -168,7 +173,18 @@ impl Reference {
             legs,
             root,
             com,
+            feet,
         })
+    }
+
+    /// Source ankle of `side` at clip time `t`: position (m, Z up) and world rotation (file).
+    pub fn foot_at(&self, t: f64, side: usize) -> (V3, Quat) {
+        let (a, b, w) = self.at(t);
+        let ((pa, qa), (pb, qb)) = (self.feet[a][side], self.feet[b][side]);
+        (
+            std::array::from_fn(|i| pa[i] + w * (pb[i] - pa[i])),
+            rot::slerp(qa, qb, w),
+        )
     }
 
     /// Frame position of clip time `t` (s): `(f0, f1, w)`, clamped to the kept frames.
@@ -247,6 +263,19 @@ impl PoseWorkspace {
             free_q: vec![rot::QUAT_IDENTITY; sk.n_joints()],
         }
     }
+}
+
+/// World rotations of one frame's local rotations (parents before children).
+fn world_quats(sk: &crate::skeleton::Skeleton, local: &[Quat]) -> Vec<Quat> {
+    let mut w: Vec<Quat> = Vec::with_capacity(local.len());
+    for (j, q) in local.iter().enumerate() {
+        let v = match sk.parents[j] {
+            None => *q,
+            Some(p) => rot::mul(w[p], *q),
+        };
+        w.push(v);
+    }
+    w
 }
 
 /// FK of a quaternion pose: world rotations and file-frame points, then metres Z up.
@@ -330,45 +359,25 @@ fn wrap_pi(a: f64) -> f64 {
     a - t * (a / t).round()
 }
 
-/// The anchored targets of stance `k`'s feet from the reference pose now in `ws.pose`
-/// (before the yaw): ankle position (file) and world orientation, weighted by `w`.
-fn anchors(
+/// Foot `side` anchored to planned stance `k`, from the source foot at clip time `t_src`:
+/// ankle position (file) and world orientation.
+fn anchored(
     r: &Reference,
     path: &ComPath,
     s: &StanceSource,
     k: usize,
     yaw: f64,
-    w: f64,
-    ws: &mut PoseWorkspace,
-    out: &mut Vec<Target>,
-) {
-    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-    let body = &r.body;
-    let c_plan = path.stances[k].contact_point();
-    let yaw_int = rot::axis_angle([0.0, 0.0, 1.0], yaw);
-    let q_yaw = rot::axis_angle(up_file(body), yaw);
-    for side in 0..2 {
-        if s.feet[side] {
-            let ankle = r.legs[side][2];
-            let rel = rot::rotate(yaw_int, sub(ws.pts[ankle], s.anchor));
-            out.push(Target {
-                side,
-                pos: body.to_file(add(c_plan, rel)),
-                orient: rot::mul(q_yaw, ws.world_q[ankle]),
-                weight: w,
-            });
-        }
-    }
-}
-
-/// A foot target: where the ankle goes (file frame), its world orientation, and how much
-/// of it is taken (1 in stance; the smooth flight weight next to a stance).
-#[derive(Debug, Clone, Copy)]
-struct Target {
+    t_src: f64,
     side: usize,
-    pos: V3,
-    orient: Quat,
-    weight: f64,
+) -> (V3, Quat) {
+    let body = &r.body;
+    let (p, q) = r.foot_at(t_src, side);
+    let rel = rot::rotate(rot::axis_angle([0.0, 0.0, 1.0], yaw), sub(p, s.anchor));
+    let c_plan = path.stances[k].contact_point();
+    (
+        body.to_file(add(c_plan, rel)),
+        rot::mul(rot::axis_angle(up_file(body), yaw), q),
+    )
 }
 
 fn up_file(body: &BodyModel) -> V3 {
@@ -377,11 +386,74 @@ fn up_file(body: &BodyModel) -> V3 {
     u.map(|v| v / n)
 }
 
+/// Where foot `side` goes at `t`: anchored to its stance while in one; in a swing, the
+/// blend (smooth weight over the swing) of its motion after the last liftoff, anchored to
+/// that stance, and before the next touchdown, anchored to that one. The difference of
+/// the two is constant (the change of the footprint spacing), so the foot leaves and
+/// reaches the floor exactly as the source foot does. `None`: no stance of this foot.
+fn foot_goal(
+    r: &Reference,
+    path: &ComPath,
+    src: &[StanceSource],
+    t: f64,
+    side: usize,
+) -> Option<(V3, Quat, f64)> {
+    let st = &path.stances;
+    let has = |k: usize| src[st[k].source].feet[side];
+    let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src[st[k].source].heading_rad);
+    let rate = |k: usize| {
+        let (td, lo) = st[k].contact_window();
+        let s = &src[st[k].source];
+        if lo > td {
+            (s.lo_clip_s - s.td_clip_s) / (lo - td)
+        } else {
+            1.0
+        }
+    };
+    for k in (0..st.len()).filter(|&k| has(k)) {
+        let (td, lo) = st[k].contact_window();
+        if t >= td && t <= lo {
+            let s = &src[st[k].source];
+            let (p, q) = anchored(r, path, s, k, yaw_of(k), s.td_clip_s + (t - td) * rate(k), side);
+            return Some((p, q, 1.0));
+        }
+    }
+    let b = (0..st.len()).rev().find(|&k| has(k) && st[k].contact_window().1 <= t);
+    let a = (0..st.len()).find(|&k| has(k) && st[k].contact_window().0 >= t);
+    let from_b = b.map(|k| {
+        let s = &src[st[k].source];
+        let lo = st[k].contact_window().1;
+        anchored(r, path, s, k, yaw_of(k), s.lo_clip_s + (t - lo) * rate(k), side)
+    });
+    let from_a = a.map(|k| {
+        let s = &src[st[k].source];
+        let td = st[k].contact_window().0;
+        anchored(r, path, s, k, yaw_of(k), s.td_clip_s - (td - t) * rate(k), side)
+    });
+    match (from_b, from_a, b, a) {
+        (Some(pb), Some(pa), Some(b), Some(a)) => {
+            let (lo, td) = (st[b].contact_window().1, st[a].contact_window().0);
+            let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
+            let p = std::array::from_fn(|i| pb.0[i] + w * (pa.0[i] - pb.0[i]));
+            Some((p, rot::slerp(pb.1, pa.1, w), 1.0))
+        }
+        // Before the first or after the last stance of this foot: the free (reference)
+        // foot, pulled onto its anchor smoothly towards the contact edge.
+        (Some(p), None, Some(b), _) => {
+            let lo = st[b].contact_window().1;
+            let u = if path.t_end > lo { (t - lo) / (path.t_end - lo) } else { 1.0 };
+            Some((p.0, p.1, 1.0 - smooth(u)))
+        }
+        (None, Some(p), _, Some(a)) => {
+            let td = st[a].contact_window().0;
+            let u = if td > path.t_start { (t - path.t_start) / (td - path.t_start) } else { 1.0 };
+            Some((p.0, p.1, smooth(u)))
+        }
+        _ => None,
+    }
+}
+
 /// Poses one output time into `ws.pose`; returns the frame's outcome.
-///
-/// In a flight the feet of the stance before keep following their anchored reference with
-/// weight `1 − w`, and those of the stance after with weight `w`, so a foot reaches and
-/// leaves the floor as the source foot does and never jumps at a contact edge.
 pub fn pose_frame(
     r: &Reference,
     path: &ComPath,
@@ -394,7 +466,6 @@ pub fn pose_frame(
     let st = &path.stances;
     let src_of = |k: usize| &src[st[k].source];
     let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src_of(k).heading_rad);
-    let mut targets: Vec<Target> = Vec::with_capacity(4);
     // 1. Reference pose, foot anchors and yaw.
     let (yaw, stance) = match phase {
         Phase::Stance(k) => {
@@ -402,7 +473,6 @@ pub fn pose_frame(
             let s = src_of(k);
             let u = if lo > td { (t - td) / (lo - td) } else { 0.0 };
             r.sample(s.td_clip_s + u * (s.lo_clip_s - s.td_clip_s), &mut ws.pose);
-            anchors(r, path, s, k, yaw_of(k), 1.0, ws, &mut targets);
             (yaw_of(k), Some(k))
         }
         Phase::Flight { before, after } => {
@@ -425,10 +495,8 @@ pub fn pose_frame(
                     let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
                     let (ya, yb) = (yaw_of(b), yaw_of(a));
                     r.sample(tb, &mut ws.pose);
-                    anchors(r, path, src_of(a), a, yb, w, ws, &mut targets);
                     std::mem::swap(&mut ws.pose, &mut ws.other);
                     r.sample(ta, &mut ws.pose);
-                    anchors(r, path, src_of(b), b, ya, 1.0 - w, ws, &mut targets);
                     for (qa, qb) in ws.pose.q.iter_mut().zip(&ws.other.q) {
                         *qa = rot::slerp(*qa, *qb, w);
                     }
@@ -439,12 +507,10 @@ pub fn pose_frame(
                 }
                 (Some((_, ta)), _, Some(b), _) => {
                     r.sample(ta, &mut ws.pose);
-                    anchors(r, path, src_of(b), b, yaw_of(b), 1.0, ws, &mut targets);
                     (yaw_of(b), None)
                 }
                 (_, Some((_, tb)), _, Some(a)) => {
                     r.sample(tb, &mut ws.pose);
-                    anchors(r, path, src_of(a), a, yaw_of(a), 1.0, ws, &mut targets);
                     (yaw_of(a), None)
                 }
                 _ => {
@@ -465,28 +531,20 @@ pub fn pose_frame(
     let mut iterations = 0;
     let (mut err_m, mut foot_err) = (f64::INFINITY, 0.0);
     let mut com_pose = [0.0; 3];
+    let pulls: [Option<(V3, Quat, f64)>; 2] = [0, 1].map(|side| foot_goal(r, path, src, t, side));
     let mut goal: [Option<(V3, Quat)>; 2] = [None; 2];
     while iterations < opts.max_iterations {
         iterations += 1;
         ws.pose.q.copy_from_slice(&ws.free_q);
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-        if !targets.is_empty() {
-            // Each foot: free position plus the weighted pulls of its anchors.
-            goal = [None; 2];
+        if pulls.iter().any(Option::is_some) {
             for side in 0..2 {
-                let ankle = r.legs[side][2];
-                let (free_p, free_o) = (ws.file[ankle], ws.world_q[ankle]);
-                let (mut p, mut o, mut any) = (free_p, free_o, false);
-                let mut w_sum = 0.0;
-                for tg in targets.iter().filter(|tg| tg.side == side && tg.weight > 0.0) {
-                    any = true;
-                    p = add(p, sub(tg.pos, free_p).map(|v| v * tg.weight));
-                    w_sum += tg.weight;
-                    o = rot::slerp(o, tg.orient, tg.weight / w_sum);
-                }
-                if any {
-                    goal[side] = Some((p, o));
-                }
+                goal[side] = pulls[side].map(|(p, q, w)| {
+                    let ankle = r.legs[side][2];
+                    let (fp, fq) = (ws.file[ankle], ws.world_q[ankle]);
+                    let pos = std::array::from_fn(|i| fp[i] + w * (p[i] - fp[i]));
+                    (pos, rot::slerp(fq, q, w))
+                });
             }
             for side in 0..2 {
                 if let Some((p, _)) = goal[side] {
@@ -502,7 +560,10 @@ pub fn pose_frame(
                 }
             }
             forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+            // Support feet only: a swing foot may be out of reach and is not planted.
+            let planted = |side: usize| stance.is_some_and(|k| src_of(k).feet[side]);
             foot_err = (0..2)
+                .filter(|&side| planted(side))
                 .filter_map(|side| goal[side].map(|(p, _)| norm(sub(ws.file[r.legs[side][2]], p))))
                 .fold(0.0, f64::max)
                 * body.unit_m;
