@@ -131,8 +131,8 @@ pub fn write_file(path: &Path, bvh: &Bvh) -> Result<()> {
     let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
     let result = (|| {
         let f = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, "cannot create", e))?;
-        write_writer(std::io::BufWriter::new(f), &bvh.hierarchy, &bvh.motion).map_err(|e| {
-            match e.kind {
+        write_writer(std::io::BufWriter::new(f), &bvh.hierarchy, &bvh.motion).map_err(
+            |e| match e.kind {
                 crate::error::ErrorKind::Io { msg, source, .. } => Error {
                     kind: crate::error::ErrorKind::Io {
                         path: path.to_path_buf(),
@@ -141,8 +141,8 @@ pub fn write_file(path: &Path, bvh: &Bvh) -> Result<()> {
                     },
                 },
                 _ => e,
-            }
-        })?;
+            },
+        )?;
         std::fs::rename(&tmp, path).map_err(|e| Error::io(path, "cannot rename into place", e))
     })();
     if result.is_err() {
@@ -157,7 +157,16 @@ mod tests {
 
     #[test]
     fn numbers_keep_ten_significant_digits() {
-        for v in [0.0, 1.0, -2.5, 0.123456789012, 12345.6789012345, 1e-9, -3.3e12, 179.99999] {
+        for v in [
+            0.0,
+            1.0,
+            -2.5,
+            0.123456789012,
+            12345.6789012345,
+            1e-9,
+            -3.3e12,
+            179.99999,
+        ] {
             let mut s = String::new();
             num(&mut s, v);
             let back: f64 = s.parse().unwrap();

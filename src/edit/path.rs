@@ -106,7 +106,11 @@ impl PlannedStance {
         let (p, v) = self.local(t - self.t0);
         let w = self.to_world(p);
         (
-            [self.origin[0] + w[0], self.origin[1] + w[1], self.z_c + w[2]],
+            [
+                self.origin[0] + w[0],
+                self.origin[1] + w[1],
+                self.z_c + w[2],
+            ],
             self.to_world(v),
         )
     }
@@ -247,7 +251,10 @@ mod tests {
             let h = 3.0 * t + 0.5 * u * u + 0.25 * after;
             let z = 1.0 - 0.5 * GRAVITY * t * t + 10.0 * u * u + 5.0 * after;
             // Closed forms of constant forces: roundoff only (1e-12 m).
-            assert!((p[0] - h).abs() < 1e-12 && (p[2] - z).abs() < 1e-12, "t = {t}");
+            assert!(
+                (p[0] - h).abs() < 1e-12 && (p[2] - z).abs() < 1e-12,
+                "t = {t}"
+            );
             assert!((v[0] - (3.0 + u)).abs() < 1e-12);
         }
     }

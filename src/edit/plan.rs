@@ -168,8 +168,16 @@ pub fn place(
         planned.push(p);
     }
     let (first, last) = (&planned[0], &planned[planned.len() - 1]);
-    let t_start = if from_touchdown { first.t0 + first.t_td } else { first.t0 };
-    let t_end = if to_liftoff { last.t0 + last.t_lo } else { last.end() };
+    let t_start = if from_touchdown {
+        first.t0 + first.t_td
+    } else {
+        first.t0
+    };
+    let t_end = if to_liftoff {
+        last.t0 + last.t_lo
+    } else {
+        last.end()
+    };
     let sources = stances
         .iter()
         .map(|e| {

@@ -142,7 +142,11 @@ impl Reference {
                     return Err(Error::skeleton(format!(
                         "leg joint '{}' needs 3 distinct rotation channels below the joint \
                          before it for the foot IK",
-                        if j < nj { name(j) } else { format!("point {j}") }
+                        if j < nj {
+                            name(j)
+                        } else {
+                            format!("point {j}")
+                        }
                     )));
                 }
             }
@@ -157,7 +161,11 @@ impl Reference {
         for f in 0..n {
             let row = motion.row(f);
             for j in 0..nj {
-                let deg: Vec<f64> = sk.channels[j].rotations.iter().map(|&(_, i)| row[i]).collect();
+                let deg: Vec<f64> = sk.channels[j]
+                    .rotations
+                    .iter()
+                    .map(|&(_, i)| row[i])
+                    .collect();
                 quats.push(rot::from_euler(&axes[j], &deg));
             }
             body.points(&mut ws, row, &mut file, &mut pts);
@@ -414,21 +422,47 @@ fn foot_goal(
         let (td, lo) = st[k].contact_window();
         if t >= td && t <= lo {
             let s = &src[st[k].source];
-            let (p, q) = anchored(r, path, s, k, yaw_of(k), s.td_clip_s + (t - td) * rate(k), side);
+            let (p, q) = anchored(
+                r,
+                path,
+                s,
+                k,
+                yaw_of(k),
+                s.td_clip_s + (t - td) * rate(k),
+                side,
+            );
             return Some((p, q, 1.0));
         }
     }
-    let b = (0..st.len()).rev().find(|&k| has(k) && st[k].contact_window().1 <= t);
+    let b = (0..st.len())
+        .rev()
+        .find(|&k| has(k) && st[k].contact_window().1 <= t);
     let a = (0..st.len()).find(|&k| has(k) && st[k].contact_window().0 >= t);
     let from_b = b.map(|k| {
         let s = &src[st[k].source];
         let lo = st[k].contact_window().1;
-        anchored(r, path, s, k, yaw_of(k), s.lo_clip_s + (t - lo) * rate(k), side)
+        anchored(
+            r,
+            path,
+            s,
+            k,
+            yaw_of(k),
+            s.lo_clip_s + (t - lo) * rate(k),
+            side,
+        )
     });
     let from_a = a.map(|k| {
         let s = &src[st[k].source];
         let td = st[k].contact_window().0;
-        anchored(r, path, s, k, yaw_of(k), s.td_clip_s - (td - t) * rate(k), side)
+        anchored(
+            r,
+            path,
+            s,
+            k,
+            yaw_of(k),
+            s.td_clip_s - (td - t) * rate(k),
+            side,
+        )
     });
     match (from_b, from_a, b, a) {
         (Some(pb), Some(pa), Some(b), Some(a)) => {
@@ -441,12 +475,20 @@ fn foot_goal(
         // foot, pulled onto its anchor smoothly towards the contact edge.
         (Some(p), None, Some(b), _) => {
             let lo = st[b].contact_window().1;
-            let u = if path.t_end > lo { (t - lo) / (path.t_end - lo) } else { 1.0 };
+            let u = if path.t_end > lo {
+                (t - lo) / (path.t_end - lo)
+            } else {
+                1.0
+            };
             Some((p.0, p.1, 1.0 - smooth(u)))
         }
         (None, Some(p), _, Some(a)) => {
             let td = st[a].contact_window().0;
-            let u = if td > path.t_start { (t - path.t_start) / (td - path.t_start) } else { 1.0 };
+            let u = if td > path.t_start {
+                (t - path.t_start) / (td - path.t_start)
+            } else {
+                1.0
+            };
             Some((p.0, p.1, smooth(u)))
         }
         _ => None,
@@ -555,7 +597,8 @@ pub fn pose_frame(
             for side in 0..2 {
                 if let Some((_, o)) = goal[side] {
                     let ankle = r.legs[side][2];
-                    let parent = body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
+                    let parent =
+                        body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
                     ws.pose.q[ankle] = rot::normalize(rot::mul(rot::conj(parent), o));
                 }
             }

@@ -200,13 +200,27 @@ mod tests {
     #[test]
     fn euler_round_trip_for_every_tait_bryan_order() {
         // Angles away from gimbal lock (|θ₂| < 80°) come back to 1e-9° (acos/atan2 roundoff).
-        let orders = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+        let orders = [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ];
         for axes in orders {
-            for ang in [[10.0, 20.0, 30.0], [-170.0, 75.0, 100.0], [45.0, -60.0, -135.0]] {
+            for ang in [
+                [10.0, 20.0, 30.0],
+                [-170.0, 75.0, 100.0],
+                [45.0, -60.0, -135.0],
+            ] {
                 let q = from_euler(&axes, &ang);
                 let back = to_euler(q, axes, ang);
                 for n in 0..3 {
-                    assert!((back[n] - ang[n]).abs() < 1e-9, "{axes:?} {ang:?} → {back:?}");
+                    assert!(
+                        (back[n] - ang[n]).abs() < 1e-9,
+                        "{axes:?} {ang:?} → {back:?}"
+                    );
                 }
                 // The quaternion's matrix is the FK's composition of the same channels.
                 let mut m = IDENTITY;

@@ -116,7 +116,8 @@ impl BodyModel {
     pub fn toe_tips(&self, pts: &[V3]) -> [V3; 2] {
         let lm = &self.landmarks;
         let fwd = facing(pts[lm.left.hip], pts[lm.right.hip]);
-        [(0, &lm.left), (1, &lm.right)].map(|(k, l)| toe_tip(self.toe[k], pts, l.ankle, fwd, self.leg_m))
+        [(0, &lm.left), (1, &lm.right)]
+            .map(|(k, l)| toe_tip(self.toe[k], pts, l.ankle, fwd, self.leg_m))
     }
 
     /// Whole-body COM of a frame's points (metres, Z up), as the ingest computes it.

@@ -492,6 +492,9 @@ pub fn read_clip_sources(path: &Path) -> Result<BTreeMap<String, ClipSource>> {
 }
 
 fn opt_strings(t: &Table, name: &str) -> Result<Vec<Option<String>>> {
-    let s = t.column(name)?.str().map_err(|_| t.wrong_type(name, "string"))?;
+    let s = t
+        .column(name)?
+        .str()
+        .map_err(|_| t.wrong_type(name, "string"))?;
     Ok(s.iter().map(|v| v.map(str::to_string)).collect())
 }

@@ -81,7 +81,11 @@ fn view(
         .label("planned COM")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue.stroke_width(2)));
     chart
-        .draw_series(d.footprints.iter().map(|p| Cross::new(pr(p), 6, RED.stroke_width(2))))
+        .draw_series(
+            d.footprints
+                .iter()
+                .map(|p| Cross::new(pr(p), 6, RED.stroke_width(2))),
+        )
         .map_err(|e| err(path, e))?
         .label("footprints (planned contact points)")
         .legend(|(x, y)| Cross::new((x + 8, y), 6, RED.stroke_width(2)));

@@ -33,11 +33,17 @@ const PLOT_STICK_EVERY_S: f64 = 0.1;
 
 /// The sidecar paths of `FILE.bvh`: `FILE.plan.parquet`, `FILE.png`.
 pub fn sidecars(out: &Path) -> (PathBuf, PathBuf) {
-    (out.with_extension("plan.parquet"), out.with_extension("png"))
+    (
+        out.with_extension("plan.parquet"),
+        out.with_extension("png"),
+    )
 }
 
 fn check_out(c: &EditCommon) -> anyhow::Result<()> {
-    let ok = c.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
+    let ok = c
+        .out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
     anyhow::ensure!(ok, "--out {}: must end in .bvh", c.out.display());
     if let Some(f) = c.fps {
         anyhow::ensure!(
@@ -140,7 +146,8 @@ fn compute(
     let bvh = scale_source(bvh, length);
     let body = BodyModel::new(&bvh, unit, up, Sex::Male).with_context(|| format!("clip {clip}"))?;
     let fps = c.fps.unwrap_or(1.0 / bvh.motion.frame_time_s);
-    let reference = Reference::new(body, bvh.motion.clone()).with_context(|| format!("clip {clip}"))?;
+    let reference =
+        Reference::new(body, bvh.motion.clone()).with_context(|| format!("clip {clip}"))?;
     let (path, sources) = place(&stances, &order, &reference, jump, jump);
     let edited = pose_motion(&reference, &path, &sources, &EditOptions::default(), fps);
     let footprints = path.stances.iter().map(|s| s.contact_point()).collect();
@@ -176,7 +183,10 @@ fn plan_table(e: &Edit) -> anyhow::Result<DataFrame> {
     };
     let dt = e.edited.motion.frame_time_s;
     let mut cols = vec![
-        Column::new("time_s".into(), (0..f.len()).map(|i| i as f64 * dt).collect::<Vec<_>>()),
+        Column::new(
+            "time_s".into(),
+            (0..f.len()).map(|i| i as f64 * dt).collect::<Vec<_>>(),
+        ),
         Column::new(
             "phase".into(),
             f.iter()
@@ -186,7 +196,10 @@ fn plan_table(e: &Edit) -> anyhow::Result<DataFrame> {
                 })
                 .collect::<Vec<_>>(),
         ),
-        Column::new("stance_id".into(), f.iter().map(|x| id(&x.phase)).collect::<Vec<_>>()),
+        Column::new(
+            "stance_id".into(),
+            f.iter().map(|x| id(&x.phase)).collect::<Vec<_>>(),
+        ),
     ];
     cols.extend(v3("com", &|i| Some(f[i].com_plan)));
     cols.extend(v3("pose_com", &|i| Some(f[i].com_pose)));
@@ -242,7 +255,12 @@ fn plot_of(e: &Edit, title: String) -> EditPlot {
 }
 
 /// Refuses an infeasible edit (unless allowed), then writes the BVH and its sidecars.
-fn finish(c: &EditCommon, e: Edit, kv: Vec<(String, String)>, title: String) -> anyhow::Result<Outcome> {
+fn finish(
+    c: &EditCommon,
+    e: Edit,
+    kv: Vec<(String, String)>,
+    title: String,
+) -> anyhow::Result<Outcome> {
     if !e.violated.is_empty() && !c.allow_infeasible {
         anyhow::bail!(
             "infeasible request: {} (nothing written; --allow-infeasible writes it anyway)",
@@ -313,18 +331,30 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
     let cycles: Vec<_> = run_cycles(&lib.stances)
         .into_iter()
         .filter(|cy| !time_scaled(&lib, &lib.stances[cy.stances[0]].clip))
-        .filter(|cy| a.stance.as_ref().is_none_or(|id| &lib.stances[cy.stances[0]].stance_id == id))
+        .filter(|cy| {
+            a.stance
+                .as_ref()
+                .is_none_or(|id| &lib.stances[cy.stances[0]].stance_id == id)
+        })
         .collect();
     if cycles.is_empty() {
         match &a.stance {
-            Some(id) => anyhow::bail!("--stance {id}: not the first stance of a run cycle in {}", c.lib.display()),
-            None => anyhow::bail!("{}: no run cycle (two chained single-foot stances between flights)", c.lib.display()),
+            Some(id) => anyhow::bail!(
+                "--stance {id}: not the first stance of a run cycle in {}",
+                c.lib.display()
+            ),
+            None => anyhow::bail!(
+                "{}: no run cycle (two chained single-foot stances between flights)",
+                c.lib.display()
+            ),
         }
     }
     let solved: Vec<(f64, Result<Vec<EditStance>, String>)> = cycles
         .iter()
         .map(|cy| {
-            let prep = cy.stances.map(|i| Prepared::with_active_fraction(pool[i].stance.scaled(length, mass), active));
+            let prep = cy.stances.map(|i| {
+                Prepared::with_active_fraction(pool[i].stance.scaled(length, mass), active)
+            });
             let k = a.speed / (cy.v_orig * length.sqrt());
             let req = run_requests([&prep[0].stance, &prep[1].stance], k);
             let out = (0..2)
@@ -362,7 +392,10 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
         "stance": first, "k": k, "length_scale": length, "mass_scale": mass,
         "limits": form.name(), "mu": mu, "active_set": active,
     }));
-    let title = format!("edit run: {:.2} m/s, cycle {first}, {} cycles", a.speed, a.cycles);
+    let title = format!(
+        "edit run: {:.2} m/s, cycle {first}, {} cycles",
+        a.speed, a.cycles
+    );
     finish(c, e, kv, title)
 }
 
@@ -370,7 +403,8 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
 fn recorded_pair(lib: &StanceLibrary) -> Option<(usize, usize)> {
     let s = &lib.stances;
     (1..s.len()).find_map(|i| {
-        (s[i - 1].clip == s[i].clip && is_liftoff(&s[i - 1]) && is_landing(&s[i])).then_some((i - 1, i))
+        (s[i - 1].clip == s[i].clip && is_liftoff(&s[i - 1]) && is_landing(&s[i]))
+            .then_some((i - 1, i))
     })
 }
 
@@ -382,7 +416,11 @@ fn recorded_pair(lib: &StanceLibrary) -> Option<(usize, usize)> {
 pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
     let c = &a.common;
     check_out(c)?;
-    for (n, v) in [("--height", a.height), ("--distance", a.distance), ("--height-scale", a.height_scale)] {
+    for (n, v) in [
+        ("--height", a.height),
+        ("--distance", a.distance),
+        ("--height-scale", a.height_scale),
+    ] {
         if let Some(v) = v {
             anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
         }
@@ -402,22 +440,39 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
         Some(p) => {
             // Stance ids hold ':' themselves: split at the middle ':' of the 5 parts.
             let parts: Vec<&str> = p.split(':').collect();
-            anyhow::ensure!(parts.len() == 6, "--pair: expected LIFTOFF_ID:LANDING_ID (each <clip>:<label>:<frame>), found {p}");
+            anyhow::ensure!(
+                parts.len() == 6,
+                "--pair: expected LIFTOFF_ID:LANDING_ID (each <clip>:<label>:<frame>), found {p}"
+            );
             let (i, j) = (index(&parts[..3].join(":"))?, index(&parts[3..].join(":"))?);
-            anyhow::ensure!(is_liftoff(&lib.stances[i]), "--pair: {} is not a liftoff stance (rest or clip edge, then flight)", lib.stances[i].stance_id);
-            anyhow::ensure!(is_landing(&lib.stances[j]), "--pair: {} is not a landing stance (flight, then rest or clip edge)", lib.stances[j].stance_id);
+            anyhow::ensure!(
+                is_liftoff(&lib.stances[i]),
+                "--pair: {} is not a liftoff stance (rest or clip edge, then flight)",
+                lib.stances[i].stance_id
+            );
+            anyhow::ensure!(
+                is_landing(&lib.stances[j]),
+                "--pair: {} is not a landing stance (flight, then rest or clip edge)",
+                lib.stances[j].stance_id
+            );
             Some((i, j))
         }
-        None if a.height.is_none() || a.distance.is_none() => Some(recorded_pair(&lib).context("no recorded jump (liftoff then landing in one clip) in the library: give --pair")?),
+        None if a.height.is_none() || a.distance.is_none() => Some(recorded_pair(&lib).context(
+            "no recorded jump (liftoff then landing in one clip) in the library: give --pair",
+        )?),
         None => None,
     };
     let candidates: Vec<(usize, usize)> = match given {
         Some(p) => vec![p],
         None => {
             let ups = (0..pool.len()).filter(|&i| is_liftoff(&lib.stances[i]));
-            ups.flat_map(|i| (0..pool.len()).filter(|&j| is_landing(&lib.stances[j])).map(move |j| (i, j)))
-                .filter(|&(i, j)| lib.stances[i].clip == lib.stances[j].clip)
-                .collect()
+            ups.flat_map(|i| {
+                (0..pool.len())
+                    .filter(|&j| is_landing(&lib.stances[j]))
+                    .map(move |j| (i, j))
+            })
+            .filter(|&(i, j)| lib.stances[i].clip == lib.stances[j].clip)
+            .collect()
         }
     };
     let request = |(i, j): (usize, usize)| {
@@ -425,15 +480,32 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
         let h = a.height.unwrap_or(h0 * a.height_scale.unwrap_or(1.0));
         (h, a.distance.unwrap_or(d0))
     };
-    let solved: Vec<((usize, usize), f64, f64, Result<crate::query::jump::Jump, String>)> = candidates
+    let solved: Vec<(
+        (usize, usize),
+        f64,
+        f64,
+        Result<crate::query::jump::Jump, String>,
+    )> = candidates
         .iter()
         .map(|&(i, j)| {
             let (h, d) = request((i, j));
-            let lim = [stance_limits(&pool[i], form, &absolute, mu), stance_limits(&pool[j], form, &absolute, mu)];
-            ((i, j), h, d, jump(&pool[i], &pool[j], h, d, Some(lim)).map_err(|e| e.to_string()))
+            let lim = [
+                stance_limits(&pool[i], form, &absolute, mu),
+                stance_limits(&pool[j], form, &absolute, mu),
+            ];
+            (
+                (i, j),
+                h,
+                d,
+                jump(&pool[i], &pool[j], h, d, Some(lim)).map_err(|e| e.to_string()),
+            )
         })
         .collect();
-    anyhow::ensure!(!solved.is_empty(), "{}: no liftoff and landing stance of one clip", c.lib.display());
+    anyhow::ensure!(
+        !solved.is_empty(),
+        "{}: no liftoff and landing stance of one clip",
+        c.lib.display()
+    );
     let key = |r: &Result<crate::query::jump::Jump, String>| match r {
         Ok(j) => (!j.feasible(), j.force_change()),
         Err(_) => (true, f64::INFINITY),
@@ -469,7 +541,10 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
         })
         .collect();
     let clip = lib.stances[*i].clip.clone();
-    let ids = format!("{} → {}", lib.stances[*i].stance_id, lib.stances[*j].stance_id);
+    let ids = format!(
+        "{} → {}",
+        lib.stances[*i].stance_id, lib.stances[*j].stance_id
+    );
     let e = compute(c, &clip, 1.0, stances, vec![0, 1], true)?;
     let kv = query_kv(serde_json::json!({
         "edit": "jump", "lib": c.lib, "height_m": h, "distance_m": d, "pair": ids,
