@@ -325,7 +325,7 @@ fn edited_runs_round_trip_within_the_issue_bounds() {
     // event lands 1.15 frames from the plan and the rebuilt cycle runs at 1.894 m/s (the
     // periodic requests change T, so the planned mean speed is not exactly V); at 4 m/s a
     // flight's re-measured curvature is 0.95 m/s² from −g (a swing foot out of reach).
-    let cases: [(f64, &[(&str, f64)], f64); 3] = [
+    let cases: [RunCase; 3] = [
         (2.0, &[("event_frames", 1.2)], 0.06),
         (3.0, &[], 0.02),
         (4.0, &[("flight_az", 1.0)], 0.02),
@@ -361,6 +361,9 @@ fn edited_runs_round_trip_within_the_issue_bounds() {
         assert_bounds_except(&f, misses);
     }
 }
+
+/// A run edit of the round-trip test: speed, known misses, speed tolerance.
+type RunCase = (f64, &'static [(&'static str, f64)], f64);
 
 /// Index of a stance id in a library's file order.
 fn stance_index(lib: &Path, id: &str) -> usize {
@@ -430,7 +433,7 @@ fn first_window(out: &Path) -> (f64, f64, String) {
 fn identity_run_reproduces_the_recorded_motion() {
     let dir = tmp();
     let src = fixture("run_120hz_m_yup");
-    let lib = library(dir.path(), &[src.clone()]);
+    let lib = library(dir.path(), std::slice::from_ref(&src));
     let (id, v0) = cycle_of(&lib, "run_120hz_m_yup");
     let out = dir.path().join("identity.bvh");
     ok(&[
@@ -513,7 +516,7 @@ fn infeasible_run_is_refused_naming_the_constraint_and_writes_nothing() {
 fn edited_jumps_reach_the_requested_apex_and_round_trip() {
     let dir = tmp();
     let src = fixture("jump_120hz_cmu_yup");
-    let lib = library(dir.path(), &[src.clone()]);
+    let lib = library(dir.path(), std::slice::from_ref(&src));
     let l = open_library(&lib).unwrap();
     let s = &l.stances;
     let (i, j) = (1..s.len())
@@ -543,7 +546,7 @@ fn edited_jumps_reach_the_requested_apex_and_round_trip() {
         let f = measure(&out);
         assert_bounds_except(&f, misses);
         let sub = tempfile::tempdir_in(dir.path()).unwrap();
-        let rl = library(sub.path(), &[out.clone()]);
+        let rl = library(sub.path(), std::slice::from_ref(&out));
         let r = open_library(&rl).unwrap();
         let rs = &r.stances;
         let (a, b) = (1..rs.len())

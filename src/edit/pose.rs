@@ -160,12 +160,8 @@ impl Reference {
         let (mut file, mut pts) = (vec![[0.0; 3]; np], vec![[0.0; 3]; np]);
         for f in 0..n {
             let row = motion.row(f);
-            for j in 0..nj {
-                let deg: Vec<f64> = sk.channels[j]
-                    .rotations
-                    .iter()
-                    .map(|&(_, i)| row[i])
-                    .collect();
+            for (j, ch) in sk.channels.iter().enumerate() {
+                let deg: Vec<f64> = ch.rotations.iter().map(|&(_, i)| row[i]).collect();
                 quats.push(rot::from_euler(&axes[j], &deg));
             }
             body.points(&mut ws, row, &mut file, &mut pts);
@@ -580,22 +576,22 @@ pub fn pose_frame(
         ws.pose.q.copy_from_slice(&ws.free_q);
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
         if pulls.iter().any(Option::is_some) {
-            for side in 0..2 {
-                goal[side] = pulls[side].map(|(p, q, w)| {
+            for (side, g) in goal.iter_mut().enumerate() {
+                *g = pulls[side].map(|(p, q, w)| {
                     let ankle = r.legs[side][2];
                     let (fp, fq) = (ws.file[ankle], ws.world_q[ankle]);
                     let pos = std::array::from_fn(|i| fp[i] + w * (p[i] - fp[i]));
                     (pos, rot::slerp(fq, q, w))
                 });
             }
-            for side in 0..2 {
-                if let Some((p, _)) = goal[side] {
+            for (side, g) in goal.iter().enumerate() {
+                if let Some((p, _)) = *g {
                     two_bone(r, ws, side, p, opts.max_reach);
                     forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
                 }
             }
-            for side in 0..2 {
-                if let Some((_, o)) = goal[side] {
+            for (side, g) in goal.iter().enumerate() {
+                if let Some((_, o)) = *g {
                     let ankle = r.legs[side][2];
                     let parent =
                         body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);

@@ -399,6 +399,14 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
     finish(c, e, kv, title)
 }
 
+/// A jump candidate: (liftoff, landing) pool indices, apex height, distance, outcome.
+type Solved = (
+    (usize, usize),
+    f64,
+    f64,
+    Result<crate::query::jump::Jump, String>,
+);
+
 /// The first recorded jump of a library: a liftoff followed by a landing in its clip.
 fn recorded_pair(lib: &StanceLibrary) -> Option<(usize, usize)> {
     let s = &lib.stances;
@@ -480,12 +488,7 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
         let h = a.height.unwrap_or(h0 * a.height_scale.unwrap_or(1.0));
         (h, a.distance.unwrap_or(d0))
     };
-    let solved: Vec<(
-        (usize, usize),
-        f64,
-        f64,
-        Result<crate::query::jump::Jump, String>,
-    )> = candidates
+    let solved: Vec<Solved> = candidates
         .iter()
         .map(|&(i, j)| {
             let (h, d) = request((i, j));
