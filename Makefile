@@ -3,9 +3,23 @@ CARGO ?= cargo
 
 .PHONY: demo test lint bench nightly build doc fixtures fuzz
 
-## Run the main job on the bundled fixtures (pipelines/demo.toml); tables go to out/demo/.
+DEMO_EDITS = out/demo/edits
+RUN_CLIP = fixtures/bvh/run_120hz_m_yup.bvh
+JUMP_CLIP = fixtures/bvh/jump_120hz_cmu_yup.bvh
+## Run the main job on the bundled fixtures (pipelines/demo.toml); tables go to out/demo/,
+## edited runs and a jump (BVH + plan + PNG) to out/demo/edits/.
 demo:
 	$(CARGO) run --release -- run pipelines/demo.toml
+	@# Edited motion (issue 14): runs at 2, 3, 4 m/s and a jump 20 % higher than recorded.
+	@# Frames whose support foot is out of reach are reported (exit 1) and still written.
+	mkdir -p $(DEMO_EDITS)
+	for v in 2 3 4; do \
+		$(CARGO) run --release --quiet -- edit run --lib out/demo --speed $$v --source $(RUN_CLIP) \
+			--stance run_120hz_m_yup:R:51 --allow-infeasible --out $(DEMO_EDITS)/run_$${v}mps.bvh || test $$? -eq 1; \
+	done
+	$(CARGO) run --release --quiet -- edit jump --lib out/demo --height-scale 1.2 --source $(JUMP_CLIP) \
+		--pair jump_120hz_cmu_yup:LR:42:jump_120hz_cmu_yup:LR:150 --allow-infeasible \
+		--out $(DEMO_EDITS)/jump_120pct.bvh || test $$? -eq 1
 
 ## Every test: unit, integration (real clips from ../shared/data when present) and doc tests.
 test:
@@ -26,19 +40,19 @@ fuzz:
 
 ## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances
 ## (library); candidate evaluations and the 200 × 200 jump map (queries); 2PAC H-rep,
-## transition QP and 10-phase trajectory (twopac).
+## transition QP and 10-phase trajectory (twopac); 1 s of edited motion at 120 Hz (edit).
 bench:
 	$(CARGO) bench --bench stages
 	$(CARGO) bench --bench library
 	$(CARGO) bench --bench queries
 	$(CARGO) bench --bench twopac
+	$(CARGO) bench --bench edit
 
 ## The nightly job over ../shared/data (pipelines/nightly.toml).
 nightly:
 	$(CARGO) run --release -- run pipelines/nightly.toml
 
 build:
-	$(CARGO) build --release
 
 doc:
 	$(CARGO) doc --no-deps

@@ -25,6 +25,7 @@ pub mod bvh;
 pub mod cli;
 pub mod constraints;
 pub mod contacts;
+pub mod edit;
 pub mod error;
 pub mod force_model;
 pub mod ingest;

@@ -8,6 +8,8 @@
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `force_export`: `forces` (the model on its grid, impulse, norms) and `plot stance` (PNG,
 //!   plates of the treadmill run); unknown stances exit 2 and write nothing.
+//! - `edit_motion`: issue 14 — `edit run`/`edit jump` BVH re-ingested: COM on the plan,
+//!   planted feet, contact timing, speed, jump apex, flight curvature, joint steps, identity.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
 //! - `regression`: one test per review finding, named after it.
 //! - `safety_outputs`: issue 11 — `--out` never destroys what the tool did not write; input
@@ -33,6 +35,7 @@ mod bad_input;
 mod bvh_oracle;
 mod cli;
 mod contacts_physics;
+mod edit_motion;
 mod fixtures;
 mod force_export;
 mod forceplate;

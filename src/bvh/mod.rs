@@ -1,4 +1,5 @@
-//! BVH reader: hierarchy and motion, in f64, streaming, with line-numbered errors.
+//! BVH reader and writer: hierarchy and motion, in f64, streaming, with line-numbered
+//! errors; [`write_file`] writes what the reader reads (the edited motion of `edit`).
 //!
 //! # Model
 //! ```text
@@ -27,8 +28,10 @@
 //! ```
 
 mod parse;
+mod write;
 
 pub use parse::{parse_file, parse_reader, MAX_FRAME_TIME_S, MAX_LINE_BYTES, MIN_FRAME_TIME_S};
+pub use write::{hierarchy_text, write_file, write_writer, DEFAULT_SIGNIFICANT_DIGITS};
 
 /// One channel of a joint: a translation or a rotation about a file axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

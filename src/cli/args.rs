@@ -46,6 +46,86 @@ pub enum Command {
     /// Plots of a library's stances.
     #[command(subcommand)]
     Plot(PlotCommand),
+    /// Edited motion as full-body BVH: scaled runs and jumps with planted feet.
+    #[command(subcommand)]
+    Edit(EditCommand),
+}
+
+/// `stancelib edit …`.
+#[derive(Debug, Subcommand)]
+pub enum EditCommand {
+    /// Steady run cycles at a speed (the best feasible cycle, or `--stance`).
+    Run(EditRunArgs),
+    /// A liftoff → flight → landing at an apex height and distance.
+    Jump(EditJumpArgs),
+}
+
+/// Options every edit shares.
+#[derive(Debug, Args)]
+pub struct EditCommon {
+    /// Library folder (from `build` or `run`).
+    #[arg(long)]
+    pub lib: PathBuf,
+    /// Output BVH file; `FILE.plan.parquet` and `FILE.png` are written beside it.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Output frame rate, Hz (default: the source clip's).
+    #[arg(long)]
+    pub fps: Option<f64>,
+    /// Source BVH to take poses from, instead of the path recorded in `clips.parquet`.
+    #[arg(long)]
+    pub source: Option<PathBuf>,
+    /// Write the motion even when the request breaks a constraint (the sidecar says which).
+    #[arg(long = "allow-infeasible")]
+    pub allow_infeasible: bool,
+    /// Limit form and μ (§7.5).
+    #[command(flatten)]
+    pub lim: LimitArgs,
+}
+
+/// `stancelib edit run`.
+#[derive(Debug, Args)]
+pub struct EditRunArgs {
+    /// Library, output and shared options.
+    #[command(flatten)]
+    pub common: EditCommon,
+    /// Target speed, m/s.
+    #[arg(long)]
+    pub speed: f64,
+    /// Steady cycles written.
+    #[arg(long, default_value_t = crate::edit::DEFAULT_CYCLES)]
+    pub cycles: usize,
+    /// The cycle's first stance (`<clip>:<label>:<first frame>`); default: the best
+    /// feasible cycle.
+    #[arg(long)]
+    pub stance: Option<String>,
+    /// Leg-length ratio target/recorded character (dynamic similarity, §9).
+    #[arg(long = "length-scale", default_value_t = 1.0)]
+    pub length_scale: f64,
+    /// Body-mass ratio target/recorded character.
+    #[arg(long = "mass-scale", default_value_t = 1.0)]
+    pub mass_scale: f64,
+}
+
+/// `stancelib edit jump`.
+#[derive(Debug, Args)]
+pub struct EditJumpArgs {
+    /// Library, output and shared options.
+    #[command(flatten)]
+    pub common: EditCommon,
+    /// Flight apex height above the liftoff contact, m (default: the recorded pair's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub height: Option<f64>,
+    /// The recorded pair's apex height times this (instead of `--height`).
+    #[arg(long = "height-scale", conflicts_with = "height")]
+    pub height_scale: Option<f64>,
+    /// Jump distance, m (default: the recorded pair's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub distance: Option<f64>,
+    /// `LIFTOFF_ID:LANDING_ID`; default: the best feasible pair (with `--height` and
+    /// `--distance`), or the library's first recorded jump (without them).
+    #[arg(long)]
+    pub pair: Option<String>,
 }
 
 /// `stancelib plot …`.

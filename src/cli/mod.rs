@@ -3,7 +3,7 @@
 pub mod args;
 pub mod cmd;
 
-use args::{Cli, Command, MapCommand, PlotCommand, QueryCommand};
+use args::{Cli, Command, EditCommand, MapCommand, PlotCommand, QueryCommand};
 
 /// How a command finished (fatal errors are `Err`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,5 +33,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Twopac(a) => cmd::twopac::run(a),
         Command::Forces(a) => cmd::forces::run(a),
         Command::Plot(PlotCommand::Stance(a)) => cmd::plot::run_stance(a),
+        Command::Edit(EditCommand::Run(a)) => cmd::edit::run(a),
+        Command::Edit(EditCommand::Jump(a)) => cmd::edit::run_jump(a),
     }
 }

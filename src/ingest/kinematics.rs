@@ -52,7 +52,7 @@ pub fn facing(hip_l: V3, hip_r: V3) -> V3 {
 }
 
 /// FK over the kept frames into one flat array (frames × points), file units and axes.
-fn fk_frames(skel: &Skeleton, bvh: &Bvh, skip: usize) -> Vec<V3> {
+pub(super) fn fk_frames(skel: &Skeleton, bvh: &Bvh, skip: usize) -> Vec<V3> {
     let np = skel.n_points();
     let n = bvh.motion.n_frames() - skip;
     let mut out = vec![[0.0; 3]; n * np];
@@ -63,7 +63,23 @@ fn fk_frames(skel: &Skeleton, bvh: &Bvh, skip: usize) -> Vec<V3> {
     out
 }
 
-fn choose_toe(
+/// The toe tip of one frame: the chosen point, or the fallback ahead of and below the
+/// ankle (`fwd`: the hips' facing direction of the frame).
+pub(super) fn toe_tip(p: Option<usize>, fp: &[V3], ankle: usize, fwd: V3, leg_m: f64) -> V3 {
+    match p {
+        Some(p) => fp[p],
+        None => std::array::from_fn(|i| {
+            fp[ankle][i] + TTIP_FALLBACK_AHEAD * leg_m * fwd[i]
+                - if i == 2 {
+                    TTIP_FALLBACK_BELOW * leg_m
+                } else {
+                    0.0
+                }
+        }),
+    }
+}
+
+pub(super) fn choose_toe(
     lm: &Landmarks,
     s: Side,
     rest: &[V3],
@@ -95,7 +111,7 @@ fn choose_toe(
     (ToeTipRule::Fallback, None)
 }
 
-fn side_points(limb: &Limb, fp: &[V3], ttip: V3) -> SidePoints {
+pub(super) fn side_points(limb: &Limb, fp: &[V3], ttip: V3) -> SidePoints {
     SidePoints {
         hjc: fp[limb.hip],
         kjc: fp[limb.knee],
@@ -202,20 +218,7 @@ pub(super) fn run(
         summary.toe_tip_rule[k] = Some(rule.as_str().to_string());
         let ankle = lm.limb(s).ankle;
         toe[k] = (0..n)
-            .map(|f| {
-                let fp = frames[f];
-                match p {
-                    Some(p) => fp[p],
-                    None => std::array::from_fn(|i| {
-                        fp[ankle][i] + TTIP_FALLBACK_AHEAD * leg_m * fwd[f][i]
-                            - if i == 2 {
-                                TTIP_FALLBACK_BELOW * leg_m
-                            } else {
-                                0.0
-                            }
-                    }),
-                }
-            })
+            .map(|f| toe_tip(p, frames[f], ankle, fwd[f], leg_m))
             .collect();
     }
     if let Some(s) = summary.skeleton.as_mut() {

@@ -11,6 +11,7 @@
 //! # References
 //! spec com-from-bvh §1–§8.
 
+pub mod body;
 mod contact_runs;
 mod kinematics;
 

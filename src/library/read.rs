@@ -453,3 +453,69 @@ pub fn open_library(dir: &Path) -> Result<StanceLibrary> {
         clips: read_clip_info(&dir.join(CLIPS_FILE))?,
     })
 }
+
+/// Where each stance of `stances.parquet` sits in its clip, in file order (the order of
+/// [`read_stances`]): touchdown, liftoff and heading.
+///
+/// # Errors
+/// The file cannot be read, or a column is missing, mistyped or null.
+pub fn read_stance_timing(path: &Path) -> Result<Vec<crate::edit::plan::StanceTiming>> {
+    let t = Table::open(path)?;
+    let (td, lo) = (t.f64s("td_clip_s")?, t.f64s("lo_clip_s")?);
+    let (hx, hy) = (t.f64s("heading_x")?, t.f64s("heading_y")?);
+    Ok((0..t.height())
+        .map(|i| crate::edit::plan::StanceTiming {
+            td_clip_s: td[i],
+            lo_clip_s: lo[i],
+            heading: [hx[i], hy[i]],
+        })
+        .collect())
+}
+
+/// A clip's source file as `clips.parquet` records it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClipSource {
+    /// The path as given to the build.
+    pub path: String,
+    /// SHA-256 of the file's bytes (hex).
+    pub content_sha256: String,
+    /// Metres per file unit.
+    pub unit_scale: Option<f64>,
+    /// Up axis (`+Y`, …).
+    pub up_axis: Option<String>,
+}
+
+/// The source file of every clip of `clips.parquet`, by clip name.
+///
+/// # Errors
+/// The file cannot be read, or a column is missing or mistyped.
+pub fn read_clip_sources(path: &Path) -> Result<BTreeMap<String, ClipSource>> {
+    let t = Table::open(path)?;
+    let (names, paths, sha) = (
+        t.strings("clip")?,
+        t.strings("path")?,
+        t.strings("content_sha256")?,
+    );
+    let (unit, up) = (t.opt_f64("unit_scale")?, opt_strings(&t, "up_axis")?);
+    Ok(names
+        .into_iter()
+        .enumerate()
+        .map(|(i, n)| {
+            let c = ClipSource {
+                path: paths[i].clone(),
+                content_sha256: sha[i].clone(),
+                unit_scale: unit[i],
+                up_axis: up[i].clone(),
+            };
+            (n, c)
+        })
+        .collect())
+}
+
+fn opt_strings(t: &Table, name: &str) -> Result<Vec<Option<String>>> {
+    let s = t
+        .column(name)?
+        .str()
+        .map_err(|_| t.wrong_type(name, "string"))?;
+    Ok(s.iter().map(|v| v.map(str::to_string)).collect())
+}

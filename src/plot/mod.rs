@@ -13,6 +13,7 @@ use plotters::style::FontStyle;
 
 use crate::query::map::JumpMap;
 
+pub mod edit;
 pub mod stance;
 pub mod trajectory;
 

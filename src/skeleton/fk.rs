@@ -92,7 +92,7 @@ fn mix<const A: usize, const B: usize>(m: &mut Mat3, s: f64, c: f64) {
 
 /// The local translation of joint `j` for a motion row.
 #[inline(always)]
-fn local_translation(skel: &Skeleton, j: usize, row: &[f64]) -> [f64; 3] {
+pub fn local_translation(skel: &Skeleton, j: usize, row: &[f64]) -> [f64; 3] {
     let ch = &skel.channels[j];
     let off = skel.offsets[j];
     match ch.mode {

@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod build;
+pub mod edit;
 pub mod equilibrium;
 pub mod forces;
 pub mod frames;

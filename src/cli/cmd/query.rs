@@ -133,7 +133,7 @@ pub fn query_kv(options: serde_json::Value) -> Vec<(String, String)> {
 }
 
 /// The clips whose flights say their time base is wrong (`s_eff` outside [0.9, 1.1]).
-fn time_scaled(lib: &StanceLibrary, clip: &str) -> bool {
+pub fn time_scaled(lib: &StanceLibrary, clip: &str) -> bool {
     lib.clips
         .get(clip)
         .and_then(|c| c.s_eff)

@@ -1,0 +1,213 @@
+//! From a query's answer to a placed plan: the requests of a periodic run cycle, the solved
+//! stances, and the chain of stances in the world with their source facts.
+//!
+//! # Model
+//! ```text
+//! run cycle S1, S2 at k = v / v_orig (the run-at-speed policy: (vs, ve, x)·k, vp kept),
+//! made exactly periodic so N cycles chain (the recorded S2 → S1 join is not checked):
+//!   Z_a = ½((zs1 + z_c1) + (ze2 + z_c2)),   Z_b = ½((ze1 + z_c1) + (zs2 + z_c2))
+//!   U_a = ½(k·vs1 + |(k·ve2, vp2)|),         U_b = ½(k·vs2 + |(k·ve1, vp1)|)
+//!   S1: zs = Z_a − z_c1, vs = U_a, ze = Z_b − z_c1, ve = √(U_b² − vp1²), vp1, vps = 0, x = k·x1
+//!   S2: zs = Z_b − z_c2, vs = U_b, ze = Z_a − z_c2, ve = √(U_a² − vp2²), vp2, vps = 0, x = k·x2
+//! jump: the requests of `query::jump` (they chain by construction: ve1 = vs2 = u_apex)
+//! placement: the first stance keeps its recorded heading, and its COM at touchdown is the
+//!   recorded one; every later stance is chained at the apex (`path`)
+//! ```
+//! Each request is solved and checked by the query code (`query::run::scale_and_check`), so
+//! an edit is feasible exactly when the query says its stances are.
+
+use super::path::{ComPath, PlannedStance};
+use super::pose::{Reference, StanceSource};
+use crate::library::queries::violation_name;
+use crate::query::feasibility::Limits;
+use crate::query::pool::{PoolStance, Prepared};
+use crate::query::run::{scale_and_check, ScaledStance};
+use crate::query::solve::Request;
+
+type V3 = [f64; 3];
+
+/// Where a source stance sits in its clip (from `stances.parquet`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceTiming {
+    /// Touchdown, clip time (s).
+    pub td_clip_s: f64,
+    /// Liftoff, clip time (s).
+    pub lo_clip_s: f64,
+    /// Unit heading `e_h` (world x, y).
+    pub heading: [f64; 2],
+}
+
+/// One solved stance of an edit.
+#[derive(Debug, Clone)]
+pub struct EditStance {
+    /// The source stance, unscaled (its timing in the clip).
+    pub source: PoolStance,
+    /// Its timing in the clip.
+    pub timing: StanceTiming,
+    /// The character-scaled stance and tables.
+    pub prepared: Prepared,
+    /// The request solved.
+    pub request: Request,
+    /// The solution and verdicts.
+    pub scaled: ScaledStance,
+}
+
+impl EditStance {
+    /// `<stance_id>: <constraint>` when the exact check fails.
+    pub fn violated(&self) -> Option<String> {
+        self.scaled
+            .verdict
+            .violated
+            .map(|v| format!("{}: {}", self.source.stance_id, violation_name(v)))
+    }
+}
+
+/// The periodic requests of a run cycle at `k` (see the module docs).
+pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
+    let (p1, p2) = (&s[0].params, &s[1].params);
+    let (z1, z2) = (s[0].z_c, s[1].z_c);
+    let za = 0.5 * ((p1.zs + z1) + (p2.ze + z2));
+    let zb = 0.5 * ((p1.ze + z1) + (p2.zs + z2));
+    let ua = 0.5 * (k * p1.vs + (k * p2.ve).hypot(p2.vp));
+    let ub = 0.5 * (k * p2.vs + (k * p1.ve).hypot(p1.vp));
+    let ve = |u: f64, vp: f64| (u * u - vp * vp).max(0.0).sqrt();
+    [
+        Request {
+            zs: za - z1,
+            vs: ua,
+            ze: zb - z1,
+            ve: ve(ub, p1.vp),
+            vp: p1.vp,
+            vps: 0.0,
+            x: k * p1.x,
+        },
+        Request {
+            zs: zb - z2,
+            vs: ub,
+            ze: za - z2,
+            ve: ve(ua, p2.vp),
+            vp: p2.vp,
+            vps: 0.0,
+            x: k * p2.x,
+        },
+    ]
+}
+
+/// Solves and checks one request of an edit.
+///
+/// # Errors
+/// `<stance_id>: <reason>` when the closed form has no admissible solution.
+pub fn solve_stance(
+    source: &PoolStance,
+    timing: StanceTiming,
+    prepared: &Prepared,
+    request: Request,
+    limits: &Limits,
+) -> Result<EditStance, String> {
+    let scaled = scale_and_check(prepared, &request, limits)
+        .map_err(|e| format!("{}: {e}", source.stance_id))?;
+    Ok(EditStance {
+        source: source.clone(),
+        timing,
+        prepared: prepared.clone(),
+        request,
+        scaled,
+    })
+}
+
+/// Feet in contact (left, right) from a stance label (`L`, `R`, `LR`, `LR+LH`, …).
+pub fn feet_of(label: &str) -> [bool; 2] {
+    let feet = label.split('+').next().unwrap_or("");
+    [feet.contains('L'), feet.contains('R')]
+}
+
+/// Places the sequence `order` of solved stances in the world: the first keeps its recorded
+/// heading and touchdown COM (from `reference`), the rest chain at their apexes. With
+/// `from_touchdown` the path starts at the first touchdown (a jump from rest), else at the
+/// first start apex; with `to_liftoff` it ends at the last liftoff, else at the last apex.
+pub fn place(
+    stances: &[EditStance],
+    order: &[usize],
+    reference: &Reference,
+    from_touchdown: bool,
+    to_liftoff: bool,
+) -> (ComPath, Vec<StanceSource>) {
+    let planned_of = |e: &EditStance, source: usize| PlannedStance {
+        source,
+        model: e.prepared.stance.model.clone(),
+        beta: e.scaled.solution.beta,
+        zs: e.request.zs,
+        vs: e.request.vs,
+        vps: e.request.vps,
+        t_td: e.scaled.solution.t_td,
+        t_lo: e.scaled.solution.t_lo,
+        t_e: e.scaled.solution.t_e,
+        z_c: e.prepared.stance.z_c,
+        cp: e.scaled.cp,
+        t0: 0.0,
+        origin: [0.0, 0.0],
+        heading: e.timing.heading,
+    };
+    let mut planned: Vec<PlannedStance> = Vec::with_capacity(order.len());
+    for &i in order {
+        let mut p = planned_of(&stances[i], i);
+        match planned.last() {
+            None => {
+                let c_td = reference.com_at(stances[i].timing.td_clip_s);
+                let (l, _) = p.local(p.t_td);
+                let w = p.to_world(l);
+                p.origin = [c_td[0] - w[0], c_td[1] - w[1]];
+                if from_touchdown {
+                    p.t0 = -p.t_td;
+                }
+            }
+            Some(prev) => {
+                prev.chain(&mut p);
+            }
+        }
+        planned.push(p);
+    }
+    let (first, last) = (&planned[0], &planned[planned.len() - 1]);
+    let t_start = if from_touchdown {
+        first.t0 + first.t_td
+    } else {
+        first.t0
+    };
+    let t_end = if to_liftoff {
+        last.t0 + last.t_lo
+    } else {
+        last.end()
+    };
+    let sources = stances
+        .iter()
+        .map(|e| {
+            let (s, t) = (&e.source, &e.timing);
+            let c = reference.com_at(t.td_clip_s);
+            let [hx, hy] = t.heading;
+            let cp = e.prepared.stance.cp;
+            let anchor: V3 = [
+                c[0] + hx * cp[0] - hy * cp[1],
+                c[1] + hy * cp[0] + hx * cp[1],
+                e.prepared.stance.z_c,
+            ];
+            StanceSource {
+                stance_id: s.stance_id.clone(),
+                td_clip_s: t.td_clip_s,
+                lo_clip_s: t.lo_clip_s,
+                before_s: s.params.t_td,
+                after_s: s.params.t_e - s.params.t_lo,
+                heading_rad: hy.atan2(hx),
+                anchor,
+                feet: feet_of(&s.label),
+            }
+        })
+        .collect();
+    (
+        ComPath {
+            stances: planned,
+            t_start,
+            t_end,
+        },
+        sources,
+    )
+}

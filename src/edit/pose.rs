@@ -1,0 +1,730 @@
+//! A full-body pose per output frame: the time-warped reference, the new heading, the
+//! support feet planted by analytic two-bone IK and the root placed so the COM is the
+//! planned one.
+//!
+//! # Model
+//! ```text
+//! reference  stance k: t_src = td_k + (t − TD_k)·(lo_k − td_k)/(LO_k − TD_k)
+//!            flight after k:   t_A = lo_k + (t − LO_k)·e_k/E_k     (e, E: liftoff → apex,
+//!            flight before k': t_B = td_k' − (TD_k' − t)·a_k'/A_k'  a, A: apex → touchdown;
+//!            lower case source, upper case plan)
+//!            q_j = slerp(q_j(t_A), q_j(t_B), w),  w = 3u² − 2u³,  u = (t − LO_k)/(TD_k' − LO_k)
+//! heading    q_root ← yaw(Δψ)·q_root,  Δψ = ψ_plan − ψ_source (blended by w in flight)
+//! feet       ankle* = c_plan + yaw(Δψ)(ankle_src − c_src),  foot orientation = yaw(Δψ)·src
+//!            knee: rotate the shank about n = (H − K) × (A − K) to |A − H| = |ankle* − H|
+//!            hip:  the smallest rotation taking A − H onto ankle* − H
+//! root       t_root ← t_root + to_file(c_plan − COM(q))  (COM is affine in t_root)
+//!            repeat IK and root until |c_plan − COM| ≤ tol, at most max_iterations
+//! ```
+//! `c` is the contact point (COM at touchdown plus the stance's contact point `cp`), so the
+//! reference foot's motion about its contact point, heel–toe roll included, is kept and
+//! only moved to the planned point.
+//!
+//! # Frames and units
+//! FK and IK in file units and axes (rotations as unit quaternions); COM, targets and
+//! reports in metres, internal Z-up frame.
+
+use super::path::{ComPath, Phase};
+use super::rotation::{self as rot, Quat};
+use super::EditOptions;
+use crate::bvh::Motion;
+use crate::error::{Error, Result};
+use crate::ingest::body::BodyModel;
+use crate::skeleton::fk::local_translation;
+
+type V3 = [f64; 3];
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn norm(a: V3) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// What the pose stage needs of each planned stance's source stance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceSource {
+    /// `<clip>:<label>:<first frame>`.
+    pub stance_id: String,
+    /// Source touchdown and liftoff, clip time (s).
+    pub td_clip_s: f64,
+    /// Source liftoff, clip time (s).
+    pub lo_clip_s: f64,
+    /// Source start apex → touchdown (s).
+    pub before_s: f64,
+    /// Source liftoff → end apex (s).
+    pub after_s: f64,
+    /// Source heading angle `atan2(e_h,y, e_h,x)` (rad).
+    pub heading_rad: f64,
+    /// Source contact point, world (m).
+    pub anchor: V3,
+    /// Feet in contact: left, right.
+    pub feet: [bool; 2],
+}
+
+/// The reference motion: the source clip's joint rotations per frame.
+#[derive(Debug, Clone)]
+pub struct Reference {
+    /// The (character-scaled) body.
+    pub body: BodyModel,
+    /// Source rows (character-scaled translations), row-major.
+    pub motion: Motion,
+    /// Local rotation per frame and joint (`frame · n_joints + joint`).
+    pub quats: Vec<Quat>,
+    /// Rotation axes per joint (file axes, in channel order).
+    pub axes: Vec<Vec<usize>>,
+    /// Hip, knee, ankle joints of the left and right legs.
+    pub legs: [[usize; 3]; 2],
+    /// Root joint.
+    pub root: usize,
+    /// Source COM per frame (m, Z up).
+    pub com: Vec<V3>,
+    /// Source ankles per frame (left, right): position (m, Z up), world rotation (file).
+    pub feet: Vec<[(V3, Quat); 2]>,
+}
+
+impl Reference {
+    /// Prepares a reference from a body and its clip's motion.
+    ///
+    /// # Errors
+    /// `ErrorKind::Skeleton` when the root has no three translation and three distinct
+    /// rotation channels, or a hip, knee or ankle has no three distinct rotation channels
+    /// or is not below the one before (the edit cannot place or bend them).
+    pub fn new(body: BodyModel, motion: Motion) -> Result<Reference> {
+        let sk = &body.skeleton;
+        let nj = sk.n_joints();
+        let axes: Vec<Vec<usize>> = sk
+            .channels
+            .iter()
+            .map(|c| c.rotations.iter().map(|&(a, _)| a).collect())
+            .collect();
+        let root = (0..nj).find(|&j| sk.parents[j].is_none()).unwrap_or(0);
+        let name = |j: usize| sk.names.get(j).cloned().unwrap_or_else(|| format!("#{j}"));
+        if sk.channels[root].translations.iter().any(Option::is_none)
+            || !rot::is_tait_bryan(&axes[root])
+        {
+            return Err(Error::skeleton(format!(
+                "root '{}' needs 3 position and 3 distinct rotation channels to be placed",
+                name(root)
+            )));
+        }
+        let lm = &body.landmarks;
+        let legs = [
+            [lm.left.hip, lm.left.knee, lm.left.ankle],
+            [lm.right.hip, lm.right.knee, lm.right.ankle],
+        ];
+        let below = |a: usize, b: usize| {
+            let mut p = sk.parents.get(b).copied().flatten();
+            while let Some(q) = p {
+                if q == a {
+                    return true;
+                }
+                p = sk.parents[q];
+            }
+            false
+        };
+        for leg in legs {
+            for (k, &j) in leg.iter().enumerate() {
+                if j >= nj || !rot::is_tait_bryan(&axes[j]) || (k > 0 && !below(leg[k - 1], j)) {
+                    return Err(Error::skeleton(format!(
+                        "leg joint '{}' needs 3 distinct rotation channels below the joint \
+                         before it for the foot IK",
+                        if j < nj {
+                            name(j)
+                        } else {
+                            format!("point {j}")
+                        }
+                    )));
+                }
+            }
+        }
+        let n = motion.n_frames();
+        let mut quats = Vec::with_capacity(n * nj);
+        let mut com = Vec::with_capacity(n);
+        let mut feet = Vec::with_capacity(n);
+        let mut ws = crate::skeleton::fk::FkWorkspace::new(sk);
+        let np = sk.n_points();
+        let (mut file, mut pts) = (vec![[0.0; 3]; np], vec![[0.0; 3]; np]);
+        for f in 0..n {
+            let row = motion.row(f);
+            for (j, ch) in sk.channels.iter().enumerate() {
+                let deg: Vec<f64> = ch.rotations.iter().map(|&(_, i)| row[i]).collect();
+                quats.push(rot::from_euler(&axes[j], &deg));
+            }
+            body.points(&mut ws, row, &mut file, &mut pts);
+            com.push(body.com(&pts));
+            let wq = world_quats(sk, &quats[f * nj..(f + 1) * nj]);
+            feet.push([0, 1].map(|k| (pts[legs[k][2]], wq[legs[k][2]])));
+        }
+        Ok(Reference {
+            body,
+            motion,
+            quats,
+            axes,
+            legs,
+            root,
+            com,
+            feet,
+        })
+    }
+
+    /// Source ankle of `side` at clip time `t`: position (m, Z up) and world rotation (file).
+    pub fn foot_at(&self, t: f64, side: usize) -> (V3, Quat) {
+        let (a, b, w) = self.at(t);
+        let ((pa, qa), (pb, qb)) = (self.feet[a][side], self.feet[b][side]);
+        (
+            std::array::from_fn(|i| pa[i] + w * (pb[i] - pa[i])),
+            rot::slerp(qa, qb, w),
+        )
+    }
+
+    /// Frame position of clip time `t` (s): `(f0, f1, w)`, clamped to the kept frames.
+    fn at(&self, t: f64) -> (usize, usize, f64) {
+        let n = self.motion.n_frames();
+        let first = self.body.leadin.min(n - 1);
+        let x = (t / self.motion.frame_time_s).clamp(first as f64, (n - 1) as f64);
+        let f0 = x.floor() as usize;
+        let f1 = (f0 + 1).min(n - 1);
+        (f0, f1, x - f0 as f64)
+    }
+
+    /// Source COM at clip time `t` (m), linear between frames.
+    pub fn com_at(&self, t: f64) -> V3 {
+        let (a, b, w) = self.at(t);
+        std::array::from_fn(|i| self.com[a][i] + w * (self.com[b][i] - self.com[a][i]))
+    }
+
+    /// The reference pose at clip time `t` into `pose` (rotations slerped, other channels
+    /// linear between the two frames).
+    fn sample(&self, t: f64, pose: &mut Pose) {
+        let (a, b, w) = self.at(t);
+        let nj = self.body.skeleton.n_joints();
+        let (ra, rb) = (self.motion.row(a), self.motion.row(b));
+        for (i, v) in pose.row.iter_mut().enumerate() {
+            *v = ra[i] + w * (rb[i] - ra[i]);
+        }
+        for j in 0..nj {
+            pose.q[j] = rot::slerp(self.quats[a * nj + j], self.quats[b * nj + j], w);
+        }
+        pose.ref_frame = if w < 0.5 { a } else { b };
+    }
+}
+
+/// A pose being built: local rotations and the row of every channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pose {
+    /// Local rotation per joint.
+    pub q: Vec<Quat>,
+    /// Every channel (translations used; rotation values are rewritten from `q`).
+    pub row: Vec<f64>,
+    /// Nearest source frame (Euler branch reference for the first output frame).
+    pub ref_frame: usize,
+}
+
+/// Per-thread scratch of the pose stage.
+#[derive(Debug, Clone)]
+pub struct PoseWorkspace {
+    pose: Pose,
+    other: Pose,
+    world_q: Vec<Quat>,
+    file: Vec<V3>,
+    pts: Vec<V3>,
+    knee_axis: [Option<V3>; 2],
+    prev_angles: Option<Vec<f64>>,
+    free_q: Vec<Quat>,
+}
+
+impl PoseWorkspace {
+    /// Scratch for a reference's skeleton.
+    pub fn new(r: &Reference) -> PoseWorkspace {
+        let sk = &r.body.skeleton;
+        let pose = Pose {
+            q: vec![rot::QUAT_IDENTITY; sk.n_joints()],
+            row: vec![0.0; sk.n_channels],
+            ref_frame: 0,
+        };
+        PoseWorkspace {
+            other: pose.clone(),
+            pose,
+            world_q: vec![rot::QUAT_IDENTITY; sk.n_joints()],
+            file: vec![[0.0; 3]; sk.n_points()],
+            pts: vec![[0.0; 3]; sk.n_points()],
+            knee_axis: [None; 2],
+            prev_angles: None,
+            free_q: vec![rot::QUAT_IDENTITY; sk.n_joints()],
+        }
+    }
+}
+
+/// World rotations of one frame's local rotations (parents before children).
+fn world_quats(sk: &crate::skeleton::Skeleton, local: &[Quat]) -> Vec<Quat> {
+    let mut w: Vec<Quat> = Vec::with_capacity(local.len());
+    for (j, q) in local.iter().enumerate() {
+        let v = match sk.parents[j] {
+            None => *q,
+            Some(p) => rot::mul(w[p], *q),
+        };
+        w.push(v);
+    }
+    w
+}
+
+/// FK of a quaternion pose: world rotations and file-frame points, then metres Z up.
+fn forward(r: &Reference, pose: &Pose, wq: &mut [Quat], file: &mut [V3], pts: &mut [V3]) {
+    let sk = &r.body.skeleton;
+    for j in 0..sk.n_joints() {
+        let t = local_translation(sk, j, &pose.row);
+        match sk.parents[j] {
+            None => {
+                wq[j] = pose.q[j];
+                file[j] = t;
+            }
+            Some(p) => {
+                wq[j] = rot::mul(wq[p], pose.q[j]);
+                file[j] = add(file[p], rot::rotate(wq[p], t));
+            }
+        }
+    }
+    let nj = sk.n_joints();
+    for (e, (j, off)) in sk.end_sites.iter().enumerate() {
+        file[nj + e] = add(file[*j], rot::rotate(wq[*j], *off));
+    }
+    for (o, p) in pts.iter_mut().zip(file.iter()) {
+        *o = r.body.to_internal(*p);
+    }
+}
+
+/// Sets joint `j`'s world rotation to `delta · world` (its parent unchanged).
+fn turn_world(r: &Reference, pose: &mut Pose, wq: &[Quat], j: usize, delta: Quat) {
+    let parent = r.body.skeleton.parents[j].map_or(rot::QUAT_IDENTITY, |p| wq[p]);
+    let world = rot::mul(delta, wq[j]);
+    pose.q[j] = rot::normalize(rot::mul(rot::conj(parent), world));
+}
+
+/// One output frame's outcome.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FramePose {
+    /// Output time (s from the first output frame).
+    pub time_s: f64,
+    /// The phase.
+    pub phase: Phase,
+    /// Planned COM (m).
+    pub com_plan: V3,
+    /// COM of the written pose (m).
+    pub com_pose: V3,
+    /// Planned contact point, in stance (m).
+    pub contact: Option<V3>,
+    /// Planned touchdown and liftoff of the stance, in stance (s, output time).
+    pub window: Option<(f64, f64)>,
+    /// Support ankle (left when both), in stance (m).
+    pub foot: Option<V3>,
+    /// Largest distance of a support ankle from its target (m).
+    pub foot_error_m: f64,
+    /// Root/IK iterations used.
+    pub iterations: usize,
+    /// COM within tolerance and feet on their targets.
+    pub converged: bool,
+}
+
+/// The whole edited motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EditedMotion {
+    /// Rows in the source's channel layout.
+    pub motion: Motion,
+    /// Per frame: plan, pose COM and convergence.
+    pub frames: Vec<FramePose>,
+}
+
+fn smooth(u: f64) -> f64 {
+    let u = u.clamp(0.0, 1.0);
+    u * u * (3.0 - 2.0 * u)
+}
+
+fn heading_of(path: &ComPath, k: usize) -> f64 {
+    let h = path.stances[k].heading;
+    h[1].atan2(h[0])
+}
+
+fn wrap_pi(a: f64) -> f64 {
+    let t = std::f64::consts::TAU;
+    a - t * (a / t).round()
+}
+
+/// Foot `side` anchored to planned stance `k`, from the source foot at clip time `t_src`:
+/// ankle position (file) and world orientation.
+fn anchored(
+    r: &Reference,
+    path: &ComPath,
+    s: &StanceSource,
+    k: usize,
+    yaw: f64,
+    t_src: f64,
+    side: usize,
+) -> (V3, Quat) {
+    let body = &r.body;
+    let (p, q) = r.foot_at(t_src, side);
+    let rel = rot::rotate(rot::axis_angle([0.0, 0.0, 1.0], yaw), sub(p, s.anchor));
+    let c_plan = path.stances[k].contact_point();
+    (
+        body.to_file(add(c_plan, rel)),
+        rot::mul(rot::axis_angle(up_file(body), yaw), q),
+    )
+}
+
+fn up_file(body: &BodyModel) -> V3 {
+    let u = body.to_file([0.0, 0.0, 1.0]);
+    let n = norm(u);
+    u.map(|v| v / n)
+}
+
+/// Where foot `side` goes at `t`: anchored to its stance while in one; in a swing, the
+/// blend (smooth weight over the swing) of its motion after the last liftoff, anchored to
+/// that stance, and before the next touchdown, anchored to that one. The difference of
+/// the two is constant (the change of the footprint spacing), so the foot leaves and
+/// reaches the floor exactly as the source foot does. `None`: no stance of this foot.
+fn foot_goal(
+    r: &Reference,
+    path: &ComPath,
+    src: &[StanceSource],
+    t: f64,
+    side: usize,
+) -> Option<(V3, Quat, f64)> {
+    let st = &path.stances;
+    let has = |k: usize| src[st[k].source].feet[side];
+    let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src[st[k].source].heading_rad);
+    let rate = |k: usize| {
+        let (td, lo) = st[k].contact_window();
+        let s = &src[st[k].source];
+        if lo > td {
+            (s.lo_clip_s - s.td_clip_s) / (lo - td)
+        } else {
+            1.0
+        }
+    };
+    for k in (0..st.len()).filter(|&k| has(k)) {
+        let (td, lo) = st[k].contact_window();
+        if t >= td && t <= lo {
+            let s = &src[st[k].source];
+            let (p, q) = anchored(
+                r,
+                path,
+                s,
+                k,
+                yaw_of(k),
+                s.td_clip_s + (t - td) * rate(k),
+                side,
+            );
+            return Some((p, q, 1.0));
+        }
+    }
+    let b = (0..st.len())
+        .rev()
+        .find(|&k| has(k) && st[k].contact_window().1 <= t);
+    let a = (0..st.len()).find(|&k| has(k) && st[k].contact_window().0 >= t);
+    let from_b = b.map(|k| {
+        let s = &src[st[k].source];
+        let lo = st[k].contact_window().1;
+        anchored(
+            r,
+            path,
+            s,
+            k,
+            yaw_of(k),
+            s.lo_clip_s + (t - lo) * rate(k),
+            side,
+        )
+    });
+    let from_a = a.map(|k| {
+        let s = &src[st[k].source];
+        let td = st[k].contact_window().0;
+        anchored(
+            r,
+            path,
+            s,
+            k,
+            yaw_of(k),
+            s.td_clip_s - (td - t) * rate(k),
+            side,
+        )
+    });
+    match (from_b, from_a, b, a) {
+        (Some(pb), Some(pa), Some(b), Some(a)) => {
+            let (lo, td) = (st[b].contact_window().1, st[a].contact_window().0);
+            let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
+            let p = std::array::from_fn(|i| pb.0[i] + w * (pa.0[i] - pb.0[i]));
+            Some((p, rot::slerp(pb.1, pa.1, w), 1.0))
+        }
+        // Before the first or after the last stance of this foot: the free (reference)
+        // foot, pulled onto its anchor smoothly towards the contact edge.
+        (Some(p), None, Some(b), _) => {
+            let lo = st[b].contact_window().1;
+            let u = if path.t_end > lo {
+                (t - lo) / (path.t_end - lo)
+            } else {
+                1.0
+            };
+            Some((p.0, p.1, 1.0 - smooth(u)))
+        }
+        (None, Some(p), _, Some(a)) => {
+            let td = st[a].contact_window().0;
+            let u = if td > path.t_start {
+                (t - path.t_start) / (td - path.t_start)
+            } else {
+                1.0
+            };
+            Some((p.0, p.1, smooth(u)))
+        }
+        _ => None,
+    }
+}
+
+/// Poses one output time into `ws.pose`; returns the frame's outcome.
+pub fn pose_frame(
+    r: &Reference,
+    path: &ComPath,
+    src: &[StanceSource],
+    opts: &EditOptions,
+    t: f64,
+    ws: &mut PoseWorkspace,
+) -> FramePose {
+    let phase = path.phase(t);
+    let st = &path.stances;
+    let src_of = |k: usize| &src[st[k].source];
+    let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src_of(k).heading_rad);
+    // 1. Reference pose, foot anchors and yaw.
+    let (yaw, stance) = match phase {
+        Phase::Stance(k) => {
+            let (td, lo) = st[k].contact_window();
+            let s = src_of(k);
+            let u = if lo > td { (t - td) / (lo - td) } else { 0.0 };
+            r.sample(s.td_clip_s + u * (s.lo_clip_s - s.td_clip_s), &mut ws.pose);
+            (yaw_of(k), Some(k))
+        }
+        Phase::Flight { before, after } => {
+            let side_a = before.map(|b| {
+                let (_, lo) = st[b].contact_window();
+                let e_new = st[b].end() - lo;
+                let s = src_of(b);
+                let rate = if e_new > 0.0 { s.after_s / e_new } else { 1.0 };
+                (lo, s.lo_clip_s + (t - lo) * rate)
+            });
+            let side_b = after.map(|a| {
+                let (td, _) = st[a].contact_window();
+                let b_new = td - st[a].t0;
+                let s = src_of(a);
+                let rate = if b_new > 0.0 { s.before_s / b_new } else { 1.0 };
+                (td, s.td_clip_s - (td - t) * rate)
+            });
+            match (side_a, side_b, before, after) {
+                (Some((lo, ta)), Some((td, tb)), Some(b), Some(a)) => {
+                    let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
+                    let (ya, yb) = (yaw_of(b), yaw_of(a));
+                    r.sample(tb, &mut ws.pose);
+                    std::mem::swap(&mut ws.pose, &mut ws.other);
+                    r.sample(ta, &mut ws.pose);
+                    for (qa, qb) in ws.pose.q.iter_mut().zip(&ws.other.q) {
+                        *qa = rot::slerp(*qa, *qb, w);
+                    }
+                    for (va, vb) in ws.pose.row.iter_mut().zip(&ws.other.row) {
+                        *va += w * (vb - *va);
+                    }
+                    (ya + w * wrap_pi(yb - ya), None)
+                }
+                (Some((_, ta)), _, Some(b), _) => {
+                    r.sample(ta, &mut ws.pose);
+                    (yaw_of(b), None)
+                }
+                (_, Some((_, tb)), _, Some(a)) => {
+                    r.sample(tb, &mut ws.pose);
+                    (yaw_of(a), None)
+                }
+                _ => {
+                    r.sample(0.0, &mut ws.pose);
+                    (0.0, None)
+                }
+            }
+        }
+    };
+    let body = &r.body;
+    let q_yaw = rot::axis_angle(up_file(body), yaw);
+    let (com_plan, _) = path.com(t);
+    let contact = stance.map(|k| st[k].contact_point());
+    ws.pose.q[r.root] = rot::mul(q_yaw, ws.pose.q[r.root]);
+    ws.free_q.clone_from(&ws.pose.q);
+    let root_ch = body.skeleton.channels[r.root].translations;
+    // 2. Root and IK until the COM is on the plan.
+    let mut iterations = 0;
+    let (mut err_m, mut foot_err) = (f64::INFINITY, 0.0);
+    let mut com_pose = [0.0; 3];
+    let pulls: [Option<(V3, Quat, f64)>; 2] = [0, 1].map(|side| foot_goal(r, path, src, t, side));
+    let mut goal: [Option<(V3, Quat)>; 2] = [None; 2];
+    while iterations < opts.max_iterations {
+        iterations += 1;
+        ws.pose.q.copy_from_slice(&ws.free_q);
+        forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+        if pulls.iter().any(Option::is_some) {
+            for (side, g) in goal.iter_mut().enumerate() {
+                *g = pulls[side].map(|(p, q, w)| {
+                    let ankle = r.legs[side][2];
+                    let (fp, fq) = (ws.file[ankle], ws.world_q[ankle]);
+                    let pos = std::array::from_fn(|i| fp[i] + w * (p[i] - fp[i]));
+                    (pos, rot::slerp(fq, q, w))
+                });
+            }
+            for (side, g) in goal.iter().enumerate() {
+                if let Some((p, _)) = *g {
+                    two_bone(r, ws, side, p, opts.max_reach);
+                    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+                }
+            }
+            for (side, g) in goal.iter().enumerate() {
+                if let Some((_, o)) = *g {
+                    let ankle = r.legs[side][2];
+                    let parent =
+                        body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
+                    ws.pose.q[ankle] = rot::normalize(rot::mul(rot::conj(parent), o));
+                }
+            }
+            forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+            // Support feet only: a swing foot may be out of reach and is not planted.
+            let planted = |side: usize| stance.is_some_and(|k| src_of(k).feet[side]);
+            foot_err = (0..2)
+                .filter(|&side| planted(side))
+                .filter_map(|side| goal[side].map(|(p, _)| norm(sub(ws.file[r.legs[side][2]], p))))
+                .fold(0.0, f64::max)
+                * body.unit_m;
+        }
+        com_pose = body.com(&ws.pts);
+        let e = sub(com_plan, com_pose);
+        err_m = norm(e);
+        if err_m <= opts.com_tol_m {
+            break;
+        }
+        let d = body.to_file(e);
+        for a in 0..3 {
+            if let Some(i) = root_ch[a] {
+                ws.pose.row[i] += d[a];
+            }
+        }
+    }
+    if err_m > opts.com_tol_m {
+        // The last root shift is not yet seen by FK: measure the pose as written.
+        forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+        com_pose = body.com(&ws.pts);
+        err_m = norm(sub(com_plan, com_pose));
+    }
+    let support = stance.and_then(|k| src_of(k).feet.iter().position(|&f| f));
+    let foot = support.map(|side| ws.pts[r.legs[side][2]]);
+    FramePose {
+        time_s: t,
+        phase,
+        com_plan,
+        com_pose,
+        contact,
+        window: stance.map(|k| {
+            let (td, lo) = st[k].contact_window();
+            (td - path.t_start, lo - path.t_start)
+        }),
+        foot,
+        foot_error_m: foot_err,
+        iterations,
+        converged: err_m <= opts.com_tol_m && foot_err <= opts.com_tol_m,
+    }
+}
+
+/// Analytic two-bone IK of one leg towards `target` (file frame): knee about its hinge,
+/// then the hip by the smallest rotation. Reach is clamped to `max_reach` of the leg.
+fn two_bone(r: &Reference, ws: &mut PoseWorkspace, side: usize, target: V3, max_reach: f64) {
+    let [hip, knee, ankle] = r.legs[side];
+    let (h, k, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
+    let (v1, v2) = (sub(h, k), sub(a, k));
+    let (l1, l2) = (norm(v1), norm(v2));
+    if l1 == 0.0 || l2 == 0.0 {
+        return;
+    }
+    let lo = (l1 - l2).abs() * 1.001;
+    let d = norm(sub(target, h)).clamp(lo, max_reach * (l1 + l2));
+    let cur = (dot(v1, v2) / (l1 * l2)).clamp(-1.0, 1.0).acos();
+    let want = ((l1 * l1 + l2 * l2 - d * d) / (2.0 * l1 * l2))
+        .clamp(-1.0, 1.0)
+        .acos();
+    let c = cross(v1, v2);
+    let n = if norm(c) > 1e-6 * l1 * l2 {
+        let n = c.map(|v| v / norm(c));
+        ws.knee_axis[side] = Some(n);
+        n
+    } else {
+        ws.knee_axis[side].unwrap_or_else(|| rot::rotate(ws.world_q[knee], [1.0, 0.0, 0.0]))
+    };
+    let dk = rot::axis_angle(n, want - cur);
+    turn_world(r, &mut ws.pose, &ws.world_q, knee, dk);
+    let a2 = add(k, rot::rotate(dk, v2));
+    let dh = rot::between(sub(a2, h), sub(target, h));
+    turn_world(r, &mut ws.pose, &ws.world_q, hip, dh);
+}
+
+/// Writes the rotation channels of `ws.pose` into its row (Euler angles nearest the
+/// previous frame's, or the reference frame's for the first).
+fn write_angles(r: &Reference, ws: &mut PoseWorkspace) {
+    let sk = &r.body.skeleton;
+    let prev = ws
+        .prev_angles
+        .get_or_insert_with(|| r.motion.row(ws.pose.ref_frame).to_vec());
+    for j in 0..sk.n_joints() {
+        let ch = &sk.channels[j].rotations;
+        if ch.len() == 3 && rot::is_tait_bryan(&r.axes[j]) {
+            let axes = [r.axes[j][0], r.axes[j][1], r.axes[j][2]];
+            let reference = [prev[ch[0].1], prev[ch[1].1], prev[ch[2].1]];
+            let e = rot::to_euler(ws.pose.q[j], axes, reference);
+            for n in 0..3 {
+                ws.pose.row[ch[n].1] = e[n];
+            }
+        }
+    }
+    prev.copy_from_slice(&ws.pose.row);
+}
+
+/// Poses every output frame `t = t_start + i/fps` of the plan.
+pub fn pose_motion(
+    r: &Reference,
+    path: &ComPath,
+    src: &[StanceSource],
+    opts: &EditOptions,
+    fps: f64,
+) -> EditedMotion {
+    let n = ((path.t_end - path.t_start) * fps + 1e-9).floor() as usize + 1;
+    let nc = r.body.skeleton.n_channels;
+    let mut values = Vec::with_capacity(n * nc);
+    let mut frames = Vec::with_capacity(n);
+    let mut ws = PoseWorkspace::new(r);
+    for i in 0..n {
+        let t = path.t_start + i as f64 / fps;
+        let mut f = pose_frame(r, path, src, opts, t, &mut ws);
+        f.time_s = i as f64 / fps;
+        write_angles(r, &mut ws);
+        values.extend_from_slice(&ws.pose.row);
+        frames.push(f);
+    }
+    EditedMotion {
+        motion: Motion {
+            frames_header: Some(n as u64),
+            frame_time_s: 1.0 / fps,
+            n_channels: nc,
+            values,
+        },
+        frames,
+    }
+}

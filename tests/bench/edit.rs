@@ -1,0 +1,76 @@
+//! Edit benchmark (issue 14): 1 s of edited motion at 120 Hz on the 31-joint CMU skeleton
+//! of `cmu_09_01_run_mb` (a run cycle at 1.1 × its recorded speed), IK and root/COM
+//! iteration included, one thread. Target: at most 5 ms.
+//!
+//! Run with `cargo bench --bench edit` (`make bench`). Needs `../shared/data/bvh` (skipped
+//! with a message without it).
+//!
+//! # Results
+//! 2026-12-02, 2-core x86_64 sandbox (shared): see the issue notes.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use stancelib::bvh::parse_file;
+use stancelib::edit::plan::{place, run_requests, solve_stance};
+use stancelib::edit::pose::{pose_motion, Reference};
+use stancelib::edit::EditOptions;
+use stancelib::ingest::body::BodyModel;
+use stancelib::library::read::{open_library, read_stance_timing};
+use stancelib::pipeline::build::{build_and_write, BuildOptions};
+use stancelib::query::feasibility::relative_limits;
+use stancelib::query::pool::Prepared;
+use stancelib::query::run::run_cycles;
+use stancelib::skeleton::com::Sex;
+use stancelib::skeleton::units::UpAxis;
+
+fn edit_one_second(c: &mut Criterion) {
+    let clip =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bvh/run/cmu_09_01_run_mb.bvh");
+    if !clip.is_file() {
+        eprintln!("edit benchmark skipped: {} is absent", clip.display());
+        return;
+    }
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lib = dir.path().join("lib");
+    build_and_write(
+        std::slice::from_ref(&clip),
+        &lib,
+        &BuildOptions::default(),
+        false,
+    )
+    .expect("build");
+    let l = open_library(&lib).expect("library");
+    let times = read_stance_timing(&lib.join("stances.parquet")).expect("timing");
+    let cy = run_cycles(&l.stances)[0];
+    let prep = cy.stances.map(|i| Prepared::new(l.stances[i].clone()));
+    let req = run_requests([&prep[0].stance, &prep[1].stance], 1.1);
+    let stances: Vec<_> = (0..2)
+        .map(|n| {
+            let i = cy.stances[n];
+            let lim = relative_limits(&prep[n].stance.coef);
+            solve_stance(&l.stances[i], times[i], &prep[n], req[n], &lim).expect("solved")
+        })
+        .collect();
+    let bvh = parse_file(&clip).expect("clip");
+    let info =
+        stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).expect("clips");
+    let src = &info[&l.stances[cy.stances[0]].clip];
+    let up = UpAxis::parse(src.up_axis.as_deref().unwrap()).unwrap();
+    let body = BodyModel::new(&bvh, src.unit_scale.unwrap(), up, Sex::Male).expect("body");
+    assert_eq!(body.skeleton.n_joints(), 31, "the CMU mb skeleton");
+    let reference = Reference::new(body, bvh.motion.clone()).expect("reference");
+    let order: Vec<usize> = (0..4).flat_map(|_| [0, 1]).collect();
+    let (mut path, sources) = place(&stances, &order, &reference, false, false);
+    path.t_end = path.t_start + 1.0;
+    let opts = EditOptions::default();
+    let mut g = c.benchmark_group("edit");
+    g.bench_function("one_second_120hz_31_joints", |b| {
+        b.iter(|| black_box(pose_motion(&reference, &path, &sources, &opts, 120.0)))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, edit_one_second);
+criterion_main!(benches);
