@@ -6,7 +6,8 @@
 //! with a message without it).
 //!
 //! # Results
-//! 2026-12-02, 2-core x86_64 sandbox (shared): see the issue notes.
+//! Not yet recorded: the first release build of the dependencies did not fit the
+//! session (2-core x86_64 sandbox, 2026-12-02).
 
 use std::hint::black_box;
 use std::path::Path;
