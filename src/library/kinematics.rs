@@ -70,27 +70,54 @@ fn com_by_frame(frames: &DataFrame) -> PolarsResult<BTreeMap<String, BTreeMap<i6
     Ok(out)
 }
 
-/// Samples grouped by (character, effector), in (clip, frame) order, with each
-/// character's leg length.
-fn samples(
-    frames: &DataFrame,
-    contacts: &DataFrame,
-    clips: &DataFrame,
-) -> PolarsResult<(Groups, BTreeMap<String, f64>)> {
-    let coms = com_by_frame(frames)?;
-    let (names, chars, legs) = (
+/// Each clip's character (`clip → character_id`) from a clips table, for the clips with a
+/// leg length (the others have no samples).
+fn characters(clips: &DataFrame) -> PolarsResult<BTreeMap<String, String>> {
+    let (names, chars) = (strs(clips, "clip")?, strs(clips, "character_id")?);
+    let legs = f64s(clips, "leg_length_m")?;
+    Ok(names
+        .into_iter()
+        .zip(chars)
+        .zip(legs)
+        .filter_map(|((n, c), l)| Some((n?, c?, l?)))
+        .map(|(n, c, _)| (n, c))
+        .collect())
+}
+
+/// Adds the leg length of each character not yet in `legs`, from a clips table in clip
+/// order: a character's leg length is that of its first clip (by name) that has one.
+///
+/// # Errors
+/// The table lacks `clip`, `character_id` or `leg_length_m`.
+pub fn add_character_legs(legs: &mut BTreeMap<String, f64>, clips: &DataFrame) -> PolarsResult<()> {
+    let (names, chars, lens) = (
         strs(clips, "clip")?,
         strs(clips, "character_id")?,
         f64s(clips, "leg_length_m")?,
     );
-    let mut character: BTreeMap<String, String> = BTreeMap::new();
-    let mut leg: BTreeMap<String, f64> = BTreeMap::new();
     for i in 0..clips.height() {
-        if let (Some(n), Some(c), Some(l)) = (&names[i], &chars[i], legs[i]) {
-            character.insert(n.clone(), c.clone());
-            leg.entry(c.clone()).or_insert(l);
+        if let (Some(_), Some(c), Some(l)) = (&names[i], &chars[i], lens[i]) {
+            legs.entry(c.clone()).or_insert(l);
         }
     }
+    Ok(())
+}
+
+/// The kinematic samples of whole clips: every contact frame's COM in its contact frame,
+/// before the outlier rules, one row per (character, effector, clip, frame) with
+/// `character_id`, `effector`, `clip`, `frame`, `x`, `y`, `z` (m), sorted by those four
+/// keys. This is the per-character summary a shard keeps (`kinematics_samples.parquet`):
+/// the polytopes of a merge are made from the shards' samples.
+///
+/// # Errors
+/// A table lacks a needed column or has it with another type.
+pub fn samples_table(
+    frames: &DataFrame,
+    contacts: &DataFrame,
+    clips: &DataFrame,
+) -> PolarsResult<DataFrame> {
+    let coms = com_by_frame(frames)?;
+    let character = characters(clips)?;
     let (clip, eff) = (strs(contacts, "clip")?, strs(contacts, "effector")?);
     let (first, last) = (
         i64s(contacts, "first_frame")?,
@@ -102,7 +129,7 @@ fn samples(
         f64s(contacts, "origin_z")?,
     ];
     let yaw = f64s(contacts, "yaw_rad")?;
-    let mut groups = Groups::new();
+    let mut rows: Vec<(&str, &str, &str, i64, [f64; 3])> = Vec::new();
     for i in 0..contacts.height() {
         let (Some(c), Some(e), Some(a), Some(b), Some(y)) =
             (&clip[i], &eff[i], first[i], last[i], yaw[i])
@@ -115,19 +142,59 @@ fn samples(
         let (Some(ch), Some(com)) = (character.get(c), coms.get(c)) else {
             continue;
         };
-        let group = groups.entry((ch.clone(), e.clone())).or_default();
         for (&frame, &p) in com.range(a..=b) {
-            group.push(Sample {
-                clip: c.clone(),
-                frame,
-                rc: com_in_contact_frame(p, [ox, oy, oz], y),
-            });
+            rows.push((ch, e, c, frame, com_in_contact_frame(p, [ox, oy, oz], y)));
         }
     }
-    for g in groups.values_mut() {
-        g.sort_by(|x, y| (&x.clip, x.frame).cmp(&(&y.clip, y.frame)));
+    // Stable: rows of one key keep the contact table's order.
+    rows.sort_by(|x, y| (x.0, x.1, x.2, x.3).cmp(&(y.0, y.1, y.2, y.3)));
+    let p = |a: usize| -> Vec<f64> { rows.iter().map(|r| r.4[a]).collect() };
+    DataFrame::new_infer_height(vec![
+        col("character_id", rows.iter().map(|r| r.0).collect::<Vec<_>>()),
+        col("effector", rows.iter().map(|r| r.1).collect::<Vec<_>>()),
+        col("clip", rows.iter().map(|r| r.2).collect::<Vec<_>>()),
+        col("frame", rows.iter().map(|r| r.3).collect::<Vec<_>>()),
+        col("x", p(0)),
+        col("y", p(1)),
+        col("z", p(2)),
+    ])
+}
+
+/// Sort keys of a samples table (see [`samples_table`]).
+pub const SAMPLES_SORT_KEYS: [&str; 4] = ["character_id", "effector", "clip", "frame"];
+
+/// Samples grouped by (character, effector), in (clip, frame) order, from a samples table
+/// sorted by [`SAMPLES_SORT_KEYS`].
+fn groups_of(samples: &DataFrame) -> PolarsResult<Groups> {
+    let (ch, eff, clip) = (
+        strs(samples, "character_id")?,
+        strs(samples, "effector")?,
+        strs(samples, "clip")?,
+    );
+    let frame = i64s(samples, "frame")?;
+    let xyz = [
+        f64s(samples, "x")?,
+        f64s(samples, "y")?,
+        f64s(samples, "z")?,
+    ];
+    let mut groups = Groups::new();
+    for i in 0..samples.height() {
+        let (Some(c), Some(e), Some(k), Some(f)) = (&ch[i], &eff[i], &clip[i], frame[i]) else {
+            continue;
+        };
+        let (Some(x), Some(y), Some(z)) = (xyz[0][i], xyz[1][i], xyz[2][i]) else {
+            continue;
+        };
+        groups
+            .entry((c.clone(), e.clone()))
+            .or_default()
+            .push(Sample {
+                clip: k.clone(),
+                frame: f,
+                rc: [x, y, z],
+            });
     }
-    Ok((groups, leg))
+    Ok(groups)
 }
 
 /// The two kinematics tables of a library from its `frames`, `contacts` and `clips`
@@ -141,7 +208,22 @@ pub fn kinematics_tables(
     contacts: &DataFrame,
     clips: &DataFrame,
 ) -> PolarsResult<(DataFrame, DataFrame)> {
-    let (groups, legs) = samples(frames, contacts, clips)?;
+    let samples = samples_table(frames, contacts, clips)?;
+    let mut legs = BTreeMap::new();
+    add_character_legs(&mut legs, clips)?;
+    kinematics_from_samples(&samples, &legs)
+}
+
+/// The two kinematics tables (`(facets, points)`) from a samples table sorted by
+/// [`SAMPLES_SORT_KEYS`] and each character's leg length (m).
+///
+/// # Errors
+/// The samples table lacks a column or has it with another type.
+pub fn kinematics_from_samples(
+    samples: &DataFrame,
+    legs: &BTreeMap<String, f64>,
+) -> PolarsResult<(DataFrame, DataFrame)> {
+    let groups = groups_of(samples)?;
     let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
     for (key, g) in &groups {
         let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
