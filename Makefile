@@ -1,7 +1,7 @@
 # stancelib: the two commands a newcomer needs are `make demo` and `make test`.
 CARGO ?= cargo
 
-.PHONY: demo test lint bench nightly build doc fixtures fuzz
+.PHONY: demo test lint bench nightly build doc fixtures fuzz spark-demo
 
 ## Run the main job on the bundled fixtures (pipelines/demo.toml); tables go to out/demo/.
 demo:
@@ -39,6 +39,14 @@ nightly:
 
 build:
 	$(CARGO) build --release
+
+## The bulk CMU set built by Apache Spark in local mode (8 shards on local[2], then merge) into
+## out/spark-demo/; needs Java 17 and `python3 -m pip install pyspark` (pipelines/spark/).
+STANCELIB_BIN ?= $${CARGO_TARGET_DIR:-target}/release/stancelib
+spark-demo:
+	$(CARGO) build --release
+	python3 pipelines/spark/stancelib_spark.py --master 'local[2]' --shards 8 \
+		--stancelib $(STANCELIB_BIN) --out out/spark-demo ../shared/data/bvh-bulk/cmu
 
 doc:
 	$(CARGO) doc --no-deps

@@ -390,3 +390,82 @@ fn merge_output_follows_the_build_output_rules() {
     assert!(err.contains("--shard"), "{err}");
     let _ = Shard { index: 1, count: 1 };
 }
+
+/// Why the Spark driver cannot run here (no `java`, or no `pyspark` for `python3`).
+fn spark_missing() -> Option<String> {
+    let runs = |cmd: &str, args: &[&str]| {
+        std::process::Command::new(cmd)
+            .args(args)
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !runs("java", &["-version"]) {
+        return Some("java is not installed".into());
+    }
+    if !runs("python3", &["-c", "import pyspark"]) {
+        return Some("pyspark is not installed (python3 -m pip install pyspark)".into());
+    }
+    None
+}
+
+#[test]
+fn the_spark_driver_builds_the_single_run_library() {
+    if let Some(why) = spark_missing() {
+        // .ci/run installs both: there, a missing engine is a failure.
+        assert!(std::env::var("CI").is_err(), "CI: {why}");
+        eprintln!("SKIPPED the_spark_driver_builds_the_single_run_library: {why}");
+        return;
+    }
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let single = d.path().join("single");
+    build_cli(&inputs, &single, &["--joints"]);
+    let lib = d.path().join("spark-lib");
+    let o = std::process::Command::new("python3")
+        .arg(root().join("pipelines/spark/stancelib_spark.py"))
+        .args(["--master", "local[2]", "--shards", "3", "--stancelib"])
+        .arg(env!("CARGO_BIN_EXE_stancelib"))
+        .arg("--out")
+        .arg(&lib)
+        .arg(root().join("fixtures/bvh"))
+        .args(["--", "--joints"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    // Exit 1: the malformed fixtures fail, as in the single build.
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_same_library(&single, &lib);
+    // The shard libraries are removed after the merge; nothing else is left beside it.
+    let mut left = files_of(d.path());
+    left.sort();
+    assert_eq!(left, vec!["single", "spark-lib"]);
+}
+
+#[test]
+fn the_spark_driver_names_a_failed_shard_and_writes_nothing() {
+    if let Some(why) = spark_missing() {
+        assert!(std::env::var("CI").is_err(), "CI: {why}");
+        eprintln!("SKIPPED the_spark_driver_names_a_failed_shard_and_writes_nothing: {why}");
+        return;
+    }
+    let d = tmp();
+    let lib = d.path().join("lib");
+    // A bad build option: every shard's build exits 2 before any work.
+    let o = std::process::Command::new("python3")
+        .arg(root().join("pipelines/spark/stancelib_spark.py"))
+        .args(["--master", "local[1]", "--shards", "2", "--stancelib"])
+        .arg(env!("CARGO_BIN_EXE_stancelib"))
+        .arg("--out")
+        .arg(&lib)
+        .arg(root().join("fixtures/bvh"))
+        .args(["--", "--mass=-1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("shard 1/2 failed") && err.contains("--mass"),
+        "{err}"
+    );
+    assert!(!lib.exists());
+}
