@@ -469,3 +469,38 @@ fn the_spark_driver_names_a_failed_shard_and_writes_nothing() {
     );
     assert!(!lib.exists());
 }
+
+#[test]
+fn an_incremental_shard_rebuilds_only_its_missing_clips() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let (part, full) = (d.path().join("part"), d.path().join("full"));
+    // The first run saw only some of the inputs (a crash, or files that came later).
+    let few: Vec<PathBuf> = inputs.iter().step_by(2).cloned().collect();
+    let first = |p: &Path| -> Vec<String> {
+        manifest(p)["inputs"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .cloned()
+            .collect()
+    };
+    build_cli(&few, &part, &["--shard", "1/2"]);
+    let had = first(&part).len();
+    let mut args: Vec<String> = vec!["build".into()];
+    args.extend(inputs.iter().map(|p| s(p)));
+    args.extend(["--out", &s(&part), "--shard", "1/2", "--incremental"].map(String::from));
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, out, err) = stancelib(&argv);
+    assert!(code <= 1, "{err}");
+    // Reused: the clips of the first run that did not fail (failed ones are retried).
+    let reused: usize = out
+        .split(" clips reused")
+        .next()
+        .and_then(|t| t.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(reused > 0 && reused <= had, "{out}");
+    build_cli(&inputs, &full, &["--shard", "1/2"]);
+    assert_same_library(&full, &part);
+}

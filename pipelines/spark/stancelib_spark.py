@@ -55,6 +55,10 @@ def parse_args(argv):
                    help="Spark master when not set by spark-submit (default local[*])")
     p.add_argument("--keep-shards", action="store_true",
                    help="keep the shard libraries after the merge")
+    p.add_argument("--incremental", action="store_true",
+                   help="rerun after a crash: each shard reuses the clips its library in "
+                        "--work already holds (unchanged path, content and options) and "
+                        "builds only the missing ones; the shards are kept")
     if "--" in argv:
         k = argv.index("--")
         args, extra = p.parse_args(argv[:k]), argv[k + 1:]
@@ -120,7 +124,8 @@ def main(argv):
         os.path.dirname(out), ".%s.shards" % os.path.basename(out)))
     os.makedirs(work, exist_ok=True)
     inputs = [os.path.abspath(i) for i in args.inputs]
-    specs = [(args.stancelib, inputs, work, i, count, args.threads, args.build_args)
+    build_args = args.build_args + (["--incremental"] if args.incremental else [])
+    specs = [(args.stancelib, inputs, work, i, count, args.threads, build_args)
              for i in range(1, count + 1)]
     # One partition per shard: Spark runs each shard as one task, retrying lost executors.
     results = sc.parallelize(specs, count).map(shard_task).collect()
@@ -135,7 +140,7 @@ def main(argv):
         return 2
     shards = [os.path.join(work, "shard-%d" % i) for i in range(1, count + 1)]
     merge = subprocess.run([resolve_binary(args.stancelib), "merge", *shards, "--out", out])
-    if merge.returncode in (0, 1) and not args.keep_shards:
+    if merge.returncode in (0, 1) and not (args.keep_shards or args.incremental):
         shutil.rmtree(work, ignore_errors=True)
     return merge.returncode
 
