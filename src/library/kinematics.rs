@@ -10,6 +10,7 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use polars::prelude::*;
 
@@ -23,7 +24,7 @@ use crate::twopac::polytope::Polytope;
 /// One kinematic sample: the COM in an effector's contact frame at one frame.
 #[derive(Debug, Clone, PartialEq)]
 struct Sample {
-    clip: String,
+    clip: Arc<str>,
     frame: i64,
     rc: [f64; 3],
 }
@@ -166,33 +167,59 @@ pub const SAMPLES_SORT_KEYS: [&str; 4] = ["character_id", "effector", "clip", "f
 /// Samples grouped by (character, effector), in (clip, frame) order, from a samples table
 /// sorted by [`SAMPLES_SORT_KEYS`].
 fn groups_of(samples: &DataFrame) -> PolarsResult<Groups> {
+    let str_col =
+        |n: &str| -> PolarsResult<StringChunked> { Ok(samples.column(n)?.str()?.clone()) };
+    let f64_col =
+        |n: &str| -> PolarsResult<Float64Chunked> { Ok(samples.column(n)?.f64()?.clone()) };
     let (ch, eff, clip) = (
-        strs(samples, "character_id")?,
-        strs(samples, "effector")?,
-        strs(samples, "clip")?,
+        str_col("character_id")?,
+        str_col("effector")?,
+        str_col("clip")?,
     );
-    let frame = i64s(samples, "frame")?;
-    let xyz = [
-        f64s(samples, "x")?,
-        f64s(samples, "y")?,
-        f64s(samples, "z")?,
-    ];
+    let frame = samples.column("frame")?.i64()?.clone();
+    let (x, y, z) = (f64_col("x")?, f64_col("y")?, f64_col("z")?);
     let mut groups = Groups::new();
-    for i in 0..samples.height() {
-        let (Some(c), Some(e), Some(k), Some(f)) = (&ch[i], &eff[i], &clip[i], frame[i]) else {
+    // One shared name per run of a clip's samples (memory: a pointer per sample).
+    let mut last_clip: Option<Arc<str>> = None;
+    let mut group: Option<((String, String), Vec<Sample>)> = None;
+    let rows = ch
+        .iter()
+        .zip(eff.iter())
+        .zip(clip.iter())
+        .zip(frame.iter())
+        .zip(x.iter().zip(y.iter()).zip(z.iter()));
+    for ((((c, e), k), f), ((x, y), z)) in rows {
+        let (Some(c), Some(e), Some(k), Some(f), Some(x), Some(y), Some(z)) = (c, e, k, f, x, y, z)
+        else {
             continue;
         };
-        let (Some(x), Some(y), Some(z)) = (xyz[0][i], xyz[1][i], xyz[2][i]) else {
-            continue;
+        let name = match &last_clip {
+            Some(l) if &**l == k => l.clone(),
+            _ => {
+                let l: Arc<str> = Arc::from(k);
+                last_clip = Some(l.clone());
+                l
+            }
         };
-        groups
-            .entry((c.clone(), e.clone()))
-            .or_default()
-            .push(Sample {
-                clip: k.clone(),
+        if group
+            .as_ref()
+            .is_none_or(|(key, _)| key.0 != c || key.1 != e)
+        {
+            if let Some((key, g)) = group.take() {
+                groups.entry(key).or_default().extend(g);
+            }
+            group = Some(((c.to_string(), e.to_string()), Vec::new()));
+        }
+        if let Some((_, g)) = group.as_mut() {
+            g.push(Sample {
+                clip: name,
                 frame: f,
                 rc: [x, y, z],
             });
+        }
+    }
+    if let Some((key, g)) = group.take() {
+        groups.entry(key).or_default().extend(g);
     }
     Ok(groups)
 }
@@ -288,7 +315,7 @@ pub fn kinematics_from_samples(
         ),
         col(
             "clip",
-            rows.iter().map(|(_, s)| s.clip.clone()).collect::<Vec<_>>(),
+            rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
         ),
         col(
             "frame",
