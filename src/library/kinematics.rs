@@ -166,7 +166,7 @@ pub const SAMPLES_SORT_KEYS: [&str; 4] = ["character_id", "effector", "clip", "f
 
 /// Samples grouped by (character, effector), in (clip, frame) order, from a samples table
 /// sorted by [`SAMPLES_SORT_KEYS`].
-fn groups_of(samples: &DataFrame) -> PolarsResult<Groups> {
+fn add_groups(groups: &mut Groups, samples: &DataFrame) -> PolarsResult<()> {
     let str_col =
         |n: &str| -> PolarsResult<StringChunked> { Ok(samples.column(n)?.str()?.clone()) };
     let f64_col =
@@ -178,7 +178,6 @@ fn groups_of(samples: &DataFrame) -> PolarsResult<Groups> {
     );
     let frame = samples.column("frame")?.i64()?.clone();
     let (x, y, z) = (f64_col("x")?, f64_col("y")?, f64_col("z")?);
-    let mut groups = Groups::new();
     // One shared name per run of a clip's samples (memory: a pointer per sample).
     let mut last_clip: Option<Arc<str>> = None;
     let mut group: Option<((String, String), Vec<Sample>)> = None;
@@ -221,7 +220,88 @@ fn groups_of(samples: &DataFrame) -> PolarsResult<Groups> {
     if let Some((key, g)) = group.take() {
         groups.entry(key).or_default().extend(g);
     }
-    Ok(groups)
+    Ok(())
+}
+
+/// Kinematic samples kept across batches or shards, compactly (a shared clip name, the
+/// frame and the point: 48 bytes a sample), grouped by (character, effector).
+#[derive(Debug, Default)]
+pub struct SampleStore {
+    groups: Groups,
+}
+
+impl SampleStore {
+    /// Add the rows of a samples table (see [`samples_table`]; any order of batches).
+    ///
+    /// # Errors
+    /// The table lacks a column or has it with another type.
+    pub fn add(&mut self, samples: &DataFrame) -> PolarsResult<()> {
+        add_groups(&mut self.groups, samples)
+    }
+
+    /// Samples held.
+    pub fn len(&self) -> usize {
+        self.groups.values().map(Vec::len).sum()
+    }
+
+    /// No samples held.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Each group in (clip, frame) order (stable: rows of one clip and frame keep theirs).
+    fn sort(&mut self) {
+        for g in self.groups.values_mut() {
+            g.sort_by(|a, b| (&a.clip, a.frame).cmp(&(&b.clip, b.frame)));
+        }
+    }
+
+    /// The samples table, sorted by [`SAMPLES_SORT_KEYS`] (a shard's summary).
+    ///
+    /// # Errors
+    /// A column cannot be built.
+    pub fn table(&mut self) -> PolarsResult<DataFrame> {
+        self.sort();
+        let rows: Vec<(&(String, String), &Sample)> = self
+            .groups
+            .iter()
+            .flat_map(|(k, g)| g.iter().map(move |s| (k, s)))
+            .collect();
+        let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
+        DataFrame::new_infer_height(vec![
+            col(
+                "character_id",
+                rows.iter().map(|(k, _)| k.0.as_str()).collect::<Vec<_>>(),
+            ),
+            col(
+                "effector",
+                rows.iter().map(|(k, _)| k.1.as_str()).collect::<Vec<_>>(),
+            ),
+            col(
+                "clip",
+                rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
+            ),
+            col(
+                "frame",
+                rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
+            ),
+            col("x", p(0)),
+            col("y", p(1)),
+            col("z", p(2)),
+        ])
+    }
+
+    /// The two kinematics tables (`(facets, points)`) with each character's leg length (m).
+    ///
+    /// # Errors
+    /// A column cannot be built.
+    pub fn kinematics(
+        mut self,
+        legs: &BTreeMap<String, f64>,
+    ) -> PolarsResult<(DataFrame, DataFrame)> {
+        self.sort();
+        kinematics_from_groups(&self.groups, legs)
+    }
 }
 
 /// The two kinematics tables of a library from its `frames`, `contacts` and `clips`
@@ -250,9 +330,17 @@ pub fn kinematics_from_samples(
     samples: &DataFrame,
     legs: &BTreeMap<String, f64>,
 ) -> PolarsResult<(DataFrame, DataFrame)> {
-    let groups = groups_of(samples)?;
+    let mut store = SampleStore::default();
+    store.add(samples)?;
+    store.kinematics(legs)
+}
+
+fn kinematics_from_groups(
+    groups: &Groups,
+    legs: &BTreeMap<String, f64>,
+) -> PolarsResult<(DataFrame, DataFrame)> {
     let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
-    for (key, g) in &groups {
+    for (key, g) in groups {
         let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
         let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
         let keep = inliers(&pts, leg);

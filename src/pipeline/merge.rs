@@ -238,7 +238,7 @@ pub fn merge_into(shards: &[PathBuf], out: &Path, rules: &OutputRules) -> Result
         let mut cursors: Vec<Vec<ClipCursor>> = Vec::new();
         for lib in &libs {
             sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
-            sink.push_samples(read_parquet(&lib.dir.join(KINEMATICS_SAMPLES_FILE))?);
+            sink.push_samples(&read_parquet(&lib.dir.join(KINEMATICS_SAMPLES_FILE))?)?;
             let names: Vec<&str> = sink.template().named().iter().map(|(n, _)| *n).collect();
             cursors.push(
                 names

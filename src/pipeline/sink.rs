@@ -23,7 +23,7 @@ use polars::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::library::kinematics::{
-    add_character_legs, kinematics_from_samples, samples_table, SAMPLES_SORT_KEYS,
+    add_character_legs, samples_table, SampleStore, SAMPLES_SORT_KEYS,
 };
 use crate::library::read::parquet_rows;
 use crate::library::schema::{
@@ -182,7 +182,7 @@ pub(crate) struct LibrarySink {
     writers: Vec<(&'static str, TableWriter)>,
     template: Tables,
     errors: Vec<DataFrame>,
-    samples: Vec<DataFrame>,
+    samples: SampleStore,
     legs: BTreeMap<String, f64>,
     stance_facts: Vec<StanceFacts>,
     clip_facts: BTreeMap<String, ClipFacts>,
@@ -213,7 +213,7 @@ impl LibrarySink {
             writers,
             template,
             errors: Vec::new(),
-            samples: Vec::new(),
+            samples: SampleStore::default(),
             legs: BTreeMap::new(),
             stance_facts: Vec::new(),
             clip_facts: BTreeMap::new(),
@@ -236,7 +236,9 @@ impl LibrarySink {
         if self.compute_samples {
             let s = samples_table(&t.frames, &t.contacts, &t.clips)
                 .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
-            self.samples.push(s);
+            self.samples
+                .add(&s)
+                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
         }
         add_character_legs(&mut self.legs, &t.clips).map_err(|e| pe(CLIPS_FILE, e))?;
         self.stance_facts.extend(stance_facts(&t.stances));
@@ -276,8 +278,10 @@ impl LibrarySink {
     }
 
     /// Add kinematic samples (any order; sorted at the end).
-    pub fn push_samples(&mut self, df: DataFrame) {
-        self.samples.push(df);
+    pub fn push_samples(&mut self, df: &DataFrame) -> Result<()> {
+        self.samples
+            .add(df)
+            .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))
     }
 
     /// Write the remaining tables, the footers and `manifest.json`; `shard` is recorded in
@@ -310,25 +314,19 @@ impl LibrarySink {
             w.finish(&kv)?;
         }
         write_atomic(&dir, ERRORS_FILE, &mut errors, &kv)?;
-        let empty_samples = samples_table(
-            &self.template.frames,
-            &self.template.contacts,
-            &self.template.clips,
-        )
-        .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
-        let mut samples = concat(
-            std::mem::take(&mut self.samples),
-            &empty_samples,
-            KINEMATICS_SAMPLES_FILE,
-        )?;
-        let (mut facets, mut points) =
-            kinematics_from_samples(&samples, &self.legs).map_err(|e| pe(KINEMATICS_FILE, e))?;
+        let mut samples = std::mem::take(&mut self.samples);
+        if self.keep_samples {
+            let mut table = samples
+                .table()
+                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+            write_atomic(&dir, KINEMATICS_SAMPLES_FILE, &mut table, &kv)?;
+        }
+        let (mut facets, mut points) = samples
+            .kinematics(&self.legs)
+            .map_err(|e| pe(KINEMATICS_FILE, e))?;
         write_atomic(&dir, KINEMATICS_FILE, &mut facets, &kv)?;
         write_atomic(&dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
-        if self.keep_samples {
-            write_atomic(&dir, KINEMATICS_SAMPLES_FILE, &mut samples, &kv)?;
-        }
-        drop(samples);
+        drop((facets, points));
         let count = |s: &str| self.status.iter().filter(|v| *v == s).count();
         let mut manifest = serde_json::json!({
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
