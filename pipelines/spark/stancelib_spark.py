@@ -123,7 +123,8 @@ def main(argv):
     work = os.path.abspath(args.work or os.path.join(
         os.path.dirname(out), ".%s.shards" % os.path.basename(out)))
     os.makedirs(work, exist_ok=True)
-    inputs = [os.path.abspath(i) for i in args.inputs]
+    # As given: clips.parquet records each path as given (absolute paths on a cluster).
+    inputs = list(args.inputs)
     build_args = args.build_args + (["--incremental"] if args.incremental else [])
     specs = [(args.stancelib, inputs, work, i, count, args.threads, build_args)
              for i in range(1, count + 1)]
