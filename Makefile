@@ -1,7 +1,7 @@
 # stancelib: the two commands a newcomer needs are `make demo` and `make test`.
 CARGO ?= cargo
 
-.PHONY: demo test lint bench nightly build doc fixtures fuzz
+.PHONY: demo test lint bench nightly build doc fixtures fuzz spark-demo
 
 DEMO_EDITS = out/demo/edits
 RUN_CLIP = fixtures/bvh/run_120hz_m_yup.bvh
@@ -53,6 +53,14 @@ nightly:
 	$(CARGO) run --release -- run pipelines/nightly.toml
 
 build:
+
+## The bulk CMU set built by Apache Spark in local mode (8 shards on local[2], then merge) into
+## out/spark-demo/; needs Java 17 and `python3 -m pip install pyspark` (pipelines/spark/).
+STANCELIB_BIN ?= $${CARGO_TARGET_DIR:-target}/release/stancelib
+spark-demo:
+	$(CARGO) build --release
+	python3 pipelines/spark/stancelib_spark.py --master 'local[2]' --shards 8 \
+		--stancelib $(STANCELIB_BIN) --out out/spark-demo ../shared/data/bvh-bulk/cmu
 
 doc:
 	$(CARGO) doc --no-deps

@@ -26,6 +26,8 @@
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 //! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
 //! - `stances_truth`: stances of the fixtures against the generator's truth; Parquet round trip.
+//! - `scale`: issue 16 — streaming build (any batch size and thread count), `--shard I/N`
+//!   and `merge` equal to one build byte for byte, merge refusals, the Spark driver.
 //! - `safety_limits`: issue 11 items 6, 10, 11, 12: every documented work limit refused
 //!   before work (exit 2, field and limit named), pipelines validated before the library
 //!   is touched, no option accepted and ignored, duplicate JSON/TOML keys refused.
@@ -50,6 +52,7 @@ mod regression;
 mod safety_inputs;
 mod safety_limits;
 mod safety_outputs;
+mod scale;
 mod stances;
 mod stances_truth;
 mod twopac;

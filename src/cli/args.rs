@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 
+use crate::pipeline::shard::Shard;
 use crate::pipeline::spec::Overrides;
 use crate::query::feasibility::{check_mu, LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::map::Axis;
@@ -29,6 +30,8 @@ pub enum Command {
     Run(RunArgs),
     /// Build a stance library (stances, force models, constraint coefficients).
     Build(BuildArgs),
+    /// Join shard libraries (`build --shard I/N`) into one library.
+    Merge(MergeArgs),
     /// Write a generated clip with known ground truth (fixtures).
     Synth(SynthArgs),
     /// Scaled runs and jumps from a stance library.
@@ -420,12 +423,34 @@ pub struct BuildArgs {
     /// in it (never a file, nor a folder that holds or lies in an input).
     #[arg(long)]
     pub force: bool,
+    /// Build only the I-th of N shards of the inputs (by content hash), for `merge`.
+    #[arg(long, value_parser = parse_shard)]
+    pub shard: Option<Shard>,
     /// Body and contact options.
     #[command(flatten)]
     pub body: BodyArgs,
     /// Stance-stage options.
     #[command(flatten)]
     pub fit: FitArgs,
+}
+
+/// `I/N`.
+fn parse_shard(s: &str) -> Result<Shard, String> {
+    s.parse::<Shard>().map_err(|e| e.to_string())
+}
+
+/// `stancelib merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Shard libraries, one per shard of one build (any order).
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Library folder (the output rules of `build`; never one of the shards).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Replace an existing `--out` folder that is not a stancelib library (as `build`).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `stancelib run`.

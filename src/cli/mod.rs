@@ -25,6 +25,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Frames(a) => cmd::frames::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Build(a) => cmd::build::run(a),
+        Command::Merge(a) => cmd::build::run_merge(a),
         Command::Synth(a) => cmd::synth::run(a),
         Command::Query(QueryCommand::Run(a)) => cmd::query::run(a),
         Command::Query(QueryCommand::Jump(a)) => cmd::query::run_jump(a),

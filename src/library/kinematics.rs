@@ -10,6 +10,7 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use polars::prelude::*;
 
@@ -23,7 +24,7 @@ use crate::twopac::polytope::Polytope;
 /// One kinematic sample: the COM in an effector's contact frame at one frame.
 #[derive(Debug, Clone, PartialEq)]
 struct Sample {
-    clip: String,
+    clip: Arc<str>,
     frame: i64,
     rc: [f64; 3],
 }
@@ -70,27 +71,54 @@ fn com_by_frame(frames: &DataFrame) -> PolarsResult<BTreeMap<String, BTreeMap<i6
     Ok(out)
 }
 
-/// Samples grouped by (character, effector), in (clip, frame) order, with each
-/// character's leg length.
-fn samples(
-    frames: &DataFrame,
-    contacts: &DataFrame,
-    clips: &DataFrame,
-) -> PolarsResult<(Groups, BTreeMap<String, f64>)> {
-    let coms = com_by_frame(frames)?;
-    let (names, chars, legs) = (
+/// Each clip's character (`clip → character_id`) from a clips table, for the clips with a
+/// leg length (the others have no samples).
+fn characters(clips: &DataFrame) -> PolarsResult<BTreeMap<String, String>> {
+    let (names, chars) = (strs(clips, "clip")?, strs(clips, "character_id")?);
+    let legs = f64s(clips, "leg_length_m")?;
+    Ok(names
+        .into_iter()
+        .zip(chars)
+        .zip(legs)
+        .filter_map(|((n, c), l)| Some((n?, c?, l?)))
+        .map(|(n, c, _)| (n, c))
+        .collect())
+}
+
+/// Adds the leg length of each character not yet in `legs`, from a clips table in clip
+/// order: a character's leg length is that of its first clip (by name) that has one.
+///
+/// # Errors
+/// The table lacks `clip`, `character_id` or `leg_length_m`.
+pub fn add_character_legs(legs: &mut BTreeMap<String, f64>, clips: &DataFrame) -> PolarsResult<()> {
+    let (names, chars, lens) = (
         strs(clips, "clip")?,
         strs(clips, "character_id")?,
         f64s(clips, "leg_length_m")?,
     );
-    let mut character: BTreeMap<String, String> = BTreeMap::new();
-    let mut leg: BTreeMap<String, f64> = BTreeMap::new();
     for i in 0..clips.height() {
-        if let (Some(n), Some(c), Some(l)) = (&names[i], &chars[i], legs[i]) {
-            character.insert(n.clone(), c.clone());
-            leg.entry(c.clone()).or_insert(l);
+        if let (Some(_), Some(c), Some(l)) = (&names[i], &chars[i], lens[i]) {
+            legs.entry(c.clone()).or_insert(l);
         }
     }
+    Ok(())
+}
+
+/// The kinematic samples of whole clips: every contact frame's COM in its contact frame,
+/// before the outlier rules, one row per (character, effector, clip, frame) with
+/// `character_id`, `effector`, `clip`, `frame`, `x`, `y`, `z` (m), sorted by those four
+/// keys. This is the per-character summary a shard keeps (`kinematics_samples.parquet`):
+/// the polytopes of a merge are made from the shards' samples.
+///
+/// # Errors
+/// A table lacks a needed column or has it with another type.
+pub fn samples_table(
+    frames: &DataFrame,
+    contacts: &DataFrame,
+    clips: &DataFrame,
+) -> PolarsResult<DataFrame> {
+    let coms = com_by_frame(frames)?;
+    let character = characters(clips)?;
     let (clip, eff) = (strs(contacts, "clip")?, strs(contacts, "effector")?);
     let (first, last) = (
         i64s(contacts, "first_frame")?,
@@ -102,7 +130,7 @@ fn samples(
         f64s(contacts, "origin_z")?,
     ];
     let yaw = f64s(contacts, "yaw_rad")?;
-    let mut groups = Groups::new();
+    let mut rows: Vec<(&str, &str, &str, i64, [f64; 3])> = Vec::new();
     for i in 0..contacts.height() {
         let (Some(c), Some(e), Some(a), Some(b), Some(y)) =
             (&clip[i], &eff[i], first[i], last[i], yaw[i])
@@ -115,19 +143,165 @@ fn samples(
         let (Some(ch), Some(com)) = (character.get(c), coms.get(c)) else {
             continue;
         };
-        let group = groups.entry((ch.clone(), e.clone())).or_default();
         for (&frame, &p) in com.range(a..=b) {
-            group.push(Sample {
-                clip: c.clone(),
-                frame,
-                rc: com_in_contact_frame(p, [ox, oy, oz], y),
+            rows.push((ch, e, c, frame, com_in_contact_frame(p, [ox, oy, oz], y)));
+        }
+    }
+    // Stable: rows of one key keep the contact table's order.
+    rows.sort_by(|x, y| (x.0, x.1, x.2, x.3).cmp(&(y.0, y.1, y.2, y.3)));
+    let p = |a: usize| -> Vec<f64> { rows.iter().map(|r| r.4[a]).collect() };
+    DataFrame::new_infer_height(vec![
+        col("character_id", rows.iter().map(|r| r.0).collect::<Vec<_>>()),
+        col("effector", rows.iter().map(|r| r.1).collect::<Vec<_>>()),
+        col("clip", rows.iter().map(|r| r.2).collect::<Vec<_>>()),
+        col("frame", rows.iter().map(|r| r.3).collect::<Vec<_>>()),
+        col("x", p(0)),
+        col("y", p(1)),
+        col("z", p(2)),
+    ])
+}
+
+/// Sort keys of a samples table (see [`samples_table`]).
+pub const SAMPLES_SORT_KEYS: [&str; 4] = ["character_id", "effector", "clip", "frame"];
+
+/// Samples grouped by (character, effector), in (clip, frame) order, from a samples table
+/// sorted by [`SAMPLES_SORT_KEYS`].
+fn add_groups(groups: &mut Groups, samples: &DataFrame) -> PolarsResult<()> {
+    let str_col =
+        |n: &str| -> PolarsResult<StringChunked> { Ok(samples.column(n)?.str()?.clone()) };
+    let f64_col =
+        |n: &str| -> PolarsResult<Float64Chunked> { Ok(samples.column(n)?.f64()?.clone()) };
+    let (ch, eff, clip) = (
+        str_col("character_id")?,
+        str_col("effector")?,
+        str_col("clip")?,
+    );
+    let frame = samples.column("frame")?.i64()?.clone();
+    let (x, y, z) = (f64_col("x")?, f64_col("y")?, f64_col("z")?);
+    // One shared name per run of a clip's samples (memory: a pointer per sample).
+    let mut last_clip: Option<Arc<str>> = None;
+    let mut group: Option<((String, String), Vec<Sample>)> = None;
+    let rows = ch
+        .iter()
+        .zip(eff.iter())
+        .zip(clip.iter())
+        .zip(frame.iter())
+        .zip(x.iter().zip(y.iter()).zip(z.iter()));
+    for ((((c, e), k), f), ((x, y), z)) in rows {
+        let (Some(c), Some(e), Some(k), Some(f), Some(x), Some(y), Some(z)) = (c, e, k, f, x, y, z)
+        else {
+            continue;
+        };
+        let name = match &last_clip {
+            Some(l) if &**l == k => l.clone(),
+            _ => {
+                let l: Arc<str> = Arc::from(k);
+                last_clip = Some(l.clone());
+                l
+            }
+        };
+        if group
+            .as_ref()
+            .is_none_or(|(key, _)| key.0 != c || key.1 != e)
+        {
+            if let Some((key, g)) = group.take() {
+                groups.entry(key).or_default().extend(g);
+            }
+            group = Some(((c.to_string(), e.to_string()), Vec::new()));
+        }
+        if let Some((_, g)) = group.as_mut() {
+            g.push(Sample {
+                clip: name,
+                frame: f,
+                rc: [x, y, z],
             });
         }
     }
-    for g in groups.values_mut() {
-        g.sort_by(|x, y| (&x.clip, x.frame).cmp(&(&y.clip, y.frame)));
+    if let Some((key, g)) = group.take() {
+        groups.entry(key).or_default().extend(g);
     }
-    Ok((groups, leg))
+    Ok(())
+}
+
+/// Kinematic samples kept across batches or shards, compactly (a shared clip name, the
+/// frame and the point: 48 bytes a sample), grouped by (character, effector).
+#[derive(Debug, Default)]
+pub struct SampleStore {
+    groups: Groups,
+}
+
+impl SampleStore {
+    /// Add the rows of a samples table (see [`samples_table`]; any order of batches).
+    ///
+    /// # Errors
+    /// The table lacks a column or has it with another type.
+    pub fn add(&mut self, samples: &DataFrame) -> PolarsResult<()> {
+        add_groups(&mut self.groups, samples)
+    }
+
+    /// Samples held.
+    pub fn len(&self) -> usize {
+        self.groups.values().map(Vec::len).sum()
+    }
+
+    /// No samples held.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Each group in (clip, frame) order (stable: rows of one clip and frame keep theirs).
+    fn sort(&mut self) {
+        for g in self.groups.values_mut() {
+            g.sort_by(|a, b| (&a.clip, a.frame).cmp(&(&b.clip, b.frame)));
+        }
+    }
+
+    /// The samples table, sorted by [`SAMPLES_SORT_KEYS`] (a shard's summary).
+    ///
+    /// # Errors
+    /// A column cannot be built.
+    pub fn table(&mut self) -> PolarsResult<DataFrame> {
+        self.sort();
+        let rows: Vec<(&(String, String), &Sample)> = self
+            .groups
+            .iter()
+            .flat_map(|(k, g)| g.iter().map(move |s| (k, s)))
+            .collect();
+        let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
+        DataFrame::new_infer_height(vec![
+            col(
+                "character_id",
+                rows.iter().map(|(k, _)| k.0.as_str()).collect::<Vec<_>>(),
+            ),
+            col(
+                "effector",
+                rows.iter().map(|(k, _)| k.1.as_str()).collect::<Vec<_>>(),
+            ),
+            col(
+                "clip",
+                rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
+            ),
+            col(
+                "frame",
+                rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
+            ),
+            col("x", p(0)),
+            col("y", p(1)),
+            col("z", p(2)),
+        ])
+    }
+
+    /// The two kinematics tables (`(facets, points)`) with each character's leg length (m).
+    ///
+    /// # Errors
+    /// A column cannot be built.
+    pub fn kinematics(
+        mut self,
+        legs: &BTreeMap<String, f64>,
+    ) -> PolarsResult<(DataFrame, DataFrame)> {
+        self.sort();
+        kinematics_from_groups(&self.groups, legs)
+    }
 }
 
 /// The two kinematics tables of a library from its `frames`, `contacts` and `clips`
@@ -141,9 +315,32 @@ pub fn kinematics_tables(
     contacts: &DataFrame,
     clips: &DataFrame,
 ) -> PolarsResult<(DataFrame, DataFrame)> {
-    let (groups, legs) = samples(frames, contacts, clips)?;
+    let samples = samples_table(frames, contacts, clips)?;
+    let mut legs = BTreeMap::new();
+    add_character_legs(&mut legs, clips)?;
+    kinematics_from_samples(&samples, &legs)
+}
+
+/// The two kinematics tables (`(facets, points)`) from a samples table sorted by
+/// [`SAMPLES_SORT_KEYS`] and each character's leg length (m).
+///
+/// # Errors
+/// The samples table lacks a column or has it with another type.
+pub fn kinematics_from_samples(
+    samples: &DataFrame,
+    legs: &BTreeMap<String, f64>,
+) -> PolarsResult<(DataFrame, DataFrame)> {
+    let mut store = SampleStore::default();
+    store.add(samples)?;
+    store.kinematics(legs)
+}
+
+fn kinematics_from_groups(
+    groups: &Groups,
+    legs: &BTreeMap<String, f64>,
+) -> PolarsResult<(DataFrame, DataFrame)> {
     let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
-    for (key, g) in &groups {
+    for (key, g) in groups {
         let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
         let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
         let keep = inliers(&pts, leg);
@@ -206,7 +403,7 @@ pub fn kinematics_tables(
         ),
         col(
             "clip",
-            rows.iter().map(|(_, s)| s.clip.clone()).collect::<Vec<_>>(),
+            rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
         ),
         col(
             "frame",

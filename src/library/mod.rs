@@ -14,6 +14,7 @@ pub mod read;
 pub mod schema;
 pub mod scratch;
 pub mod stances;
+pub mod stream;
 pub mod twopac;
 pub mod write;
 

@@ -27,6 +27,9 @@ pub const ERRORS_FILE: &str = "errors.parquet";
 pub const KINEMATICS_FILE: &str = "kinematics.parquet";
 /// Points behind the kinematic polytopes (two-pac §3).
 pub const KINEMATICS_POINTS_FILE: &str = "kinematics_points.parquet";
+/// The kinematic summary of a shard library (`build --shard`): every contact frame's COM
+/// in its contact frame before the outlier rules, from which `merge` makes the polytopes.
+pub const KINEMATICS_SAMPLES_FILE: &str = "kinematics_samples.parquet";
 /// Provenance of a library (JSON).
 pub const MANIFEST_FILE: &str = "manifest.json";
 /// Start of the manifest's `schema` value, `stancelib.library/<SCHEMA_VERSION>`: what makes

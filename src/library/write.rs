@@ -1,7 +1,8 @@
 //! Building the output tables from clip records and writing them atomically.
 //!
 //! Rows are sorted by stable keys (`clip`, then frame or effector) before writing, with
-//! fixed writer settings (zstd, statistics on, one row group per 64 Ki rows), so the files
+//! fixed writer settings (zstd, statistics on, row groups of exactly 64 Ki rows, the last
+//! one shorter: [`super::stream`]), so the files
 //! do not depend on thread count or input order.
 
 use std::path::Path;
@@ -11,7 +12,8 @@ use polars::prelude::*;
 use super::columns::col;
 
 use super::schema::*;
-use super::scratch::{remove_stale, scratch_name, Scratch};
+use super::scratch::{remove_stale, Scratch};
+use super::stream::TableWriter;
 use super::ClipRecord;
 use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
@@ -337,7 +339,9 @@ pub fn joints_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
 }
 
 /// Write a table to `dir/name` atomically: a temporary file in `dir`, then a rename, so a
-/// reader never sees a half-written file and an earlier file survives a failed write.
+/// reader never sees a half-written file and an earlier file survives a failed write. The
+/// layout is that of [`TableWriter`] (row groups of [`ROW_GROUP_ROWS`] rows), so a table
+/// written whole equals the same rows written in batches, byte for byte.
 ///
 /// # Errors
 /// The directory is not writable or the table cannot be encoded.
@@ -347,43 +351,9 @@ pub fn write_atomic(
     df: &mut DataFrame,
     kv: &[(String, String)],
 ) -> Result<()> {
-    let path = dir.join(name);
-    let tmp = dir.join(scratch_name(name, Scratch::Tmp));
-    let result = (|| {
-        let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, "cannot create", e))?;
-        ParquetWriter::new(file)
-            .with_compression(ParquetCompression::Zstd(None))
-            .with_statistics(StatisticsOptions::full())
-            .with_row_group_size(Some(ROW_GROUP_ROWS))
-            .set_parallel(false)
-            .with_key_value_metadata(Some(KeyValueMetadata::from_static(with_portable_schema(
-                df, kv,
-            ))))
-            .finish(df)
-            .map_err(|e| Error::io(&tmp, "cannot write parquet", e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, "cannot rename into place", e))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// `kv` preceded by an `ARROW:schema` entry of the oldest Arrow compatibility level
-/// (`large_string`, not `string_view`).
-///
-/// polars stores its newest Arrow types in the Parquet footer; pyarrow 26 then reads list
-/// columns as `list<string_view>`, which `to_pandas` (and `pandas.read_parquet`) cannot
-/// convert. The Parquet data pages are the same either way; only the type hint differs.
-fn with_portable_schema(df: &DataFrame, kv: &[(String, String)]) -> Vec<(String, String)> {
-    let schema = df.schema().to_arrow(CompatLevel::oldest());
-    let key = polars_parquet::write::schema_to_metadata_key(&schema);
-    let mut out = Vec::with_capacity(kv.len() + 1);
-    if let Some(v) = key.value {
-        out.push((key.key, v));
-    }
-    out.extend(kv.iter().cloned());
-    out
+    let mut w = TableWriter::create(dir, name, df)?;
+    w.push(df)?;
+    w.finish(kv)
 }
 
 /// The tables a `frames` run writes.

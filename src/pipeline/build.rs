@@ -1,42 +1,65 @@
 //! Building a stance library: ingest every clip, build its stances in parallel, compute the
-//! per-character limits, and write every table plus `manifest.json` into a temporary
-//! folder that replaces the library folder in one step.
+//! per-character limits and polytopes, and write every table plus `manifest.json` into a
+//! temporary folder that replaces the library folder in one step.
+//!
+//! The build streams: clips are taken in name order in batches of
+//! [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads, and each batch's rows are
+//! appended to the tables ([`super::sink`]) before the next batch is read, so memory
+//! depends on the largest clips and the thread count, not on the number of clips. The
+//! files are the same, byte for byte, whatever the batch size and thread count.
 //!
 //! With `incremental`, the rows of clips whose path, content hash and options are those
 //! of the previous library are taken from it instead of being rebuilt; the result is the
 //! same, byte for byte, as a full rebuild (rows are re-sorted by the same keys and cast to
 //! the same schema).
 //!
+//! With a [`Shard`], only the inputs of that shard are built, and the library also keeps
+//! its kinematic samples and a `shard` entry in its manifest for [`super::merge`].
+//!
 //! Layout of a library folder: `frames.parquet`, `contacts.parquet`, `clips.parquet`,
 //! `stances.parquet`, `errors.parquet`, `manifest.json` (spec stance-model §11).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+use indicatif::ProgressBar;
 use polars::prelude::*;
 use rayon::prelude::*;
 
-use super::batch::{file_sha256, ingest_named, progress};
+use super::batch::{file_sha256, ingest_file, progress};
 use super::names::clip_names;
 use super::output::{claim, name_of, parent_of, swap_into_place, OutputRules};
+use super::shard::{inputs_fingerprint, shard_of, Shard};
+use super::sink::{combine, pe, strings, ClipCursor, LibrarySink, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
-use crate::library::kinematics::kinematics_tables;
 use crate::library::read::read_parquet;
 use crate::library::schema::{
-    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, KINEMATICS_FILE,
-    KINEMATICS_POINTS_FILE, MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
+    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, MANIFEST_FILE, STANCES_FILE,
 };
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
-use crate::library::write::{
-    clips_table, contacts_table, frames_table, joints_table, write_atomic,
-};
+use crate::library::write::{clips_table, contacts_table, frames_table, joints_table};
 use crate::library::{ClipRecord, Status};
 use crate::stances::build::StanceNote;
-use crate::stances::limits::{limits, ClipFacts, Limits, StanceFacts};
 use crate::stances::{build_clip, Stance, StanceOptions};
+
+/// Clips per batch and worker thread of a streaming build: a batch holds at most this
+/// many clips per thread in memory (with their frames) before its rows are written.
+pub const DEFAULT_BATCH_CLIPS_PER_THREAD: usize = 4;
+
+/// How a build runs: none of it changes the rows of a clip.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct BuildPlan {
+    /// Reuse the rows of unchanged clips from the library at the output (`--incremental`).
+    pub incremental: bool,
+    /// Build only this shard of the inputs (`--shard I/N`).
+    pub shard: Option<Shard>,
+    /// Clips per batch; 0 = [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads.
+    pub batch_clips: usize,
+}
 
 /// Options of a library build.
 #[derive(serde::Serialize, Debug, Clone, PartialEq, Default)]
@@ -57,10 +80,10 @@ impl BuildOptions {
     }
 }
 
-/// What a build produced in memory (the rebuilt clips only, with `incremental`).
+/// What a build produced in memory (with [`build`]: every clip).
 #[derive(Debug)]
 pub struct BuildReport {
-    /// One record per rebuilt input file, sorted by clip.
+    /// One record per input file, sorted by clip.
     pub records: Vec<ClipRecord>,
     /// Every stance of those clips, sorted by (clip, first frame, label).
     pub stances: Vec<Stance>,
@@ -68,18 +91,64 @@ pub struct BuildReport {
     pub errors: Vec<ErrorRow>,
 }
 
+/// What a written build did.
+#[derive(Debug)]
+pub struct BuildSummary {
+    /// One record per rebuilt input file, sorted by clip, without its frames and contact
+    /// runs (those are in the library).
+    pub records: Vec<ClipRecord>,
+    /// Stances of the rebuilt clips.
+    pub stances: usize,
+    /// Clips whose rows came from the previous library (`incremental`).
+    pub reused: usize,
+}
+
 /// Ingest and build (pure apart from reading the input files).
 pub fn build(files: &[PathBuf], opts: &BuildOptions) -> BuildReport {
     let named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
-    build_named(&named, opts)
+    build_named(&named, opts, &Progress::hidden())
 }
 
-fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport {
-    let mut records = ingest_named(named, &opts.ingest);
-    let bar = progress(records.len(), "clips segmented and fitted");
-    let per_clip: Vec<(Vec<Stance>, Vec<StanceNote>)> = records
+/// The progress of a build: clips done of all, frames per second and an ETA.
+struct Progress {
+    bar: ProgressBar,
+    frames: AtomicU64,
+    t0: Instant,
+}
+
+impl Progress {
+    fn new(clips: usize) -> Progress {
+        Progress {
+            bar: progress(clips, "clips, {msg}, ETA {eta}"),
+            frames: AtomicU64::new(0),
+            t0: Instant::now(),
+        }
+    }
+
+    fn hidden() -> Progress {
+        let p = Progress::new(0);
+        p.bar
+            .set_draw_target(indicatif::ProgressDrawTarget::hidden());
+        p
+    }
+
+    fn done(&self, clips: u64, frames: u64) {
+        let all = self.frames.fetch_add(frames, Ordering::Relaxed) + frames;
+        let secs = self.t0.elapsed().as_secs_f64().max(1e-3);
+        self.bar
+            .set_message(format!("{:.0} frames/s", all as f64 / secs));
+        self.bar.inc(clips);
+    }
+}
+
+/// What the stance stage made of one clip: its stances and notes.
+type ClipStances = (Vec<Stance>, Vec<StanceNote>);
+
+fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions, bar: &Progress) -> BuildReport {
+    let mut per_clip: Vec<(ClipRecord, ClipStances)> = named
         .par_iter()
-        .map(|r| {
+        .map(|(path, clip)| {
+            let r = ingest_file(path, clip.clone(), &opts.ingest);
             let out = match (&r.frames, r.status) {
                 (Some(fr), Status::Ok) => build_clip(
                     &r.clip,
@@ -91,11 +160,12 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport 
                 ),
                 _ => (Vec::new(), Vec::new()),
             };
-            bar.inc(1);
-            out
+            bar.done(1, r.frames.as_ref().map_or(0, |f| f.frame.len() as u64));
+            (r, out)
         })
         .collect();
-    bar.finish_and_clear();
+    per_clip.sort_by(|a, b| a.0.clip.cmp(&b.0.clip));
+    let (mut records, per_clip): (Vec<ClipRecord>, Vec<ClipStances>) = per_clip.into_iter().unzip();
     let mut errors: Vec<ErrorRow> = records
         .iter()
         .filter(|r| r.status == Status::Error)
@@ -132,20 +202,6 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions) -> BuildReport 
     }
 }
 
-/// The tables of a library, in memory: five always, `joints.parquet` with `--joints`.
-struct Tables {
-    frames: DataFrame,
-    contacts: DataFrame,
-    clips: DataFrame,
-    stances: DataFrame,
-    errors: DataFrame,
-    joints: Option<DataFrame>,
-}
-
-fn pe(name: &str, e: PolarsError) -> Error {
-    Error::io(name, "cannot build table", e)
-}
-
 impl Tables {
     /// The tables of a build; `joints.parquet` too when the ingest kept joint positions
     /// (`--joints`: the same table as `frames --joints` writes).
@@ -161,52 +217,6 @@ impl Tables {
                 .transpose()?,
         })
     }
-
-    fn named(&mut self) -> Vec<(&'static str, &mut DataFrame)> {
-        let mut v = vec![
-            (FRAMES_FILE, &mut self.frames),
-            (CONTACTS_FILE, &mut self.contacts),
-            (CLIPS_FILE, &mut self.clips),
-            (STANCES_FILE, &mut self.stances),
-            (ERRORS_FILE, &mut self.errors),
-        ];
-        if let Some(j) = &mut self.joints {
-            v.push((JOINTS_FILE, j));
-        }
-        v
-    }
-}
-
-/// Sort keys per table (the order a full build writes).
-fn sort_keys(name: &str) -> &'static [&'static str] {
-    match name {
-        // Joint rows keep the skeleton's order within a frame (the sort is stable).
-        FRAMES_FILE | JOINTS_FILE => &["clip", "frame"],
-        CONTACTS_FILE => &["clip", "effector", "first_frame"],
-        CLIPS_FILE => &["clip"],
-        STANCES_FILE => &["clip", "first_frame", "label"],
-        _ => &["path", "stage", "message"],
-    }
-}
-
-fn strings(df: &DataFrame, col: &str) -> Vec<String> {
-    df.column(col)
-        .ok()
-        .and_then(|c| {
-            c.str().ok().map(|s| {
-                s.iter()
-                    .map(|v| v.unwrap_or_default().to_string())
-                    .collect()
-            })
-        })
-        .unwrap_or_default()
-}
-
-fn floats(df: &DataFrame, col: &str) -> Vec<Option<f64>> {
-    df.column(col)
-        .ok()
-        .and_then(|c| c.f64().ok().map(|s| s.iter().collect()))
-        .unwrap_or_default()
 }
 
 /// Clips of the previous library at `out` that can be reused for `named`.
@@ -243,95 +253,47 @@ fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTree
         .collect()
 }
 
-/// Rows of a previous table for the reused clips, cast to the fresh table's schema.
-fn previous_rows(
-    out: &Path,
-    name: &str,
-    reuse: &BTreeSet<String>,
-    schema_of: &DataFrame,
-) -> Result<DataFrame> {
-    let path = out.join(name);
+/// The previous library at the output, read forward in clip order for the reused clips.
+struct Previous {
+    cursors: Vec<(&'static str, ClipCursor)>,
+}
+
+impl Previous {
+    fn open(out: &Path, t: &mut Tables) -> Result<Previous> {
+        let cursors = t
+            .named()
+            .into_iter()
+            .map(|(name, _)| Ok((name, ClipCursor::open(&out.join(name))?)))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Previous { cursors })
+    }
+
+    /// Add the previous rows of the `reused` clips of a batch whose last clip is `last`.
+    fn add_rows(&mut self, t: &mut Tables, last: &str, reused: &BTreeSet<String>) -> Result<()> {
+        for ((name, df), (_, cur)) in t.named().into_iter().zip(self.cursors.iter_mut()) {
+            let keep = |c: &str| reused.contains(c);
+            if let Some(old) = cur.take_through(last, &keep)? {
+                *df = combine(df, old, name)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The error rows of the previous library for the reused clips.
+fn previous_errors(out: &Path, reuse: &BTreeSet<String>) -> Result<DataFrame> {
+    let path = out.join(ERRORS_FILE);
     let df = read_parquet(&path)?;
     let mask: BooleanChunked = strings(&df, "clip")
         .iter()
         .map(|c| reuse.contains(c))
         .collect();
-    let df = df
-        .filter(&mask)
-        .map_err(|e| Error::io(&path, "cannot filter previous rows", e))?;
-    let cols = schema_of
-        .columns()
-        .iter()
-        .map(|c| df.column(c.name()).and_then(|p| p.cast(c.dtype())))
-        .collect::<PolarsResult<Vec<Column>>>()
-        .map_err(|e| Error::io(&path, "previous library has another schema", e))?;
-    DataFrame::new_infer_height(cols)
-        .map_err(|e| Error::io(&path, "cannot rebuild previous rows", e))
-}
-
-fn merge(fresh: &DataFrame, old: DataFrame, name: &str) -> Result<DataFrame> {
-    let mut all = fresh.vstack(&old).map_err(|e| pe(name, e))?;
-    let keys: Vec<PlSmallStr> = sort_keys(name).iter().map(|k| (*k).into()).collect();
-    all = all
-        .sort(
-            keys,
-            SortMultipleOptions::default().with_maintain_order(true),
-        )
-        .map_err(|e| pe(name, e))?;
-    all.rechunk_mut();
-    Ok(all)
-}
-
-/// Per-character limits from the (merged) stance and clip tables.
-fn limits_of(t: &Tables) -> BTreeMap<String, Limits> {
-    let s = &t.stances;
-    let (clip, ch, b0, b1) = (
-        strings(s, "clip"),
-        strings(s, "character_id"),
-        strings(s, "boundary_start"),
-        strings(s, "boundary_end"),
-    );
-    let (m, fp, e0, e1) = (
-        floats(s, "mass_kg"),
-        floats(s, "f_peak"),
-        floats(s, "ext_min"),
-        floats(s, "ext_max"),
-    );
-    let facts: Vec<StanceFacts> = (0..s.height())
-        .map(|i| StanceFacts {
-            clip: clip[i].clone(),
-            character_id: ch[i].clone(),
-            mass_kg: m[i].unwrap_or(f64::NAN),
-            f_peak: fp[i].unwrap_or(0.0),
-            ext_min: e0[i].unwrap_or(f64::INFINITY),
-            ext_max: e1[i].unwrap_or(0.0),
-            unsupported: b0[i] == "unsupported" || b1[i] == "unsupported",
-        })
-        .collect();
-    let c = &t.clips;
-    let clips: BTreeMap<String, ClipFacts> = strings(c, "clip")
-        .into_iter()
-        .zip(
-            floats(c, "s_eff")
-                .into_iter()
-                .zip(floats(c, "leg_length_m")),
-        )
-        .map(|(k, (s_eff, leg))| {
-            (
-                k,
-                ClipFacts {
-                    s_eff,
-                    leg_m: leg.unwrap_or(1.0),
-                },
-            )
-        })
-        .collect();
-    limits(&facts, &clips)
+    df.filter(&mask)
+        .map_err(|e| Error::io(&path, "cannot filter previous rows", e))
 }
 
 /// Build the library for `files` into `out` (see the module docs) under the default
-/// [`OutputRules`] (no `--force`; `files` are the inputs); returns what was rebuilt in
-/// memory and the number of reused clips.
+/// [`OutputRules`] (no `--force`; `files` are the inputs).
 ///
 /// # Errors
 /// As [`build_into`].
@@ -340,13 +302,16 @@ pub fn build_and_write(
     out: &Path,
     opts: &BuildOptions,
     incremental: bool,
-) -> Result<(BuildReport, usize)> {
-    build_into(files, out, opts, incremental, &OutputRules::default())
+) -> Result<BuildSummary> {
+    let plan = BuildPlan {
+        incremental,
+        ..BuildPlan::default()
+    };
+    build_into(files, out, opts, &plan, &OutputRules::default())
 }
 
 /// Build the library for `files` into `out` under `rules` (the output policy of
-/// [`super::output`]: `out` is checked and locked before any work); returns what was
-/// rebuilt in memory and the number of reused clips.
+/// [`super::output`]: `out` is checked and locked before any work), as `plan` says.
 ///
 /// # Errors
 /// An `out` the output policy refuses or another build holds, a table that cannot be
@@ -355,34 +320,74 @@ pub fn build_into(
     files: &[PathBuf],
     out: &Path,
     opts: &BuildOptions,
-    incremental: bool,
+    plan: &BuildPlan,
     rules: &OutputRules,
-) -> Result<(BuildReport, usize)> {
+) -> Result<BuildSummary> {
     let _claim = claim(out, files, rules)?;
     let t0 = Instant::now();
-    let named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
+    let mut named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
+    let shard_entry = plan.shard.map(|s| {
+        serde_json::json!({
+            "index": s.index, "count": s.count, "inputs_sha256": inputs_fingerprint(&named),
+        })
+    });
+    if let Some(s) = plan.shard {
+        named = named
+            .into_par_iter()
+            .filter(|(p, _)| shard_of(p, s.count) == s.index)
+            .collect();
+    }
+    named.sort_by(|a, b| a.1.cmp(&b.1));
     let fingerprint = opts.fingerprint();
-    let reuse = if incremental {
+    let reuse = if plan.incremental {
         reusable(out, &named, &fingerprint)
     } else {
         BTreeSet::new()
     };
-    let todo: Vec<(PathBuf, String)> = named
-        .iter()
-        .filter(|(_, c)| !reuse.contains(c))
-        .cloned()
-        .collect();
-    let report = build_named(&todo, opts);
-    let mut tables = Tables::from_report(&report, opts.ingest.joints)?;
-    if !reuse.is_empty() {
-        for (name, df) in tables.named() {
-            let old = previous_rows(out, name, &reuse, df)?;
-            *df = merge(df, old, name)?;
+    let batch = match plan.batch_clips {
+        0 => DEFAULT_BATCH_CLIPS_PER_THREAD * rayon::current_num_threads().max(1),
+        n => n,
+    };
+    let bar = Progress::new(named.len() - reuse.len());
+    let mut summary = BuildSummary {
+        records: Vec::new(),
+        stances: 0,
+        reused: reuse.len(),
+    };
+    replace_library(out, |tmp| {
+        let joints = opts.ingest.joints;
+        let mut sink = LibrarySink::create(tmp, joints, true, plan.shard.is_some())?;
+        let mut prev = if reuse.is_empty() {
+            None
+        } else {
+            sink.push_errors(previous_errors(out, &reuse)?);
+            Some(Previous::open(out, sink.template())?)
+        };
+        for chunk in named.chunks(batch) {
+            let todo: Vec<(PathBuf, String)> = chunk
+                .iter()
+                .filter(|(_, c)| !reuse.contains(c))
+                .cloned()
+                .collect();
+            let report = build_named(&todo, opts, &bar);
+            let mut t = Tables::from_report(&report, joints)?;
+            if let (Some(prev), Some((_, last))) = (prev.as_mut(), chunk.last()) {
+                prev.add_rows(&mut t, last, &reuse)?;
+            }
+            sink.push(&mut t)?;
+            summary.stances += report.stances.len();
+            summary
+                .records
+                .extend(report.records.into_iter().map(|mut r| {
+                    r.frames = None;
+                    r.contacts = Vec::new();
+                    r
+                }));
         }
-    }
-    let lim = limits_of(&tables);
-    replace_library(out, &mut tables, &lim, &fingerprint, t0)?;
-    Ok((report, reuse.len()))
+        bar.bar.finish_and_clear();
+        sink.finish(&fingerprint, t0, shard_entry.clone())
+    })?;
+    Ok(summary)
 }
 
 /// Write an in-memory build as the library at `out` (a full build; see [`build_and_write`]),
@@ -397,90 +402,24 @@ pub fn write_library(out: &Path, report: &BuildReport, opts: &BuildOptions) -> R
         .map(|r| PathBuf::from(&r.path))
         .collect();
     let _claim = claim(out, &files, &OutputRules::default())?;
-    let mut tables = Tables::from_report(report, opts.ingest.joints)?;
-    let lim = limits_of(&tables);
-    replace_library(out, &mut tables, &lim, &opts.fingerprint(), Instant::now())
+    let t0 = Instant::now();
+    replace_library(out, |tmp| {
+        let mut sink = LibrarySink::create(tmp, opts.ingest.joints, true, false)?;
+        sink.push(&mut Tables::from_report(report, opts.ingest.joints)?)?;
+        sink.finish(&opts.fingerprint(), t0, None)
+    })
 }
 
-fn replace_library(
-    out: &Path,
-    t: &mut Tables,
-    lim: &BTreeMap<String, Limits>,
-    fingerprint: &str,
-    t0: Instant,
-) -> Result<()> {
+/// Write a library with `write` into a fresh temporary folder beside `out`, then swap it
+/// into place; the temporary folder is removed on failure. The caller holds the claim.
+pub(crate) fn replace_library(out: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     // The parent exists (the claim made it); a folder of this name is a dead process's.
     let tmp = parent_of(out).join(scratch_name(&name_of(out)?, Scratch::Tmp));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(|e| Error::io(&tmp, "cannot create folder", e))?;
-    let result =
-        write_tables(&tmp, t, lim, fingerprint, t0).and_then(|_| swap_into_place(&tmp, out));
+    let result = write(&tmp).and_then(|_| swap_into_place(&tmp, out));
     if result.is_err() {
         let _ = std::fs::remove_dir_all(&tmp);
     }
     result
-}
-
-fn write_tables(
-    dir: &Path,
-    t: &mut Tables,
-    lim: &BTreeMap<String, Limits>,
-    fingerprint: &str,
-    t0: Instant,
-) -> Result<()> {
-    let inputs: BTreeMap<String, String> = strings(&t.clips, "clip")
-        .into_iter()
-        .zip(strings(&t.clips, "content_sha256"))
-        .collect();
-    let json = |v: &dyn erased::Json| v.to_json();
-    let kv: Vec<(String, String)> = vec![
-        ("stancelib.schema_version".into(), SCHEMA_VERSION.into()),
-        (
-            "stancelib.tool_version".into(),
-            env!("CARGO_PKG_VERSION").into(),
-        ),
-        ("stancelib.options".into(), fingerprint.to_string()),
-        ("stancelib.inputs".into(), json(&inputs)),
-        ("stancelib.limits".into(), json(lim)),
-    ];
-    let status = strings(&t.clips, "status");
-    let count = |s: &str| status.iter().filter(|v| *v == s).count();
-    let (n_clips, n_stances) = (t.clips.height(), t.stances.height());
-    let failures = strings(&t.errors, "message");
-    for (name, df) in t.named() {
-        write_atomic(dir, name, df, &kv)?;
-    }
-    let (mut facets, mut points) =
-        kinematics_tables(&t.frames, &t.contacts, &t.clips).map_err(|e| pe(KINEMATICS_FILE, e))?;
-    write_atomic(dir, KINEMATICS_FILE, &mut facets, &kv)?;
-    write_atomic(dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
-    let manifest = serde_json::json!({
-        "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
-        "schema_version": SCHEMA_VERSION,
-        "tool_version": env!("CARGO_PKG_VERSION"),
-        "options": serde_json::from_str::<serde_json::Value>(fingerprint).unwrap_or_default(),
-        "inputs": inputs,
-        "limits": lim,
-        "counts": {
-            "clips": n_clips, "ok": count("ok"), "skipped": count("skipped"),
-            "failed": count("error"), "stances": n_stances,
-        },
-        "failures": failures,
-        "wall_time_s": t0.elapsed().as_secs_f64(),
-    });
-    let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
-    std::fs::write(dir.join(MANIFEST_FILE), text)
-        .map_err(|err| Error::io(dir.join(MANIFEST_FILE), "cannot write", err))
-}
-
-mod erased {
-    /// Serialize any `Serialize` value to compact JSON (deterministic for BTreeMaps).
-    pub trait Json {
-        fn to_json(&self) -> String;
-    }
-    impl<T: serde::Serialize> Json for T {
-        fn to_json(&self) -> String {
-            serde_json::to_string(self).unwrap_or_default()
-        }
-    }
 }

@@ -4,10 +4,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::super::args::BuildArgs;
+use super::super::args::{BuildArgs, MergeArgs};
 use super::super::Outcome;
 use crate::pipeline::batch::discover;
-use crate::pipeline::build::{build_into, BuildOptions};
+use crate::pipeline::build::{build_into, BuildOptions, BuildPlan};
+use crate::pipeline::merge::merge_into;
 use crate::pipeline::output::OutputRules;
 use crate::pipeline::spec::{load_body, resolve, resolve_fit};
 
@@ -26,14 +27,45 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
         inputs: a.inputs.clone(),
         force: a.force,
     };
+    let plan = BuildPlan {
+        incremental: a.incremental,
+        shard: a.shard,
+        batch_clips: 0,
+    };
     execute(
         &discover(&a.inputs)?,
         &a.out,
         &opts,
         a.body.threads,
-        a.incremental,
+        &plan,
         &rules,
     )
+}
+
+/// Run `merge`.
+///
+/// # Errors
+/// A shard library that is missing, unfinished or of another build, or an `--out` the
+/// output policy refuses.
+pub fn run_merge(a: MergeArgs) -> anyhow::Result<Outcome> {
+    let rules = OutputRules {
+        inputs: a.shards.clone(),
+        force: a.force,
+    };
+    let s = merge_into(&a.shards, &a.out, &rules)
+        .with_context(|| format!("merging into {}", a.out.display()))?;
+    println!(
+        "{} shards merged: {} clips, {} failed; library in {}",
+        s.shards,
+        s.clips,
+        s.failed,
+        a.out.display()
+    );
+    Ok(match s.failed {
+        0 => Outcome::Clean,
+        f if f == s.clips => Outcome::AllFailed,
+        _ => Outcome::SomeFailed,
+    })
 }
 
 /// Build `files` into the library folder `out` under the output `rules`.
@@ -46,18 +78,17 @@ pub fn execute(
     out: &Path,
     opts: &BuildOptions,
     threads: usize,
-    incremental: bool,
+    plan: &BuildPlan,
     rules: &OutputRules,
 ) -> anyhow::Result<Outcome> {
-    let (report, reused) = super::frames::worker_pool(files, threads)?
-        .install(|| build_into(files, out, opts, incremental, rules))
+    let report = super::frames::worker_pool(files, threads)?
+        .install(|| build_into(files, out, opts, plan, rules))
         .with_context(|| format!("writing the library to {}", out.display()))?;
+    let reused = report.reused;
     let outcome = super::frames::report(&report.records, out);
-    println!(
-        "{} stances rebuilt, {reused} clips reused",
-        report.stances.len()
-    );
-    if reused > 0 && outcome == Outcome::AllFailed {
+    println!("{} stances rebuilt, {reused} clips reused", report.stances);
+    // A shard whose clips all failed is one part of a build: the merge decides.
+    if (reused > 0 || plan.shard.is_some()) && outcome == Outcome::AllFailed {
         return Ok(Outcome::SomeFailed);
     }
     Ok(outcome)

@@ -41,7 +41,11 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
         inputs,
         force: a.force,
     };
-    let outcome = super::build::execute(&files, &lib, &opts, threads, a.incremental, &rules)?;
+    let plan = crate::pipeline::build::BuildPlan {
+        incremental: a.incremental,
+        ..Default::default()
+    };
+    let outcome = super::build::execute(&files, &lib, &opts, threads, &plan, &rules)?;
     if let Some(q) = &pipe.queries {
         run_queries(q, pipe.constraints.as_ref(), &lib)
             .with_context(|| format!("{}: [queries]", a.pipeline.display()))?;

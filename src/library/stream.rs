@@ -1,0 +1,188 @@
+//! Writing a table in pieces: rows are appended batch by batch and leave memory as soon as
+//! a row group of [`ROW_GROUP_ROWS`] rows is full, so a table of any length is written with
+//! at most one row group held.
+//!
+//! # Layout
+//! ```text
+//! row groups: ROW_GROUP_ROWS rows each, the last one shorter (never empty unless the table is)
+//! footer:     ARROW:schema (oldest compatibility level), then the caller's key-value pairs
+//! ```
+//! The layout depends only on the rows and their order, never on how they were cut into
+//! batches, so a streaming build, a one-batch build and a merge of shards write the same
+//! bytes for the same rows. The key-value metadata is given at [`TableWriter::finish`], once
+//! everything it describes (the per-character limits) is known.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::*;
+use polars_parquet::write::KeyValue;
+
+use super::scratch::{scratch_name, Scratch};
+use super::write::ROW_GROUP_ROWS;
+use crate::error::{Error, Result};
+
+/// A Parquet table being written under a temporary name in its folder; renamed into place
+/// by [`TableWriter::finish`], removed when dropped unfinished.
+pub struct TableWriter {
+    path: PathBuf,
+    tmp: PathBuf,
+    schema: Schema,
+    writer: Option<polars::io::parquet::write::BatchedWriter<File>>,
+    pending: DataFrame,
+    rows: usize,
+}
+
+impl std::fmt::Debug for TableWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TableWriter")
+            .field("path", &self.path)
+            .field("rows", &self.rows)
+            .finish()
+    }
+}
+
+fn io(path: &Path, what: &str, e: impl std::error::Error + Send + Sync + 'static) -> Error {
+    Error::io(path, what, e)
+}
+
+impl TableWriter {
+    /// Start `dir/name` with the schema of `empty` (a table of the same kind, any rows).
+    ///
+    /// # Errors
+    /// The temporary file cannot be created.
+    pub fn create(dir: &Path, name: &str, empty: &DataFrame) -> Result<TableWriter> {
+        let path = dir.join(name);
+        let tmp = dir.join(scratch_name(name, Scratch::Tmp));
+        let file = File::create(&tmp).map_err(|e| io(&tmp, "cannot create", e))?;
+        let schema = empty.schema().as_ref().clone();
+        let writer = ParquetWriter::new(file)
+            .with_compression(ParquetCompression::Zstd(None))
+            .with_statistics(StatisticsOptions::full())
+            .set_parallel(false)
+            .batched(&schema)
+            .map_err(|e| io(&tmp, "cannot write parquet", e))?;
+        Ok(TableWriter {
+            path,
+            tmp,
+            pending: empty.clear(),
+            schema,
+            writer: Some(writer),
+            rows: 0,
+        })
+    }
+
+    /// Rows appended so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Append `df` (same columns; cast to the table's types, as rows read back from
+    /// Parquet may carry other string or list encodings); full row groups are written.
+    ///
+    /// # Errors
+    /// Columns missing or not castable, or a write that fails.
+    pub fn push(&mut self, df: &DataFrame) -> Result<()> {
+        if df.height() == 0 {
+            return Ok(());
+        }
+        let cols = self
+            .schema
+            .iter()
+            .map(|(name, dtype)| df.column(name).and_then(|c| c.cast(dtype)))
+            .collect::<PolarsResult<Vec<Column>>>()
+            .map_err(|e| io(&self.path, "rows of another schema", e))?;
+        let df = DataFrame::new_infer_height(cols).map_err(|e| io(&self.path, "bad rows", e))?;
+        self.rows += df.height();
+        self.pending
+            .vstack_mut(&df)
+            .map_err(|e| io(&self.path, "rows of another schema", e))?;
+        while self.pending.height() >= ROW_GROUP_ROWS {
+            let head = self.pending.slice(0, ROW_GROUP_ROWS);
+            self.write_group(head)?;
+            let rest = self.pending.slice(ROW_GROUP_ROWS as i64, usize::MAX);
+            self.pending = rest;
+        }
+        // Free the buffers of the rows just written (the remainder is copied once).
+        self.pending.rechunk_mut();
+        Ok(())
+    }
+
+    fn write_group(&mut self, mut group: DataFrame) -> Result<()> {
+        group.rechunk_mut();
+        let Some(w) = self.writer.as_mut() else {
+            return Ok(());
+        };
+        w.write_batch(&group)
+            .map_err(|e| io(&self.tmp, "cannot write parquet", e))
+    }
+
+    /// Write the last row group and the footer with `kv` (after an `ARROW:schema` entry of
+    /// the oldest Arrow compatibility level), then rename the file into place.
+    ///
+    /// The oldest level (`large_string`, not `string_view`): with polars' newest Arrow types
+    /// in the footer, pyarrow reads list columns as `list<string_view>`, which `to_pandas`
+    /// cannot convert. The data pages are the same either way; only the type hint differs.
+    ///
+    /// # Errors
+    /// A write or the rename fails (the temporary file is removed).
+    pub fn finish(mut self, kv: &[(String, String)]) -> Result<()> {
+        let rest = std::mem::replace(&mut self.pending, DataFrame::empty());
+        if rest.height() > 0 {
+            self.write_group(rest)?;
+        }
+        let arrow = Schema::from_iter(self.schema.iter().map(|(n, d)| (n.clone(), d.clone())))
+            .to_arrow(CompatLevel::oldest());
+        let key = polars_parquet::write::schema_to_metadata_key(&arrow);
+        let mut meta: Vec<KeyValue> = Vec::with_capacity(kv.len() + 1);
+        meta.push(key);
+        meta.extend(kv.iter().map(|(k, v)| KeyValue {
+            key: k.clone(),
+            value: Some(v.clone()),
+        }));
+        let Some(w) = self.writer.take() else {
+            return Ok(());
+        };
+        let ended = w
+            .get_writer()
+            .lock()
+            .map_err(|_| {
+                io(
+                    &self.tmp,
+                    "cannot write parquet",
+                    std::io::Error::other("writer poisoned"),
+                )
+            })?
+            .end(Some(meta))
+            .map(|_| ())
+            .map_err(|e| io(&self.tmp, "cannot write parquet", e));
+        drop(w);
+        if let Err(e) = ended {
+            let _ = std::fs::remove_file(&self.tmp);
+            return Err(e);
+        }
+        std::fs::rename(&self.tmp, &self.path)
+            .map_err(|e| io(&self.path, "cannot rename into place", e))
+    }
+}
+
+impl Drop for TableWriter {
+    fn drop(&mut self) {
+        if self.writer.is_some() {
+            self.writer = None;
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Read rows `offset .. offset + len` of a Parquet file (only the row groups they touch).
+///
+/// # Errors
+/// The file cannot be opened or read.
+pub fn read_rows(path: &Path, offset: usize, len: usize) -> Result<DataFrame> {
+    let f = File::open(path).map_err(|e| io(path, "cannot open", e))?;
+    ParquetReader::new(f)
+        .with_slice(Some((offset, len)))
+        .finish()
+        .map_err(|e| io(path, "cannot read parquet", e))
+}

@@ -1,0 +1,286 @@
+//! `stancelib merge`: shard libraries (`build --shard I/N`) joined into one library, the
+//! same byte for byte as a single `build` of all the inputs with the same options.
+//!
+//! # Model
+//! ```text
+//! check:  every shard is a finished shard library; same schema, tool version, options,
+//!         shard count and input list (manifest `shard.inputs_sha256`); indices 1..N once each
+//! rows:   per-clip tables read forward in clip order from every shard, a batch of clips
+//!         (about one row group of frames) at a time, sorted by the table's keys, appended
+//! limits: recomputed from the stance and clip facts of the merged rows
+//! polytopes: recomputed from the shards' kinematic samples (`kinematics_samples.parquet`)
+//! ```
+//! The output obeys the policy of [`super::output`] (the shards are its inputs: `--out`
+//! never is, holds or lies in one), is locked while written and swapped in at the end.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::build::replace_library;
+use super::output::{claim, is_library, OutputRules};
+use super::sink::{sorted, ClipCursor, LibrarySink, Tables};
+use crate::error::{Error, Result};
+use crate::library::read::read_parquet;
+use crate::library::schema::{
+    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, KINEMATICS_SAMPLES_FILE,
+    MANIFEST_FILE, STANCES_FILE,
+};
+use crate::library::write::ROW_GROUP_ROWS;
+
+/// What a merge wrote.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MergeSummary {
+    /// Shards merged.
+    pub shards: usize,
+    /// Clips of the library.
+    pub clips: usize,
+    /// Clips that failed (status `error`).
+    pub failed: usize,
+}
+
+/// One shard library, checked.
+struct ShardLib {
+    dir: PathBuf,
+    index: usize,
+    manifest: serde_json::Value,
+}
+
+fn bad(dir: &Path, why: impl std::fmt::Display) -> Error {
+    Error::config(
+        Some(dir.to_path_buf()),
+        None,
+        format!("shard library: {why}"),
+    )
+}
+
+/// Read and check one shard's manifest and files.
+fn open_shard(dir: &Path) -> Result<ShardLib> {
+    if !dir.is_dir() {
+        return Err(bad(
+            dir,
+            "not a folder (did the build of this shard fail or not run?)",
+        ));
+    }
+    if !is_library(dir) {
+        return Err(bad(
+            dir,
+            format!("no stancelib {MANIFEST_FILE}: the build of this shard did not finish"),
+        ));
+    }
+    let path = dir.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, "cannot read", e))?;
+    let manifest: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::config(Some(path.clone()), None, e.to_string()))?;
+    let Some(index) = manifest
+        .pointer("/shard/index")
+        .and_then(serde_json::Value::as_u64)
+    else {
+        return Err(bad(
+            dir,
+            "not a shard library (built without --shard I/N; its manifest has no shard)",
+        ));
+    };
+    let joints = manifest
+        .pointer("/options/ingest/joints")
+        .and_then(serde_json::Value::as_bool)
+        .unwrap_or(false);
+    let mut need = vec![
+        FRAMES_FILE,
+        CONTACTS_FILE,
+        CLIPS_FILE,
+        STANCES_FILE,
+        ERRORS_FILE,
+        KINEMATICS_SAMPLES_FILE,
+    ];
+    if joints {
+        need.push(JOINTS_FILE);
+    }
+    if let Some(missing) = need.iter().find(|f| !dir.join(f).is_file()) {
+        return Err(bad(dir, format!("{missing} is missing")));
+    }
+    Ok(ShardLib {
+        dir: dir.to_path_buf(),
+        index: index as usize,
+        manifest,
+    })
+}
+
+/// The manifest fields all shards of one build share.
+const SHARED_FIELDS: [&str; 6] = [
+    "/schema",
+    "/schema_version",
+    "/tool_version",
+    "/options",
+    "/shard/count",
+    "/shard/inputs_sha256",
+];
+
+/// Check the shards belong to one build and cover it; sorted by index.
+fn check_shards(mut libs: Vec<ShardLib>) -> Result<Vec<ShardLib>> {
+    let Some(first) = libs.first() else {
+        return Err(Error::config(None, None, "merge: no shard libraries given"));
+    };
+    for lib in &libs[1..] {
+        for field in SHARED_FIELDS {
+            let (a, b) = (first.manifest.pointer(field), lib.manifest.pointer(field));
+            if a != b {
+                let show = |v: Option<&serde_json::Value>| {
+                    let s = v.map_or("none".to_string(), |v| v.to_string());
+                    s.chars().take(120).collect::<String>()
+                };
+                return Err(bad(
+                    &lib.dir,
+                    format!(
+                        "{} is {} here but {} in {}: shards of different builds \
+                         (options, inputs or tool versions) are never merged",
+                        field.trim_start_matches('/'),
+                        show(b),
+                        show(a),
+                        first.dir.display()
+                    ),
+                ));
+            }
+        }
+    }
+    let count = first
+        .manifest
+        .pointer("/shard/count")
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or(0) as usize;
+    libs.sort_by_key(|l| l.index);
+    for w in libs.windows(2) {
+        if w[0].index == w[1].index {
+            return Err(bad(
+                &w[1].dir,
+                format!(
+                    "shard {}/{count} is given twice (also {})",
+                    w[1].index,
+                    w[0].dir.display()
+                ),
+            ));
+        }
+    }
+    let have: Vec<usize> = libs.iter().map(|l| l.index).collect();
+    let missing: Vec<String> = (1..=count)
+        .filter(|i| !have.contains(i))
+        .map(|i| format!("{i}/{count}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(Error::config(
+            None,
+            None,
+            format!(
+                "merge: shard {} missing: no library given for it (did its build fail?)",
+                missing.join(", ")
+            ),
+        ));
+    }
+    Ok(libs)
+}
+
+/// Clips in name order with their kept frame counts and shard, from the shards' clips.
+fn clip_plan(libs: &[ShardLib]) -> Result<Vec<(String, usize)>> {
+    let mut plan: BTreeMap<String, (usize, usize)> = BTreeMap::new();
+    for (k, lib) in libs.iter().enumerate() {
+        let path = lib.dir.join(CLIPS_FILE);
+        let df = read_parquet(&path)?;
+        let names = super::sink::strings(&df, "clip");
+        let frames: Vec<Option<i64>> = df
+            .column("frames_kept")
+            .and_then(|c| c.i64().map(|s| s.iter().collect()))
+            .map_err(|e| Error::io(&path, "column frames_kept", e))?;
+        for (c, f) in names.into_iter().zip(frames) {
+            if let Some((other, _)) = plan.get(&c) {
+                return Err(bad(
+                    &lib.dir,
+                    format!(
+                        "clip {c} is also in {}: shards overlap",
+                        libs[*other].dir.display()
+                    ),
+                ));
+            }
+            plan.insert(c, (k, f.unwrap_or(0).max(0) as usize));
+        }
+    }
+    Ok(plan.into_iter().map(|(c, (_, f))| (c, f)).collect())
+}
+
+/// Merge the shard libraries `shards` into the library `out` under `rules` (module docs).
+///
+/// # Errors
+/// A shard that is missing, unfinished or of another build (the error names it), an `out`
+/// the output policy refuses or another build holds, or a table that cannot be read or
+/// written.
+pub fn merge_into(shards: &[PathBuf], out: &Path, rules: &OutputRules) -> Result<MergeSummary> {
+    let libs = check_shards(
+        shards
+            .iter()
+            .map(|d| open_shard(d))
+            .collect::<Result<Vec<_>>>()?,
+    )?;
+    let _claim = claim(out, shards, rules)?;
+    let t0 = Instant::now();
+    let options = libs[0].manifest.get("options").cloned().unwrap_or_default();
+    let fingerprint = options.to_string();
+    let joints = options
+        .pointer("/ingest/joints")
+        .and_then(serde_json::Value::as_bool)
+        .unwrap_or(false);
+    let plan = clip_plan(&libs)?;
+    let mut summary = MergeSummary {
+        shards: libs.len(),
+        clips: plan.len(),
+        failed: 0,
+    };
+    replace_library(out, |tmp| {
+        let mut sink = LibrarySink::create(tmp, joints, false, false)?;
+        let mut cursors: Vec<Vec<ClipCursor>> = Vec::new();
+        for lib in &libs {
+            sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
+            sink.push_samples(&read_parquet(&lib.dir.join(KINEMATICS_SAMPLES_FILE))?)?;
+            let names: Vec<&str> = sink.template().named().iter().map(|(n, _)| *n).collect();
+            cursors.push(
+                names
+                    .iter()
+                    .map(|n| ClipCursor::open(&lib.dir.join(n)))
+                    .collect::<Result<Vec<_>>>()?,
+            );
+        }
+        let mut start = 0;
+        while start < plan.len() {
+            // A batch: clips until about one row group of frames.
+            let (mut end, mut frames) = (start, 0);
+            while end < plan.len() && (end == start || frames < ROW_GROUP_ROWS) {
+                frames += plan[end].1;
+                end += 1;
+            }
+            let last = plan[end - 1].0.clone();
+            let mut t = Tables::empty(joints)?;
+            for shard in cursors.iter_mut() {
+                for ((name, df), cur) in t.named().into_iter().zip(shard.iter_mut()) {
+                    if let Some(rows) = cur.take_through(&last, &|_| true)? {
+                        let rows = super::sink::cast_like(rows, df, name)?;
+                        df.vstack_mut(&rows)
+                            .map_err(|e| Error::io(name, "cannot stack rows", e))?;
+                    }
+                }
+            }
+            for (name, df) in t.named() {
+                *df = sorted(std::mem::take(df), name)?;
+            }
+            summary.failed += t
+                .clips
+                .column("status")
+                .and_then(|c| {
+                    c.str()
+                        .map(|s| s.iter().filter(|v| *v == Some("error")).count())
+                })
+                .unwrap_or(0);
+            sink.push(&mut t)?;
+            start = end;
+        }
+        sink.finish(&fingerprint, t0, None)
+    })?;
+    Ok(summary)
+}

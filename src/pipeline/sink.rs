@@ -1,0 +1,447 @@
+//! Writing a library batch by batch: the per-clip tables are appended as their rows come
+//! (clips in name order), and what the per-character quantities need is kept as compact
+//! summaries, so memory depends on the batch, not on the size of the library.
+//!
+//! # What is kept until the end
+//! ```text
+//! limits:      per stance  (clip, character_id, mass_kg, f_peak, ext_min, ext_max, unsupported)
+//!              per clip    (s_eff, leg_length_m)
+//! kinematics:  per contact frame (character_id, effector, clip, frame, x, y, z)   [samples]
+//!              per character (leg length of its first clip)
+//! manifest:    per clip (content hash, status); errors rows
+//! ```
+//! The samples are the kinematic summary a shard writes (`kinematics_samples.parquet`) and
+//! a merge reads back instead of the frames. Every table is sorted by its keys before it is
+//! appended (rows of one batch), and batches arrive in clip order, so the files are the
+//! same whatever the batch size, the thread count or the number of shards.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use polars::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::library::kinematics::{
+    add_character_legs, samples_table, SampleStore, SAMPLES_SORT_KEYS,
+};
+use crate::library::read::parquet_rows;
+use crate::library::schema::{
+    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, KINEMATICS_FILE,
+    KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX,
+    SCHEMA_VERSION, STANCES_FILE,
+};
+use crate::library::stances::{errors_table, stances_table};
+use crate::library::stream::{read_rows, TableWriter};
+use crate::library::write::{
+    clips_table, contacts_table, frames_table, joints_table, write_atomic, ROW_GROUP_ROWS,
+};
+use crate::stances::limits::{limits, ClipFacts, StanceFacts};
+
+pub(crate) fn pe(name: &str, e: PolarsError) -> Error {
+    Error::io(name, "cannot build table", e)
+}
+
+/// Sort keys per table (the order a full build writes).
+pub(crate) fn sort_keys(name: &str) -> &'static [&'static str] {
+    match name {
+        // Joint rows keep the skeleton's order within a frame (the sort is stable).
+        FRAMES_FILE | JOINTS_FILE => &["clip", "frame"],
+        CONTACTS_FILE => &["clip", "effector", "first_frame"],
+        CLIPS_FILE => &["clip"],
+        STANCES_FILE => &["clip", "first_frame", "label"],
+        KINEMATICS_SAMPLES_FILE => &SAMPLES_SORT_KEYS,
+        _ => &["path", "stage", "message"],
+    }
+}
+
+/// `df` sorted by the keys of table `name` (stable).
+pub(crate) fn sorted(df: DataFrame, name: &str) -> Result<DataFrame> {
+    if df.height() < 2 {
+        return Ok(df);
+    }
+    let keys: Vec<PlSmallStr> = sort_keys(name).iter().map(|k| (*k).into()).collect();
+    let mut all = df
+        .sort(
+            keys,
+            SortMultipleOptions::default().with_maintain_order(true),
+        )
+        .map_err(|e| pe(name, e))?;
+    all.rechunk_mut();
+    Ok(all)
+}
+
+/// `fresh` and `old` rows of one table, in the table's order.
+pub(crate) fn combine(fresh: &DataFrame, old: DataFrame, name: &str) -> Result<DataFrame> {
+    let old = cast_like(old, fresh, name)?;
+    let all = fresh.vstack(&old).map_err(|e| pe(name, e))?;
+    sorted(all, name)
+}
+
+/// `df`'s columns of `like`, cast to its types (rows read back from Parquet).
+pub(crate) fn cast_like(df: DataFrame, like: &DataFrame, name: &str) -> Result<DataFrame> {
+    let cols = like
+        .columns()
+        .iter()
+        .map(|c| df.column(c.name()).and_then(|p| p.cast(c.dtype())))
+        .collect::<PolarsResult<Vec<Column>>>()
+        .map_err(|e| Error::io(name, "rows of another schema", e))?;
+    DataFrame::new_infer_height(cols).map_err(|e| pe(name, e))
+}
+
+/// The per-clip tables of a library (or of one batch of its clips).
+pub(crate) struct Tables {
+    pub frames: DataFrame,
+    pub contacts: DataFrame,
+    pub clips: DataFrame,
+    pub stances: DataFrame,
+    pub errors: DataFrame,
+    pub joints: Option<DataFrame>,
+}
+
+impl Tables {
+    /// Empty tables (the schemas).
+    pub fn empty(joints: bool) -> Result<Tables> {
+        Ok(Tables {
+            frames: frames_table(&[]).map_err(|e| pe(FRAMES_FILE, e))?,
+            contacts: contacts_table(&[]).map_err(|e| pe(CONTACTS_FILE, e))?,
+            clips: clips_table(&[]).map_err(|e| pe(CLIPS_FILE, e))?,
+            stances: stances_table(&[]).map_err(|e| pe(STANCES_FILE, e))?,
+            errors: errors_table(&[]).map_err(|e| pe(ERRORS_FILE, e))?,
+            joints: joints
+                .then(|| joints_table(&[]).map_err(|e| pe(JOINTS_FILE, e)))
+                .transpose()?,
+        })
+    }
+
+    /// The tables sorted by clip first (every one but `errors.parquet`).
+    pub fn named(&mut self) -> Vec<(&'static str, &mut DataFrame)> {
+        let mut v = vec![
+            (FRAMES_FILE, &mut self.frames),
+            (CONTACTS_FILE, &mut self.contacts),
+            (CLIPS_FILE, &mut self.clips),
+            (STANCES_FILE, &mut self.stances),
+        ];
+        if let Some(j) = &mut self.joints {
+            v.push((JOINTS_FILE, j));
+        }
+        v
+    }
+}
+
+pub(crate) fn strings(df: &DataFrame, col: &str) -> Vec<String> {
+    df.column(col)
+        .ok()
+        .and_then(|c| {
+            c.str().ok().map(|s| {
+                s.iter()
+                    .map(|v| v.unwrap_or_default().to_string())
+                    .collect()
+            })
+        })
+        .unwrap_or_default()
+}
+
+fn floats(df: &DataFrame, col: &str) -> Vec<Option<f64>> {
+    df.column(col)
+        .ok()
+        .and_then(|c| c.f64().ok().map(|s| s.iter().collect()))
+        .unwrap_or_default()
+}
+
+/// The facts the limits need of the stances of a stance table.
+fn stance_facts(s: &DataFrame) -> Vec<StanceFacts> {
+    let (clip, ch, b0, b1) = (
+        strings(s, "clip"),
+        strings(s, "character_id"),
+        strings(s, "boundary_start"),
+        strings(s, "boundary_end"),
+    );
+    let (m, fp, e0, e1) = (
+        floats(s, "mass_kg"),
+        floats(s, "f_peak"),
+        floats(s, "ext_min"),
+        floats(s, "ext_max"),
+    );
+    (0..s.height())
+        .map(|i| StanceFacts {
+            clip: clip[i].clone(),
+            character_id: ch[i].clone(),
+            mass_kg: m[i].unwrap_or(f64::NAN),
+            f_peak: fp[i].unwrap_or(0.0),
+            ext_min: e0[i].unwrap_or(f64::INFINITY),
+            ext_max: e1[i].unwrap_or(0.0),
+            unsupported: b0[i] == "unsupported" || b1[i] == "unsupported",
+        })
+        .collect()
+}
+
+/// A library being written into a temporary folder (see the module docs).
+pub(crate) struct LibrarySink {
+    dir: PathBuf,
+    writers: Vec<(&'static str, TableWriter)>,
+    template: Tables,
+    errors: Vec<DataFrame>,
+    samples: SampleStore,
+    legs: BTreeMap<String, f64>,
+    stance_facts: Vec<StanceFacts>,
+    clip_facts: BTreeMap<String, ClipFacts>,
+    inputs: BTreeMap<String, String>,
+    status: Vec<String>,
+    n_stances: usize,
+    /// Samples come from the frames of each batch (a build), or are given (a merge).
+    compute_samples: bool,
+    /// Write the samples table too (a shard).
+    keep_samples: bool,
+}
+
+impl LibrarySink {
+    /// Start a library in `dir` (an empty folder).
+    pub fn create(
+        dir: &Path,
+        joints: bool,
+        compute_samples: bool,
+        keep_samples: bool,
+    ) -> Result<LibrarySink> {
+        let mut template = Tables::empty(joints)?;
+        let mut writers = Vec::new();
+        for (name, df) in template.named() {
+            writers.push((name, TableWriter::create(dir, name, df)?));
+        }
+        Ok(LibrarySink {
+            dir: dir.to_path_buf(),
+            writers,
+            template,
+            errors: Vec::new(),
+            samples: SampleStore::default(),
+            legs: BTreeMap::new(),
+            stance_facts: Vec::new(),
+            clip_facts: BTreeMap::new(),
+            inputs: BTreeMap::new(),
+            status: Vec::new(),
+            n_stances: 0,
+            compute_samples,
+            keep_samples,
+        })
+    }
+
+    /// The empty tables, for the schemas.
+    pub fn template(&mut self) -> &mut Tables {
+        &mut self.template
+    }
+
+    /// Append one batch: whole clips, each table sorted, every clip after those of the
+    /// batches before.
+    pub fn push(&mut self, t: &mut Tables) -> Result<()> {
+        if self.compute_samples {
+            let s = samples_table(&t.frames, &t.contacts, &t.clips)
+                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+            self.samples
+                .add(&s)
+                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+        }
+        add_character_legs(&mut self.legs, &t.clips).map_err(|e| pe(CLIPS_FILE, e))?;
+        self.stance_facts.extend(stance_facts(&t.stances));
+        let c = &t.clips;
+        for (k, (s_eff, leg)) in strings(c, "clip").into_iter().zip(
+            floats(c, "s_eff")
+                .into_iter()
+                .zip(floats(c, "leg_length_m")),
+        ) {
+            self.clip_facts.insert(
+                k,
+                ClipFacts {
+                    s_eff,
+                    leg_m: leg.unwrap_or(1.0),
+                },
+            );
+        }
+        self.inputs.extend(
+            strings(c, "clip")
+                .into_iter()
+                .zip(strings(c, "content_sha256")),
+        );
+        self.status.extend(strings(c, "status"));
+        self.n_stances += t.stances.height();
+        if t.errors.height() > 0 {
+            self.errors.push(std::mem::take(&mut t.errors));
+        }
+        for ((_, df), (_, w)) in t.named().into_iter().zip(self.writers.iter_mut()) {
+            w.push(df)?;
+        }
+        Ok(())
+    }
+
+    /// Add error rows (any order).
+    pub fn push_errors(&mut self, df: DataFrame) {
+        self.errors.push(df);
+    }
+
+    /// Add kinematic samples (any order; sorted at the end).
+    pub fn push_samples(&mut self, df: &DataFrame) -> Result<()> {
+        self.samples
+            .add(df)
+            .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))
+    }
+
+    /// Write the remaining tables, the footers and `manifest.json`; `shard` is recorded in
+    /// the manifest of a shard library.
+    pub fn finish(
+        mut self,
+        fingerprint: &str,
+        t0: Instant,
+        shard: Option<serde_json::Value>,
+    ) -> Result<()> {
+        let dir = self.dir.clone();
+        let mut errors = concat(
+            std::mem::take(&mut self.errors),
+            &self.template.errors,
+            ERRORS_FILE,
+        )?;
+        let lim = limits(&self.stance_facts, &self.clip_facts);
+        let json = |v: &dyn erased::Json| v.to_json();
+        let kv: Vec<(String, String)> = vec![
+            ("stancelib.schema_version".into(), SCHEMA_VERSION.into()),
+            (
+                "stancelib.tool_version".into(),
+                env!("CARGO_PKG_VERSION").into(),
+            ),
+            ("stancelib.options".into(), fingerprint.to_string()),
+            ("stancelib.inputs".into(), json(&self.inputs)),
+            ("stancelib.limits".into(), json(&lim)),
+        ];
+        for (_, w) in std::mem::take(&mut self.writers) {
+            w.finish(&kv)?;
+        }
+        write_atomic(&dir, ERRORS_FILE, &mut errors, &kv)?;
+        let mut samples = std::mem::take(&mut self.samples);
+        if self.keep_samples {
+            let mut table = samples
+                .table()
+                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+            write_atomic(&dir, KINEMATICS_SAMPLES_FILE, &mut table, &kv)?;
+        }
+        let (mut facets, mut points) = samples
+            .kinematics(&self.legs)
+            .map_err(|e| pe(KINEMATICS_FILE, e))?;
+        write_atomic(&dir, KINEMATICS_FILE, &mut facets, &kv)?;
+        write_atomic(&dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
+        drop((facets, points));
+        let count = |s: &str| self.status.iter().filter(|v| *v == s).count();
+        let mut manifest = serde_json::json!({
+            "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
+            "schema_version": SCHEMA_VERSION,
+            "tool_version": env!("CARGO_PKG_VERSION"),
+            "options": serde_json::from_str::<serde_json::Value>(fingerprint).unwrap_or_default(),
+            "inputs": self.inputs,
+            "limits": lim,
+            "counts": {
+                "clips": self.status.len(), "ok": count("ok"), "skipped": count("skipped"),
+                "failed": count("error"), "stances": self.n_stances,
+            },
+            "failures": strings(&errors, "message"),
+            "wall_time_s": t0.elapsed().as_secs_f64(),
+        });
+        if let (Some(s), Some(m)) = (shard, manifest.as_object_mut()) {
+            m.insert("shard".into(), s);
+        }
+        let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
+        std::fs::write(dir.join(MANIFEST_FILE), text)
+            .map_err(|err| Error::io(dir.join(MANIFEST_FILE), "cannot write", err))
+    }
+}
+
+/// `parts` stacked and sorted as table `name` (`empty` when there are none).
+fn concat(parts: Vec<DataFrame>, empty: &DataFrame, name: &str) -> Result<DataFrame> {
+    let mut all = empty.clear();
+    for p in parts {
+        let p = cast_like(p, empty, name)?;
+        all.vstack_mut(&p).map_err(|e| pe(name, e))?;
+    }
+    sorted(all, name)
+}
+
+/// A table sorted by clip, read forward in clip order: the rows of a range of clips at a
+/// time, never the whole file.
+pub(crate) struct ClipCursor {
+    path: PathBuf,
+    /// Consecutive rows per clip, in file order.
+    runs: Vec<(String, usize)>,
+    next: usize,
+    offset: usize,
+}
+
+impl ClipCursor {
+    /// Index the `clip` column of `path` (read a row group's worth at a time).
+    pub fn open(path: &Path) -> Result<ClipCursor> {
+        let total = parquet_rows(path)?;
+        let mut runs: Vec<(String, usize)> = Vec::new();
+        let mut at = 0;
+        while at < total {
+            let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
+            let df = ParquetReader::new(f)
+                .with_columns(Some(vec!["clip".into()]))
+                .with_slice(Some((at, ROW_GROUP_ROWS)))
+                .finish()
+                .map_err(|e| Error::io(path, "cannot read parquet", e))?;
+            if df.height() == 0 {
+                break;
+            }
+            at += df.height();
+            for c in strings(&df, "clip") {
+                match runs.last_mut() {
+                    Some((last, n)) if *last == c => *n += 1,
+                    _ => runs.push((c, 1)),
+                }
+            }
+        }
+        Ok(ClipCursor {
+            path: path.to_path_buf(),
+            runs,
+            next: 0,
+            offset: 0,
+        })
+    }
+
+    /// The rows of every clip not read yet up to and including `last` (by name), keeping
+    /// the clips `keep` accepts.
+    pub fn take_through(
+        &mut self,
+        last: &str,
+        keep: &dyn Fn(&str) -> bool,
+    ) -> Result<Option<DataFrame>> {
+        let start = self.offset;
+        let mut wanted: Vec<bool> = Vec::new();
+        while let Some((c, n)) = self.runs.get(self.next) {
+            if c.as_str() > last {
+                break;
+            }
+            wanted.extend(std::iter::repeat_n(keep(c), *n));
+            self.offset += n;
+            self.next += 1;
+        }
+        if wanted.iter().all(|w| !w) {
+            return Ok(None);
+        }
+        let df = read_rows(&self.path, start, self.offset - start)?;
+        if wanted.iter().all(|w| *w) {
+            return Ok(Some(df));
+        }
+        let mask: BooleanChunked = wanted.into_iter().collect();
+        df.filter(&mask)
+            .map(Some)
+            .map_err(|e| Error::io(&self.path, "cannot filter rows", e))
+    }
+}
+
+mod erased {
+    /// Serialize any `Serialize` value to compact JSON (deterministic for BTreeMaps).
+    pub trait Json {
+        fn to_json(&self) -> String;
+    }
+    impl<T: serde::Serialize> Json for T {
+        fn to_json(&self) -> String {
+            serde_json::to_string(self).unwrap_or_default()
+        }
+    }
+}

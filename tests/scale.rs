@@ -1,0 +1,506 @@
+//! Issue 16: the streaming build, `--shard I/N` and `merge`, and the Spark driver.
+//!
+//! Every comparison is byte for byte on the Parquet files of two libraries; the manifests
+//! must be equal apart from `wall_time_s`.
+
+use std::path::{Path, PathBuf};
+
+use stancelib::pipeline::build::{build, build_into, write_library, BuildOptions, BuildPlan};
+use stancelib::pipeline::output::OutputRules;
+use stancelib::pipeline::shard::{shard_of, Shard};
+
+use super::util::{root, shared_or_skip, stancelib};
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// Every fixture clip, the malformed ones of `fixtures/bvh/bad` too (their error rows
+/// must merge as well).
+fn fixture_inputs() -> Vec<PathBuf> {
+    stancelib::pipeline::batch::discover(&[root().join("fixtures/bvh")]).unwrap()
+}
+
+/// `n` real clips of the bulk CMU set (every `step`-th, so several subjects), or `None`
+/// (skipped outside CI) when the shared data is absent.
+fn real_subset(test: &str, n: usize) -> Option<Vec<PathBuf>> {
+    let data = shared_or_skip(test)?;
+    let all = stancelib::pipeline::batch::discover(&[data.join("bvh-bulk/cmu")]).unwrap();
+    let step = (all.len() / n).max(1);
+    Some(all.into_iter().step_by(step).take(n).collect())
+}
+
+/// The manifest without its wall time.
+fn manifest(lib: &Path) -> serde_json::Value {
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(lib.join("manifest.json")).unwrap()).unwrap();
+    m.as_object_mut().unwrap().remove("wall_time_s");
+    m
+}
+
+fn files_of(lib: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(lib)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Two libraries hold the same files with the same bytes (manifests: but the wall time).
+fn assert_same_library(a: &Path, b: &Path) {
+    assert_eq!(
+        files_of(a),
+        files_of(b),
+        "{} vs {}",
+        a.display(),
+        b.display()
+    );
+    for f in files_of(a) {
+        if f == "manifest.json" {
+            assert_eq!(manifest(a), manifest(b), "manifest of {}", b.display());
+            continue;
+        }
+        let (x, y) = (
+            std::fs::read(a.join(&f)).unwrap(),
+            std::fs::read(b.join(&f)).unwrap(),
+        );
+        assert!(x == y, "{f} differs: {} vs {}", a.display(), b.display());
+    }
+}
+
+/// `stancelib build` of `inputs` into `out` with `extra` options; the exit code.
+fn build_cli(inputs: &[PathBuf], out: &Path, extra: &[&str]) -> i32 {
+    let mut args: Vec<String> = vec!["build".into()];
+    args.extend(inputs.iter().map(|p| s(p)));
+    args.extend(["--out".into(), s(out)]);
+    args.extend(extra.iter().map(|e| e.to_string()));
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, err) = stancelib(&argv);
+    assert!(
+        code == 0 || code == 1,
+        "build {extra:?}: exit {code}\n{err}"
+    );
+    code
+}
+
+/// Build every shard of `n` into `dir/shard-I`, merge into `dir/merged`; the merged path.
+fn shard_and_merge(inputs: &[PathBuf], dir: &Path, n: usize, extra: &[&str]) -> PathBuf {
+    let mut shards = Vec::new();
+    for i in 1..=n {
+        let out = dir.join(format!("shard-{i}"));
+        let spec = format!("{i}/{n}");
+        let mut e: Vec<&str> = vec!["--shard", &spec];
+        e.extend(extra);
+        build_cli(inputs, &out, &e);
+        shards.push(s(&out));
+    }
+    let merged = dir.join("merged");
+    let mut args: Vec<&str> = vec!["merge"];
+    // Any order: the last shard first.
+    args.extend(shards.iter().rev().map(String::as_str));
+    let m = s(&merged);
+    args.extend(["--out", &m]);
+    let (code, out, err) = stancelib(&args);
+    assert!(
+        code == 0 || code == 1,
+        "merge of {n}: exit {code}\n{out}\n{err}"
+    );
+    merged
+}
+
+#[test]
+fn shards_merged_equal_the_single_build_for_1_3_and_7_shards() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let single = d.path().join("single");
+    assert_eq!(build_cli(&inputs, &single, &[]), 1, "the bad fixtures fail");
+    for n in [1, 3, 7] {
+        let dir = d.path().join(format!("n{n}"));
+        let merged = shard_and_merge(&inputs, &dir, n, &[]);
+        assert_same_library(&single, &merged);
+        // The shards hold every clip once between them.
+        let clips: usize = (1..=n)
+            .map(|i| {
+                manifest(&dir.join(format!("shard-{i}")))["counts"]["clips"]
+                    .as_u64()
+                    .unwrap()
+            })
+            .sum::<u64>() as usize;
+        assert_eq!(clips, inputs.len());
+    }
+}
+
+#[test]
+fn shards_merged_keep_joints_and_the_force_model() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let single = d.path().join("single");
+    let opts = ["--joints", "--force-model", "fourier"];
+    build_cli(&inputs, &single, &opts);
+    let merged = shard_and_merge(&inputs, &d.path().join("n3"), 3, &opts);
+    assert!(merged.join("joints.parquet").is_file());
+    assert_same_library(&single, &merged);
+}
+
+#[test]
+fn shards_of_real_clips_merge_to_the_single_build() {
+    let Some(inputs) = real_subset("shards_of_real_clips_merge_to_the_single_build", 9) else {
+        return;
+    };
+    let d = tmp();
+    let single = d.path().join("single");
+    build_cli(&inputs, &single, &[]);
+    let merged = shard_and_merge(&inputs, &d.path().join("n3"), 3, &[]);
+    assert_same_library(&single, &merged);
+    let m = manifest(&merged);
+    assert!(m["counts"]["stances"].as_u64().unwrap() > 0, "{m}");
+}
+
+/// A build written through the streaming sink with `batch` clips per batch on `threads`.
+fn streamed(files: &[PathBuf], out: &Path, batch: usize, threads: usize) {
+    let plan = BuildPlan {
+        batch_clips: batch,
+        ..BuildPlan::default()
+    };
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| {
+            build_into(
+                files,
+                out,
+                &BuildOptions::default(),
+                &plan,
+                &OutputRules::default(),
+            )
+        })
+        .unwrap();
+}
+
+#[test]
+fn a_streaming_build_does_not_depend_on_batch_size_or_threads() {
+    let mut files = fixture_inputs();
+    if let Some(real) = real_subset("a_streaming_build_does_not_depend_on_batch_size", 4) {
+        files.extend(real);
+    }
+    let d = tmp();
+    // The whole build in memory, written in one batch: the reference.
+    let whole = d.path().join("whole");
+    let opts = BuildOptions::default();
+    write_library(&whole, &build(&files, &opts), &opts).unwrap();
+    for (batch, threads) in [(1, 1), (2, 2), (3, 1), (1000, 2)] {
+        let out = d.path().join(format!("b{batch}-t{threads}"));
+        streamed(&files, &out, batch, threads);
+        assert_same_library(&whole, &out);
+    }
+}
+
+#[test]
+fn row_groups_hold_64_ki_rows_whatever_the_batches() {
+    // 150,000 rows pushed in uneven pieces: groups of 65,536, 65,536 and 18,928 rows.
+    use polars::prelude::*;
+    let d = tmp();
+    let df = |a: i64, b: i64| {
+        DataFrame::new_infer_height(vec![Column::new("v".into(), (a..b).collect::<Vec<i64>>())])
+            .unwrap()
+    };
+    let mut w =
+        stancelib::library::stream::TableWriter::create(d.path(), "t.parquet", &df(0, 0)).unwrap();
+    for (a, b) in [
+        (0, 1000),
+        (1000, 70_000),
+        (70_000, 70_001),
+        (70_001, 150_000),
+    ] {
+        w.push(&df(a, b)).unwrap();
+    }
+    w.finish(&[]).unwrap();
+    let mut whole = df(0, 150_000);
+    stancelib::library::write::write_atomic(d.path(), "u.parquet", &mut whole, &[]).unwrap();
+    let (x, y) = (
+        std::fs::read(d.path().join("t.parquet")).unwrap(),
+        std::fs::read(d.path().join("u.parquet")).unwrap(),
+    );
+    assert!(x == y, "streamed and whole writes differ");
+    let mut r = ParquetReader::new(std::fs::File::open(d.path().join("t.parquet")).unwrap());
+    let groups: Vec<usize> = r
+        .get_metadata()
+        .unwrap()
+        .row_groups
+        .iter()
+        .map(|g| g.num_rows())
+        .collect();
+    assert_eq!(groups, vec![65_536, 65_536, 18_928]);
+}
+
+#[test]
+fn a_file_s_shard_follows_its_content_not_its_name_or_neighbours() {
+    let d = tmp();
+    let src = root().join("fixtures/bvh/run_60hz_cm_zup.bvh");
+    let copy = d.path().join("another_name.bvh");
+    std::fs::copy(&src, &copy).unwrap();
+    for n in [2, 3, 7, 1000] {
+        assert_eq!(shard_of(&src, n), shard_of(&copy, n));
+    }
+    // Shard 1/2 of two fixtures holds the same clips with or without the others.
+    let fx = fixture_inputs();
+    let clips_of = |inputs: &[PathBuf], out: &Path| -> Vec<String> {
+        build_cli(inputs, out, &["--shard", "1/2"]);
+        let m = manifest(out);
+        m["inputs"].as_object().unwrap().keys().cloned().collect()
+    };
+    let all = clips_of(&fx, &d.path().join("all"));
+    let good: Vec<PathBuf> = fx
+        .iter()
+        .filter(|p| !p.starts_with(root().join("fixtures/bvh/bad")))
+        .cloned()
+        .collect();
+    let some = clips_of(&good, &d.path().join("some"));
+    let stems: Vec<String> = good
+        .iter()
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    let expected: Vec<String> = all.iter().filter(|c| stems.contains(c)).cloned().collect();
+    assert_eq!(some, expected);
+    assert!(all.len() > some.len(), "{all:?}");
+}
+
+/// `merge` of `shards` into `out`: (exit code, stderr).
+fn merge_cli(shards: &[&Path], out: &Path) -> (i32, String) {
+    let mut args: Vec<String> = vec!["merge".into()];
+    args.extend(shards.iter().map(|p| s(p)));
+    args.extend(["--out".into(), s(out)]);
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, err) = stancelib(&argv);
+    (code, err)
+}
+
+#[test]
+fn merge_refuses_shards_built_with_other_options_naming_the_shard() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let (a, b) = (d.path().join("a"), d.path().join("b"));
+    build_cli(&inputs, &a, &["--shard", "1/2"]);
+    build_cli(&inputs, &b, &["--shard", "2/2", "--mass", "80"]);
+    let out = d.path().join("merged");
+    let (code, err) = merge_cli(&[&a, &b], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("options") && err.contains(&s(&b)), "{err}");
+    assert!(!out.exists());
+    // Another tool version: the manifest says so (edited here to stand for an old build).
+    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    let path = b.join("manifest.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("\"tool_version\": \"", "\"tool_version\": \"0.0.0-"),
+    )
+    .unwrap();
+    let (code, err) = merge_cli(&[&a, &b], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("tool_version"), "{err}");
+    // Shards of different input lists never merge either.
+    build_cli(&inputs[1..], &b, &["--shard", "2/2"]);
+    let (code, err) = merge_cli(&[&a, &b], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("inputs_sha256"), "{err}");
+}
+
+#[test]
+fn merge_names_a_missing_or_failed_shard() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let (a, b, c) = (d.path().join("a"), d.path().join("b"), d.path().join("c"));
+    build_cli(&inputs, &a, &["--shard", "1/3"]);
+    build_cli(&inputs, &b, &["--shard", "2/3"]);
+    let out = d.path().join("merged");
+    // Shard 3 never ran.
+    let (code, err) = merge_cli(&[&a, &b], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("shard 3/3 missing"), "{err}");
+    // Shard 3's folder exists but its build died before writing the library.
+    std::fs::create_dir_all(&c).unwrap();
+    let (code, err) = merge_cli(&[&a, &b, &c], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&s(&c)) && err.contains("did not finish"),
+        "{err}"
+    );
+    // A library built without --shard is not a shard.
+    build_cli(&inputs, &c, &[]);
+    let (code, err) = merge_cli(&[&a, &b, &c], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&s(&c)) && err.contains("not a shard library"),
+        "{err}"
+    );
+    // A shard given twice.
+    let (code, err) = merge_cli(&[&a, &b, &b], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("given twice"), "{err}");
+    // A shard whose summary is gone.
+    build_cli(&inputs, &c, &["--shard", "3/3"]);
+    std::fs::remove_file(c.join("kinematics_samples.parquet")).unwrap();
+    let (code, err) = merge_cli(&[&a, &b, &c], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("kinematics_samples.parquet is missing") && err.contains(&s(&c)),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn merge_output_follows_the_build_output_rules() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let a = d.path().join("a");
+    build_cli(&inputs, &a, &["--shard", "1/1"]);
+    // --out naming a shard, or a folder inside one, is refused and the shard survives.
+    let before = std::fs::read(a.join("stances.parquet")).unwrap();
+    for out in [a.clone(), a.join("inner")] {
+        let (code, err) = merge_cli(&[&a], &out);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("input"), "{err}");
+    }
+    assert_eq!(std::fs::read(a.join("stances.parquet")).unwrap(), before);
+    // A folder that is not a library is refused.
+    let other = d.path().join("notes");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::write(other.join("keep.txt"), "mine").unwrap();
+    let (code, err) = merge_cli(&[&a], &other);
+    assert_eq!(code, 2, "{err}");
+    assert!(other.join("keep.txt").is_file());
+    // The shard's --shard parse errors name the option.
+    let (code, _, err) = stancelib(&[
+        "build",
+        &s(&inputs[0]),
+        "--out",
+        &s(&d.path().join("x")),
+        "--shard",
+        "4/3",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--shard"), "{err}");
+    let _ = Shard { index: 1, count: 1 };
+}
+
+/// Why the Spark driver cannot run here (no `java`, or no `pyspark` for `python3`).
+fn spark_missing() -> Option<String> {
+    let runs = |cmd: &str, args: &[&str]| {
+        std::process::Command::new(cmd)
+            .args(args)
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !runs("java", &["-version"]) {
+        return Some("java is not installed".into());
+    }
+    if !runs("python3", &["-c", "import pyspark"]) {
+        return Some("pyspark is not installed (python3 -m pip install pyspark)".into());
+    }
+    None
+}
+
+#[test]
+fn the_spark_driver_builds_the_single_run_library() {
+    if let Some(why) = spark_missing() {
+        // .ci/run installs both: there, a missing engine is a failure.
+        assert!(std::env::var("CI").is_err(), "CI: {why}");
+        eprintln!("SKIPPED the_spark_driver_builds_the_single_run_library: {why}");
+        return;
+    }
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let single = d.path().join("single");
+    build_cli(&inputs, &single, &["--joints"]);
+    let lib = d.path().join("spark-lib");
+    let o = std::process::Command::new("python3")
+        .arg(root().join("pipelines/spark/stancelib_spark.py"))
+        .args(["--master", "local[2]", "--shards", "3", "--stancelib"])
+        .arg(env!("CARGO_BIN_EXE_stancelib"))
+        .arg("--out")
+        .arg(&lib)
+        .arg(root().join("fixtures/bvh"))
+        .args(["--", "--joints"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    // Exit 1: the malformed fixtures fail, as in the single build.
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_same_library(&single, &lib);
+    // The shard libraries are removed after the merge; nothing else is left beside it.
+    let mut left = files_of(d.path());
+    left.sort();
+    assert_eq!(left, vec!["single", "spark-lib"]);
+}
+
+#[test]
+fn the_spark_driver_names_a_failed_shard_and_writes_nothing() {
+    if let Some(why) = spark_missing() {
+        assert!(std::env::var("CI").is_err(), "CI: {why}");
+        eprintln!("SKIPPED the_spark_driver_names_a_failed_shard_and_writes_nothing: {why}");
+        return;
+    }
+    let d = tmp();
+    let lib = d.path().join("lib");
+    // A bad build option: every shard's build exits 2 before any work.
+    let o = std::process::Command::new("python3")
+        .arg(root().join("pipelines/spark/stancelib_spark.py"))
+        .args(["--master", "local[1]", "--shards", "2", "--stancelib"])
+        .arg(env!("CARGO_BIN_EXE_stancelib"))
+        .arg("--out")
+        .arg(&lib)
+        .arg(root().join("fixtures/bvh"))
+        .args(["--", "--mass=-1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("shard 1/2 failed") && err.contains("--mass"),
+        "{err}"
+    );
+    assert!(!lib.exists());
+}
+
+#[test]
+fn an_incremental_shard_rebuilds_only_its_missing_clips() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let (part, full) = (d.path().join("part"), d.path().join("full"));
+    // The first run saw only some of the inputs (a crash, or files that came later).
+    let few: Vec<PathBuf> = inputs.iter().step_by(2).cloned().collect();
+    let first = |p: &Path| -> Vec<String> {
+        manifest(p)["inputs"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .cloned()
+            .collect()
+    };
+    build_cli(&few, &part, &["--shard", "1/2"]);
+    let had = first(&part).len();
+    let mut args: Vec<String> = vec!["build".into()];
+    args.extend(inputs.iter().map(|p| s(p)));
+    args.extend(["--out", &s(&part), "--shard", "1/2", "--incremental"].map(String::from));
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, out, err) = stancelib(&argv);
+    assert!(code <= 1, "{err}");
+    // Reused: the clips of the first run that did not fail (failed ones are retried).
+    let reused: usize = out
+        .split(" clips reused")
+        .next()
+        .and_then(|t| t.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(reused > 0 && reused <= had, "{out}");
+    build_cli(&inputs, &full, &["--shard", "1/2"]);
+    assert_same_library(&full, &part);
+}
