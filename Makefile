@@ -1,7 +1,7 @@
 # stancelib: the two commands a newcomer needs are `make demo` and `make test`.
 CARGO ?= cargo
 
-.PHONY: demo test lint bench nightly build doc fixtures fuzz
+.PHONY: demo test lint bench nightly build install doc fixtures fuzz
 
 ## Run the main job on the bundled fixtures (pipelines/demo.toml); tables go to out/demo/.
 demo:
@@ -27,18 +27,24 @@ fuzz:
 ## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances
 ## (library); candidate evaluations and the 200 × 200 jump map (queries); 2PAC H-rep,
 ## transition QP and 10-phase trajectory (twopac).
+## They run in the `profiling` profile (release code with line tables, for perf).
 bench:
-	$(CARGO) bench --bench stages
-	$(CARGO) bench --bench library
-	$(CARGO) bench --bench queries
-	$(CARGO) bench --bench twopac
+	$(CARGO) bench --profile profiling --bench stages
+	$(CARGO) bench --profile profiling --bench library
+	$(CARGO) bench --profile profiling --bench queries
+	$(CARGO) bench --profile profiling --bench twopac
 
 ## The nightly job over ../shared/data (pipelines/nightly.toml).
 nightly:
 	$(CARGO) run --release -- run pipelines/nightly.toml
 
+## The release binary: target/release/stancelib (or $$CARGO_TARGET_DIR/release/stancelib).
 build:
 	$(CARGO) build --release
+
+## Install the binary into ~/.cargo/bin (on the PATH of a rustup install).
+install:
+	$(CARGO) install --path . --locked
 
 doc:
 	$(CARGO) doc --no-deps
