@@ -370,19 +370,52 @@ pub fn write_atomic(
 }
 
 /// `kv` preceded by an `ARROW:schema` entry of the oldest Arrow compatibility level
-/// (`large_string`, not `string_view`).
+/// (`large_string`, not `string_view`) whose schema metadata is `kv` itself.
 ///
 /// polars stores its newest Arrow types in the Parquet footer; pyarrow 26 then reads list
 /// columns as `list<string_view>`, which `to_pandas` (and `pandas.read_parquet`) cannot
 /// convert. The Parquet data pages are the same either way; only the type hint differs.
+/// pyarrow takes `read_table(f).schema.metadata` from this Arrow schema, not from the
+/// file's key-value list, so the `stancelib.*` keys go into both.
 fn with_portable_schema(df: &DataFrame, kv: &[(String, String)]) -> Vec<(String, String)> {
+    use polars_arrow::io::ipc::write::{default_ipc_fields, schema_to_bytes};
     let schema = df.schema().to_arrow(CompatLevel::oldest());
-    let key = polars_parquet::write::schema_to_metadata_key(&schema);
+    let meta: polars_arrow::datatypes::Metadata = kv
+        .iter()
+        .map(|(k, v)| (PlSmallStr::from_str(k), PlSmallStr::from_str(v)))
+        .collect();
+    let ipc = schema_to_bytes(
+        &schema,
+        &default_ipc_fields(schema.iter_values()),
+        Some(&meta),
+    );
+    // The legacy IPC framing Arrow readers expect: continuation marker, length, message.
+    let mut framed = Vec::with_capacity(ipc.len() + 8);
+    framed.extend_from_slice(&[255, 255, 255, 255]);
+    framed.extend_from_slice(&(ipc.len() as u32).to_le_bytes());
+    framed.extend_from_slice(&ipc);
     let mut out = Vec::with_capacity(kv.len() + 1);
-    if let Some(v) = key.value {
-        out.push((key.key, v));
-    }
+    out.push(("ARROW:schema".to_string(), base64(&framed)));
     out.extend(kv.iter().cloned());
+    out
+}
+
+/// Standard base64 with padding (RFC 4648 §4), as the `ARROW:schema` value is written.
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for c in bytes.chunks(3) {
+        let n = (u32::from(c[0]) << 16)
+            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+            | u32::from(*c.get(2).unwrap_or(&0));
+        for (i, shift) in [18, 12, 6, 0].into_iter().enumerate() {
+            if i <= c.len() {
+                out.push(char::from(A[((n >> shift) & 63) as usize]));
+            } else {
+                out.push('=');
+            }
+        }
+    }
     out
 }
 
@@ -433,4 +466,23 @@ pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()>
         write_atomic(dir, name, df, &kv)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod base64_tests {
+    #[test]
+    fn base64_matches_rfc_4648_test_vectors() {
+        // RFC 4648 §10.
+        for (plain, coded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(super::base64(plain.as_bytes()), coded, "{plain}");
+        }
+    }
 }

@@ -53,10 +53,14 @@ pub fn execute(
         .install(|| build_into(files, out, opts, incremental, rules))
         .with_context(|| format!("writing the library to {}", out.display()))?;
     let outcome = super::frames::report(&report.records, out);
-    println!(
+    crate::say!(
         "{} stances rebuilt, {reused} clips reused",
         report.stances.len()
     );
+    let mut summary = super::frames::summary(&report.records, out, "build");
+    summary["stances_rebuilt"] = report.stances.len().into();
+    summary["clips_reused"] = reused.into();
+    crate::cli::summary_json(&summary);
     if reused > 0 && outcome == Outcome::AllFailed {
         return Ok(Outcome::SomeFailed);
     }

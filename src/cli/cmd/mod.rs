@@ -4,6 +4,7 @@ pub mod build;
 pub mod equilibrium;
 pub mod forces;
 pub mod frames;
+pub mod info;
 pub mod map;
 pub mod plot;
 pub mod query;
