@@ -1,7 +1,7 @@
 # stancelib: the two commands a newcomer needs are `make demo` and `make test`.
 CARGO ?= cargo
 
-.PHONY: demo test lint bench nightly build doc fixtures fuzz spark-demo
+.PHONY: demo test lint bench nightly build install doc fixtures fuzz spark-demo
 
 DEMO_EDITS = out/demo/edits
 RUN_CLIP = fixtures/bvh/run_120hz_m_yup.bvh
@@ -41,17 +41,19 @@ fuzz:
 ## Criterion benchmarks: parse, FK+COM, ingest (stages); full library build, 10k stances
 ## (library); candidate evaluations and the 200 × 200 jump map (queries); 2PAC H-rep,
 ## transition QP and 10-phase trajectory (twopac); 1 s of edited motion at 120 Hz (edit).
+## They run in the `profiling` profile (release code with line tables, for perf).
 bench:
-	$(CARGO) bench --bench stages
-	$(CARGO) bench --bench library
-	$(CARGO) bench --bench queries
-	$(CARGO) bench --bench twopac
-	$(CARGO) bench --bench edit
+	$(CARGO) bench --profile profiling --bench stages
+	$(CARGO) bench --profile profiling --bench library
+	$(CARGO) bench --profile profiling --bench queries
+	$(CARGO) bench --profile profiling --bench twopac
+	$(CARGO) bench --profile profiling --bench edit
 
 ## The nightly job over ../shared/data (pipelines/nightly.toml).
 nightly:
 	$(CARGO) run --release -- run pipelines/nightly.toml
 
+## The release binary: target/release/stancelib (or $$CARGO_TARGET_DIR/release/stancelib).
 build:
 
 ## The bulk CMU set built by Apache Spark in local mode (8 shards on local[2], then merge) into
@@ -61,6 +63,10 @@ spark-demo:
 	$(CARGO) build --release
 	python3 pipelines/spark/stancelib_spark.py --master 'local[2]' --shards 8 \
 		--stancelib $(STANCELIB_BIN) --out out/spark-demo ../shared/data/bvh-bulk/cmu
+
+## Install the binary into ~/.cargo/bin (on the PATH of a rustup install).
+install:
+	$(CARGO) install --path . --locked
 
 doc:
 	$(CARGO) doc --no-deps

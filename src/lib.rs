@@ -8,6 +8,12 @@
 //! flights) → ingest (one clip, pure) → library (Parquet tables) ← cli / pipeline (I/O)
 //! ```
 //!
+//! The method of each stage (equations, units, the papers' numbering and where the tool
+//! departs from them) is in the repository's `docs/`. Citations `spec com-from-bvh §N`,
+//! `spec stance-model §N` and `spec two-pac §N` in these docs are the numbered sections of
+//! `docs/com-from-bvh.md`, `docs/stance-model.md` and `docs/two-pac.md`;
+//! `CORRECTIONS Issue N item K` are the entries of `docs/decisions.md`.
+//!
 //! ## Glossary
 //! - **clip**: one BVH file; its name is the file stem (spec com-from-bvh §1.1).
 //! - **frame**: one row of the MOTION section; indices are the file's own, also when

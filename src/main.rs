@@ -2,10 +2,8 @@
 //! (0 ok, 1 finished with per-clip failures, 2 fatal or every clip failed).
 use std::process::ExitCode;
 
-use clap::Parser;
-
 fn main() -> ExitCode {
-    let args = stancelib::cli::args::Cli::parse();
+    let args = stancelib::cli::args::parse();
     match stancelib::cli::run(args) {
         Ok(stancelib::cli::Outcome::Clean) => ExitCode::SUCCESS,
         Ok(stancelib::cli::Outcome::SomeFailed) => ExitCode::from(1),

@@ -288,11 +288,6 @@ fn assert_bounds_except(f: &Figures, misses: &[(&str, f64)]) {
     bound("joint_step_deg", f.joint_step_max_deg, 30.0);
 }
 
-/// The bounds on one written motion.
-fn assert_bounds(f: &Figures) {
-    assert_bounds_except(f, &[]);
-}
-
 /// Runs an edit that may finish with frames reported as not converged (exit 1: a support
 /// foot out of reach); any other outcome fails.
 fn edit(args: &[&str]) {

@@ -34,11 +34,14 @@ fn real_subset(test: &str, n: usize) -> Option<Vec<PathBuf>> {
     Some(all.into_iter().step_by(step).take(n).collect())
 }
 
-/// The manifest without its wall time.
+/// The manifest without what changes from run to run: wall time, date and command line.
 fn manifest(lib: &Path) -> serde_json::Value {
     let mut m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(lib.join("manifest.json")).unwrap()).unwrap();
-    m.as_object_mut().unwrap().remove("wall_time_s");
+    let o = m.as_object_mut().unwrap();
+    for k in ["wall_time_s", "created_utc", "command_line"] {
+        o.remove(k);
+    }
     m
 }
 

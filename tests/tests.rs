@@ -1,5 +1,8 @@
 //! The one integration-test binary. Table of contents:
 //!
+//! - `analyst`: issue 17 — the README's demo commands run and its column tables are the
+//!   written schemas; manifest date and command line, query outputs naming their library,
+//!   `info`, negative numbers, `--help` limits, `--quiet` and `--json`.
 //! - `bad_input`: malformed files name file and line; a 300 MB stream loads.
 //! - `bvh_oracle`: differential test of the BVH reader against the `bvh_anim` crate on every
 //!   shared clip it reads (f32 precision), and a write-and-reread round trip.
@@ -33,6 +36,7 @@
 //!   is touched, no option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `twopac`: `equilibrium` and `twopac` on `fixtures/twopac/`: reference margins, boundary
 //!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
+mod analyst;
 mod bad_input;
 mod bvh_oracle;
 mod cli;

@@ -19,11 +19,106 @@ pub struct Cli {
     /// The command.
     #[command(subcommand)]
     pub command: Command,
+    /// Print nothing on stdout and draw no progress bar (errors still go to stderr).
+    #[arg(long, global = true)]
+    pub quiet: bool,
+    /// Print the command's summary as one JSON object on stdout instead of text
+    /// (`frames`, `build`, `run`, `info`).
+    #[arg(long, global = true)]
+    pub json: bool,
+}
+
+/// The limits each subcommand checks before any work, for its `--help`.
+fn limits_help(command: &str) -> Option<String> {
+    use crate::query::map::{MAX_AXIS_VALUES, MAX_GRID_CELLS, MAX_MAP_CELLS};
+    let range =
+        format!("each start:stop:step range: at most {MAX_AXIS_VALUES} values (MAX_AXIS_VALUES)");
+    let threads = format!(
+        "--threads: at most {} × the cores (MAX_THREADS_PER_CORE)",
+        crate::pipeline::batch::MAX_THREADS_PER_CORE
+    );
+    let bvh = format!(
+        "inputs: regular files of at most {} GiB (MAX_BVH_BYTES), lines of at most {} MiB \
+         (MAX_LINE_BYTES)",
+        crate::pipeline::inputs::MAX_BVH_BYTES >> 30,
+        crate::bvh::MAX_LINE_BYTES >> 20
+    );
+    let twopac = format!(
+        "at most {} phases (MAX_PHASES), {} contacts per phase (MAX_CONTACTS), {} samples \
+         of 0.01 s (validate::MAX_SAMPLES), {} rows per inline polytope (polytope::MAX_ROWS)",
+        crate::twopac::trajectory::MAX_PHASES,
+        crate::twopac::equilibrium::MAX_CONTACTS,
+        crate::twopac::validate::MAX_SAMPLES,
+        crate::twopac::polytope::MAX_ROWS
+    );
+    let lines: Vec<String> = match command {
+        "frames" | "build" | "run" => vec![bvh, threads],
+        "run-query" => vec![
+            range,
+            format!(
+                "cycles × speeds: at most {} rows (MAX_RUN_ROWS)",
+                crate::query::run::MAX_RUN_ROWS
+            ),
+        ],
+        "jumps" => vec![
+            range,
+            format!("heights × speeds: at most {MAX_GRID_CELLS} cells (MAX_GRID_CELLS)"),
+            format!("cells × (pairs + stance grids): at most {MAX_MAP_CELLS} (MAX_MAP_CELLS)"),
+        ],
+        "twopac" => vec![twopac],
+        "equilibrium" => vec![format!(
+            "at most {} contacts (MAX_CONTACTS), {} COM states (MAX_COM_STATES)",
+            crate::twopac::equilibrium::MAX_CONTACTS,
+            crate::twopac::equilibrium::MAX_COM_STATES
+        )],
+        "synth" => vec![format!(
+            "--rate {} to {} Hz, --duration at most {} s",
+            crate::synth::MIN_FRAME_RATE_HZ,
+            crate::synth::MAX_FRAME_RATE_HZ,
+            crate::synth::MAX_DURATION_S
+        )],
+        _ => return None,
+    };
+    let body: Vec<String> = lines.iter().map(|l| format!("  {l}")).collect();
+    Some(format!(
+        "Limits (checked before any work; exit 2 when exceeded):\n{}",
+        body.join("\n")
+    ))
+}
+
+/// The clap command of [`Cli`], with every subcommand accepting negative numbers as
+/// values (`--speed -3`, `--distance -0.5`) and listing its limits in `--help`.
+pub fn command() -> clap::Command {
+    fn adjust(c: clap::Command, parent: &str) -> clap::Command {
+        let name = c.get_name().to_string();
+        // `query run` and `run` share a name: key the query one by its parent.
+        let key = if parent == "query" && name == "run" {
+            "run-query".to_string()
+        } else {
+            name.clone()
+        };
+        let mut c = c.allow_negative_numbers(true);
+        if let Some(h) = limits_help(&key) {
+            c = c.after_help(h);
+        }
+        c.mut_subcommands(|s| adjust(s, &name))
+    }
+    adjust(<Cli as clap::CommandFactory>::command(), "")
+}
+
+/// Parses this process's arguments with [`command`] (exits with clap's message and
+/// code 2 on bad arguments, as clap does).
+pub fn parse() -> Cli {
+    let matches = command().get_matches();
+    <Cli as clap::FromArgMatches>::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
 }
 
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// What a library holds: clips, characters, stances, failures, options, limits,
+    /// provenance.
+    Info(InfoArgs),
     /// Per-frame COM, contacts and per-clip diagnostics of BVH clips, as Parquet.
     Frames(FramesArgs),
     /// Run a declarative pipeline file (pipelines/*.toml).
@@ -136,6 +231,8 @@ pub struct EditJumpArgs {
 pub enum PlotCommand {
     /// One stance: model force against the kinematic (and plate) force, friction ratio.
     Stance(PlotStanceArgs),
+    /// One clip: COM height with its flights' −g fits, COM speed, contact bars, warnings.
+    Clip(PlotClipArgs),
 }
 
 /// `stancelib query …`.
@@ -231,6 +328,10 @@ pub struct RunQueryArgs {
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also draw Table 1 as a figure (PNG): β_h, mu_min and the leg extension against
+    /// speed, with the limits dashed and infeasible speeds marked.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
 }
 
 impl RunQueryArgs {
@@ -511,6 +612,10 @@ pub struct EquilibriumArgs {
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also draw a horizontal slice of the static-equilibrium region (margin per cell,
+    /// zero acceleration) with the contacts and the evaluated COM states (PNG).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
 }
 
 /// `stancelib twopac` (spec two-pac §1.1, §8).
@@ -566,6 +671,27 @@ pub struct PlotStanceArgs {
     /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1].
     #[arg(long = "active-set", default_value_t = crate::constraints::ACTIVE_FRACTION)]
     pub active_set: f64,
+    /// Output PNG file.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `stancelib info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Library folder (from `build` or `run`).
+    pub lib: PathBuf,
+}
+
+/// `stancelib plot clip`.
+#[derive(Debug, Args)]
+pub struct PlotClipArgs {
+    /// Library folder.
+    #[arg(long)]
+    pub lib: PathBuf,
+    /// The clip name (`clip` of `clips.parquet`).
+    #[arg(long)]
+    pub clip: String,
     /// Output PNG file.
     #[arg(long)]
     pub out: PathBuf,

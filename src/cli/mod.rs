@@ -3,7 +3,41 @@
 pub mod args;
 pub mod cmd;
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use args::{Cli, Command, EditCommand, MapCommand, PlotCommand, QueryCommand};
+
+static QUIET: AtomicBool = AtomicBool::new(false);
+static JSON: AtomicBool = AtomicBool::new(false);
+
+/// `--quiet`: nothing on stdout, no progress bar; errors still go to stderr.
+pub fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
+/// `--json`: the command's summary as one JSON object on stdout, and nothing else there.
+pub fn json() -> bool {
+    JSON.load(Ordering::Relaxed)
+}
+
+/// Prints a line of a command's human-readable report on stdout, unless `--quiet` or
+/// `--json` is given.
+#[macro_export]
+macro_rules! say {
+    ($($t:tt)*) => {
+        if !$crate::cli::quiet() && !$crate::cli::json() {
+            println!($($t)*);
+        }
+    };
+}
+
+/// Prints `summary` on stdout as one line of JSON when `--json` is given (and not
+/// `--quiet`).
+pub fn summary_json(summary: &serde_json::Value) {
+    if json() && !quiet() {
+        println!("{summary}");
+    }
+}
 
 /// How a command finished (fatal errors are `Err`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -21,7 +55,11 @@ pub enum Outcome {
 /// # Errors
 /// Fatal errors (bad configuration, unreadable inputs, unwritable output): exit code 2.
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
+    QUIET.store(cli.quiet, Ordering::Relaxed);
+    JSON.store(cli.json, Ordering::Relaxed);
+    crate::pipeline::batch::set_progress(!cli.quiet);
     match cli.command {
+        Command::Info(a) => cmd::info::run(a),
         Command::Frames(a) => cmd::frames::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Build(a) => cmd::build::run(a),
@@ -36,5 +74,6 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Plot(PlotCommand::Stance(a)) => cmd::plot::run_stance(a),
         Command::Edit(EditCommand::Run(a)) => cmd::edit::run(a),
         Command::Edit(EditCommand::Jump(a)) => cmd::edit::run_jump(a),
+        Command::Plot(PlotCommand::Clip(a)) => cmd::plot::run_clip(a),
     }
 }

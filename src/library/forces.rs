@@ -201,28 +201,17 @@ pub fn read_clip_accelerations(
     t1: f64,
 ) -> Result<ClipAccelerations> {
     let names = ["clip", "time_s", "com_ax", "com_ay", "com_az"];
-    let io = |e: PolarsError| Error::io(path, "cannot read parquet", e);
-    let source = PlRefPath::try_from_path(path).map_err(io)?;
-    let df = LazyFrame::scan_parquet(source, ScanArgsParquet::default())
-        .map_err(io)?
-        .select(names.map(polars::prelude::col))
-        .filter(
-            polars::prelude::col("clip")
-                .eq(lit(clip))
-                .and(polars::prelude::col("time_s").gt_eq(lit(t0)))
-                .and(polars::prelude::col("time_s").lt_eq(lit(t1))),
-        )
-        .collect()
-        .map_err(io)?;
-    let t = Table {
-        path: path.to_path_buf(),
-        df,
-    };
+    let t = Table::open_columns(path, &names)?;
+    let (clips, time_s) = (t.strings("clip")?, t.f64s("time_s")?);
     let (ax, ay, az) = (t.f64s("com_ax")?, t.f64s("com_ay")?, t.f64s("com_az")?);
-    Ok(ClipAccelerations {
-        time_s: t.f64s("time_s")?,
-        com_a: (0..ax.len()).map(|i| [ax[i], ay[i], az[i]]).collect(),
-    })
+    let keep =
+        (0..time_s.len()).filter(|&i| clips[i] == clip && time_s[i] >= t0 && time_s[i] <= t1);
+    let mut out = ClipAccelerations::default();
+    for i in keep {
+        out.time_s.push(time_s[i]);
+        out.com_a.push([ax[i], ay[i], az[i]]);
+    }
+    Ok(out)
 }
 
 /// The up axis of `clip`'s file (`up_axis` of `clips.parquet`).

@@ -5,10 +5,13 @@
 //! # References
 //! spec com-from-bvh §8 (column tables); STYLE.md §5.6 (deterministic files).
 
+pub mod clip_view;
 mod columns;
 pub mod forces;
+pub mod info;
 pub mod kinematics;
 pub mod plates;
+pub mod provenance;
 pub mod queries;
 pub mod read;
 pub mod schema;

@@ -57,6 +57,22 @@ impl Table {
         })
     }
 
+    /// Reads only the columns `names` of `path` (the rest of the file is not decoded).
+    ///
+    /// # Errors
+    /// The file cannot be opened, is not valid Parquet, or lacks one of `names`.
+    pub fn open_columns(path: &Path, names: &[&str]) -> Result<Self> {
+        let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
+        let df = ParquetReader::new(f)
+            .with_columns(Some(names.iter().map(|n| n.to_string()).collect()))
+            .finish()
+            .map_err(|e| Error::io(path, "cannot read parquet", e))?;
+        Ok(Table {
+            path: path.to_path_buf(),
+            df,
+        })
+    }
+
     /// Number of rows.
     pub fn height(&self) -> usize {
         self.df.height()

@@ -133,9 +133,12 @@ impl TableWriter {
         }
         let arrow = Schema::from_iter(self.schema.iter().map(|(n, d)| (n.clone(), d.clone())))
             .to_arrow(CompatLevel::oldest());
-        let key = polars_parquet::write::schema_to_metadata_key(&arrow);
+        let (key, value) = super::write::arrow_schema_entry(&arrow, kv);
         let mut meta: Vec<KeyValue> = Vec::with_capacity(kv.len() + 1);
-        meta.push(key);
+        meta.push(KeyValue {
+            key,
+            value: Some(value),
+        });
         meta.extend(kv.iter().map(|(k, v)| KeyValue {
             key: k.clone(),
             value: Some(v.clone()),

@@ -356,6 +356,52 @@ pub fn write_atomic(
     w.finish(kv)
 }
 
+/// The `ARROW:schema` key-value entry of `schema` (an Arrow schema of the oldest
+/// compatibility level) whose schema metadata is `kv` itself.
+///
+/// pyarrow takes `read_table(f).schema.metadata` from this Arrow schema, not from the
+/// file's key-value list, so the `stancelib.*` keys go into both.
+pub(crate) fn arrow_schema_entry(
+    schema: &polars_arrow::datatypes::ArrowSchema,
+    kv: &[(String, String)],
+) -> (String, String) {
+    use polars_arrow::io::ipc::write::{default_ipc_fields, schema_to_bytes};
+    let meta: polars_arrow::datatypes::Metadata = kv
+        .iter()
+        .map(|(k, v)| (PlSmallStr::from_str(k), PlSmallStr::from_str(v)))
+        .collect();
+    let ipc = schema_to_bytes(
+        schema,
+        &default_ipc_fields(schema.iter_values()),
+        Some(&meta),
+    );
+    // The legacy IPC framing Arrow readers expect: continuation marker, length, message.
+    let mut framed = Vec::with_capacity(ipc.len() + 8);
+    framed.extend_from_slice(&[255, 255, 255, 255]);
+    framed.extend_from_slice(&(ipc.len() as u32).to_le_bytes());
+    framed.extend_from_slice(&ipc);
+    ("ARROW:schema".to_string(), base64(&framed))
+}
+
+/// Standard base64 with padding (RFC 4648 §4), as the `ARROW:schema` value is written.
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for c in bytes.chunks(3) {
+        let n = (u32::from(c[0]) << 16)
+            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+            | u32::from(*c.get(2).unwrap_or(&0));
+        for (i, shift) in [18, 12, 6, 0].into_iter().enumerate() {
+            if i <= c.len() {
+                out.push(char::from(A[((n >> shift) & 63) as usize]));
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
 /// The tables a `frames` run writes.
 const FRAMES_RUN_FILES: [&str; 4] = [FRAMES_FILE, CLIPS_FILE, CONTACTS_FILE, JOINTS_FILE];
 
@@ -403,4 +449,23 @@ pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()>
         write_atomic(dir, name, df, &kv)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod base64_tests {
+    #[test]
+    fn base64_matches_rfc_4648_test_vectors() {
+        // RFC 4648 §10.
+        for (plain, coded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(super::base64(plain.as_bytes()), coded, "{plain}");
+        }
+    }
 }

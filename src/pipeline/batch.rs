@@ -112,13 +112,24 @@ fn input_error(mut rec: ClipRecord, path: &Path, problem: &InputProblem) -> Clip
 /// `stage` of an input that could not be read at all (`errors.parquet`).
 pub const INPUT_STAGE: &str = "input";
 
-/// A progress bar for `len` items, drawn on a terminal (stderr) and hidden otherwise.
+static PROGRESS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
+
+/// Turns the progress bars of this process on or off (`--quiet` turns them off).
+pub fn set_progress(enabled: bool) {
+    PROGRESS.store(enabled, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// A progress bar for `len` items with elapsed time and ETA, drawn on a terminal
+/// (stderr) and hidden otherwise or after [`set_progress`]`(false)`.
 pub fn progress(len: usize, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);
-    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+    if !PROGRESS.load(std::sync::atomic::Ordering::Relaxed)
+        || !std::io::IsTerminal::is_terminal(&std::io::stderr())
+    {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
-    if let Ok(style) = ProgressStyle::with_template(&format!("{{bar:40}} {{pos}}/{{len}} {what}")) {
+    let template = format!("{{bar:40}} {{pos}}/{{len}} {what} [{{elapsed_precise}}, ETA {{eta}}]");
+    if let Ok(style) = ProgressStyle::with_template(&template) {
         bar.set_style(style);
     }
     bar

@@ -332,6 +332,9 @@ impl LibrarySink {
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
             "schema_version": SCHEMA_VERSION,
             "tool_version": env!("CARGO_PKG_VERSION"),
+            // Not in the Parquet metadata: these change from run to run (the tables do not).
+            "created_utc": crate::library::provenance::now_utc(),
+            "command_line": crate::library::provenance::command_line(),
             "options": serde_json::from_str::<serde_json::Value>(fingerprint).unwrap_or_default(),
             "inputs": self.inputs,
             "limits": lim,

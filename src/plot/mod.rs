@@ -13,7 +13,10 @@ use plotters::style::FontStyle;
 
 use crate::query::map::JumpMap;
 
+pub mod clip;
 pub mod edit;
+pub mod equilibrium;
+pub mod runs;
 pub mod stance;
 pub mod trajectory;
 
@@ -124,18 +127,30 @@ fn panel<'a, 'b>(
     Ok(chart)
 }
 
+/// The shade of a cell holding `n` of at most `max` feasible (pair, cell)s.
+fn shade(n: u32, max: u32) -> f64 {
+    0.15 + 0.85 * f64::from(n) / f64::from(max.max(1))
+}
+
 /// `jump_map.png`: left, how many liftoff/landing pairs can make each (distance, height)
-/// by the exact check (Figure 4 over the whole pool); right, where the fast filters and
-/// the exact check agree (Figure 5).
+/// by the exact check (Figure 4 over the pool), with a colour bar and the `recorded`
+/// jumps (distance, height; m) marked ×; right, where the fast filters and the exact
+/// check agree (Figure 5). `scope` names the pool in the title (`all characters`, a
+/// `character_id`).
 ///
 /// # Errors
 /// The file cannot be written or the font cannot be used.
-pub fn jump_map_png(path: &Path, map: &JumpMap) -> Result<(), PlotError> {
+pub fn jump_map_png(
+    path: &Path,
+    map: &JumpMap,
+    scope: &str,
+    recorded: &[(f64, f64)],
+) -> Result<(), PlotError> {
     register_font();
     let root = BitMapBackend::new(path, (1500, 650)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
     let title = format!(
-        "Jump feasibility map: {} liftoff × landing pairs, library IoU(approx, exact) = {:.3}",
+        "Jump feasibility map ({scope}): {} liftoff × landing pairs, IoU(approx, exact) = {:.3}",
         map.pairs.len(),
         map.agreement.iou()
     );
@@ -143,6 +158,7 @@ pub fn jump_map_png(path: &Path, map: &JumpMap) -> Result<(), PlotError> {
         .titled(&title, ("sans-serif", 22))
         .map_err(|e| err(path, e))?;
     let (left, right) = root.split_horizontally(750);
+    let (left, bar) = left.split_horizontally(670);
     let (h0, h1) = (
         map.heights.first().copied().unwrap_or(0.0),
         map.heights.last().copied().unwrap_or(1.0),
@@ -183,8 +199,8 @@ pub fn jump_map_png(path: &Path, map: &JumpMap) -> Result<(), PlotError> {
                 let c = b.cells[row * b.n_d + k];
                 let n_exact = c[0] + c[2];
                 if n_exact > 0 {
-                    let shade = 0.15 + 0.85 * f64::from(n_exact) / f64::from(b.max_exact.max(1));
-                    exact.push(Rectangle::new(rect(b, k, row), BLUE.mix(shade).filled()));
+                    let mix = shade(n_exact, b.max_exact);
+                    exact.push(Rectangle::new(rect(b, k, row), BLUE.mix(mix).filled()));
                 }
                 let kind = (0..3).max_by_key(|&i| (c[i], 3 - i)).unwrap_or(0);
                 if c.iter().any(|&n| n > 0) {
@@ -214,6 +230,27 @@ pub fn jump_map_png(path: &Path, map: &JumpMap) -> Result<(), PlotError> {
                 });
         }
     }
+    if !recorded.is_empty() {
+        let (x, y) = (l.x_range(), l.y_range());
+        let inside: Vec<(f64, f64)> = recorded
+            .iter()
+            .copied()
+            .filter(|(d, h)| x.contains(d) && y.contains(h))
+            .collect();
+        l.draw_series(
+            inside
+                .iter()
+                .map(|&p| Cross::new(p, 7, BLACK.stroke_width(2))),
+        )
+        .map_err(|e| err(path, e))?
+        .label(format!(
+            "recorded jump ({} of {})",
+            inside.len(),
+            recorded.len()
+        ))
+        .legend(|(x, y)| Cross::new((x + 6, y), 5, BLACK.stroke_width(2)));
+    }
+    colour_bar(&bar, path, b.as_ref().map_or(0, |b| b.max_exact))?;
     for chart in [&mut l, &mut r] {
         chart
             .configure_series_labels()
@@ -225,5 +262,42 @@ pub fn jump_map_png(path: &Path, map: &JumpMap) -> Result<(), PlotError> {
             .map_err(|e| err(path, e))?;
     }
     root.present().map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+/// The colour bar of the exact panel: feasible (pair, cell)s per cell, 1 … `max`.
+fn colour_bar(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    path: &Path,
+    max: u32,
+) -> Result<(), PlotError> {
+    let top = max.max(1);
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(50)
+        .margin_bottom(57)
+        .margin_right(8)
+        .y_label_area_size(45)
+        .build_cartesian_2d(0.0..1.0, 0.5..(f64::from(top) + 0.5))
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .disable_x_axis()
+        .disable_y_mesh()
+        .y_labels(6)
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .y_desc("pairs per cell")
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(|e| err(path, e))?;
+    chart
+        .draw_series((1..=top).map(|n| {
+            let y = f64::from(n);
+            Rectangle::new(
+                [(0.0, y - 0.5), (1.0, y + 0.5)],
+                BLUE.mix(shade(n, top)).filled(),
+            )
+        }))
+        .map_err(|e| err(path, e))?;
     Ok(())
 }

@@ -1,6 +1,12 @@
-//! `trajectory.png` of `twopac` (spec two-pac §8): a side view (x–z) and a top view (x–y)
-//! of the contacts, phase states, transition points, the 2PAC curve and the quasi-static
-//! polyline, with equal scales on both axes of a view (metres).
+//! `trajectory.png` of `twopac` (spec two-pac §8): a side view and a top view of the
+//! contacts, phase states, transition points, the 2PAC curve, the quasi-static polyline,
+//! the recorded COM (`--clip`) and the curve's dynamically invalid samples, with equal
+//! scales on both axes of a view (metres).
+//!
+//! The views are along the path's own direction, not world x (a walk along y would
+//! collapse): `s` is the horizontal direction from the curve's start to its end (or, for
+//! a path that returns to its start, the principal horizontal direction of all points),
+//! `l` the horizontal direction to its left, and `z` up.
 
 use std::path::Path;
 
@@ -24,6 +30,60 @@ pub struct TrajectoryPlot {
     pub transitions: Vec<[f64; 3]>,
     /// Phase states `c^(j)`.
     pub phase_states: Vec<[f64; 3]>,
+    /// The recorded COM over the planned span (`--clip`), empty otherwise.
+    pub recorded: Vec<[f64; 3]>,
+    /// Samples of the 2PAC curve that fail the dynamic validation.
+    pub invalid: Vec<[f64; 3]>,
+}
+
+/// The unit horizontal direction `e_s` of the path: start to end of the curve, else the
+/// principal horizontal axis of every point, else world x.
+pub fn path_direction(d: &TrajectoryPlot) -> [f64; 2] {
+    let unit = |v: [f64; 2]| {
+        let n = v[0].hypot(v[1]);
+        (n > 1e-6).then(|| [v[0] / n, v[1] / n])
+    };
+    if let (Some(a), Some(b)) = (d.curve.first(), d.curve.last()) {
+        if let Some(e) = unit([b[0] - a[0], b[1] - a[1]]) {
+            return e;
+        }
+    }
+    let pts: Vec<&[f64; 3]> = d.contacts.iter().flatten().chain(&d.curve).collect();
+    if pts.is_empty() {
+        return [1.0, 0.0];
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p[0]).sum::<f64>() / n,
+        pts.iter().map(|p| p[1]).sum::<f64>() / n,
+    );
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in &pts {
+        let (x, y) = (p[0] - mx, p[1] - my);
+        sxx += x * x;
+        sxy += x * y;
+        syy += y * y;
+    }
+    // Major axis of the 2 × 2 covariance: angle ½·atan2(2 sxy, sxx − syy).
+    let a = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    unit([a.cos(), a.sin()]).unwrap_or([1.0, 0.0])
+}
+
+/// `d` with every point in path coordinates `(s, l, z)` (see the module docs).
+pub fn along_path(d: &TrajectoryPlot) -> TrajectoryPlot {
+    let e = path_direction(d);
+    let f = |p: &[f64; 3]| [p[0] * e[0] + p[1] * e[1], -p[0] * e[1] + p[1] * e[0], p[2]];
+    let all = |v: &[[f64; 3]]| v.iter().map(f).collect::<Vec<_>>();
+    TrajectoryPlot {
+        title: d.title.clone(),
+        contacts: d.contacts.iter().map(|c| all(c)).collect(),
+        curve: all(&d.curve),
+        quasi_static: all(&d.quasi_static),
+        transitions: all(&d.transitions),
+        phase_states: all(&d.phase_states),
+        recorded: all(&d.recorded),
+        invalid: all(&d.invalid),
+    }
 }
 
 /// Pixel size of one view.
@@ -40,7 +100,8 @@ fn ranges(d: &TrajectoryPlot, i: usize, k: usize) -> (std::ops::Range<f64>, std:
         .chain(&d.curve)
         .chain(&d.quasi_static)
         .chain(&d.transitions)
-        .chain(&d.phase_states);
+        .chain(&d.phase_states)
+        .chain(&d.recorded);
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     for p in all.filter(|p| p.iter().all(|v| v.is_finite())) {
@@ -84,7 +145,7 @@ fn view(
         .map_err(|e| err(path, e))?;
     chart
         .configure_mesh()
-        .x_desc("x (m)")
+        .x_desc("s, along the path (m)")
         .y_desc(y_desc)
         .label_style(("sans-serif", 14))
         .draw()
@@ -146,6 +207,32 @@ fn view(
         .map_err(|e| err(path, e))?
         .label("transition points c(j, j+1)")
         .legend(|(x, y)| TriangleMarker::new((x + 8, y), 7, RED.filled()));
+    if !d.recorded.is_empty() {
+        let black = RGBColor(20, 20, 20);
+        chart
+            .draw_series(DashedLineSeries::new(
+                d.recorded.iter().map(pr),
+                6,
+                4,
+                black.stroke_width(2),
+            ))
+            .map_err(|e| err(path, e))?
+            .label("recorded COM")
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], black.stroke_width(2))
+            });
+    }
+    if !d.invalid.is_empty() {
+        chart
+            .draw_series(
+                d.invalid
+                    .iter()
+                    .map(|p| Cross::new(pr(p), 4, RED.stroke_width(2))),
+            )
+            .map_err(|e| err(path, e))?
+            .label(format!("dynamically invalid samples ({})", d.invalid.len()))
+            .legend(|(x, y)| Cross::new((x + 8, y), 4, RED.stroke_width(2)));
+    }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
@@ -157,12 +244,14 @@ fn view(
     Ok(())
 }
 
-/// Draws `trajectory.png`: side view (x–z) left, top view (x–y) right.
+/// Draws `trajectory.png`: side view (s–z) left, top view (s–l) right, in the path's
+/// coordinates ([`along_path`]).
 ///
 /// # Errors
 /// The file cannot be written or the font cannot be used.
 pub fn trajectory_png(path: &Path, d: &TrajectoryPlot) -> Result<(), PlotError> {
     register_font();
+    let d = &along_path(d);
     let root = BitMapBackend::new(path, (2 * VIEW_PX.0, VIEW_PX.1 + 40)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
     let root = root
@@ -174,7 +263,7 @@ pub fn trajectory_png(path: &Path, d: &TrajectoryPlot) -> Result<(), PlotError> 
         path,
         d,
         (
-            "Side view (x–z)",
+            "Side view along the path (s–z)",
             2,
             "z (m)",
             SeriesLabelPosition::MiddleRight,
@@ -185,12 +274,39 @@ pub fn trajectory_png(path: &Path, d: &TrajectoryPlot) -> Result<(), PlotError> 
         path,
         d,
         (
-            "Top view (x–y)",
+            "Top view (s–l)",
             1,
-            "y (m)",
+            "l, left of the path (m)",
             SeriesLabelPosition::UpperRight,
         ),
     )?;
     root.present().map_err(|e| err(path, e))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_walk_along_y_is_drawn_along_its_own_direction() {
+        // A path along world +y: s is y, l is −x, z unchanged.
+        let d = TrajectoryPlot {
+            curve: vec![[0.0, 0.0, 0.9], [0.05, 1.0, 0.92], [0.0, 2.0, 0.9]],
+            contacts: vec![vec![[0.1, 0.5, 0.0]]],
+            ..TrajectoryPlot::default()
+        };
+        let e = path_direction(&d);
+        assert!((e[0]).abs() < 1e-12 && (e[1] - 1.0).abs() < 1e-12, "{e:?}");
+        let p = along_path(&d);
+        assert_eq!(p.curve[1], [1.0, -0.05, 0.92]);
+        assert_eq!(p.contacts[0][0], [0.5, -0.1, 0.0]);
+        // A closed loop: the principal axis of the points (here along x).
+        let loop_ = TrajectoryPlot {
+            curve: vec![[0.0, 0.0, 1.0], [2.0, 0.1, 1.0], [0.0, 0.0, 1.0]],
+            ..TrajectoryPlot::default()
+        };
+        let e = path_direction(&loop_);
+        assert!(e[0].abs() > 0.99, "{e:?}");
+    }
 }

@@ -86,7 +86,11 @@ pub fn execute(
         .with_context(|| format!("writing the library to {}", out.display()))?;
     let reused = report.reused;
     let outcome = super::frames::report(&report.records, out);
-    println!("{} stances rebuilt, {reused} clips reused", report.stances);
+    crate::say!("{} stances rebuilt, {reused} clips reused", report.stances);
+    let mut summary = super::frames::summary(&report.records, out, "build");
+    summary["stances_rebuilt"] = report.stances.into();
+    summary["clips_reused"] = reused.into();
+    crate::cli::summary_json(&summary);
     // A shard whose clips all failed is one part of a build: the merge decides.
     if (reused > 0 || plan.shard.is_some()) && outcome == Outcome::AllFailed {
         return Ok(Outcome::SomeFailed);

@@ -387,11 +387,14 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
     let order: Vec<usize> = (0..a.cycles).flat_map(|_| [0, 1]).collect();
     let first = stances[0].source.stance_id.clone();
     let e = compute(c, &clip, length, stances, order, false)?;
-    let kv = query_kv(serde_json::json!({
-        "edit": "run", "lib": c.lib, "speed_mps": a.speed, "cycles": a.cycles,
-        "stance": first, "k": k, "length_scale": length, "mass_scale": mass,
-        "limits": form.name(), "mu": mu, "active_set": active,
-    }));
+    let kv = query_kv(
+        &c.lib,
+        serde_json::json!({
+            "edit": "run", "lib": c.lib, "speed_mps": a.speed, "cycles": a.cycles,
+            "stance": first, "k": k, "length_scale": length, "mass_scale": mass,
+            "limits": form.name(), "mu": mu, "active_set": active,
+        }),
+    )?;
     let title = format!(
         "edit run: {:.2} m/s, cycle {first}, {} cycles",
         a.speed, a.cycles
@@ -549,10 +552,13 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
         lib.stances[*i].stance_id, lib.stances[*j].stance_id
     );
     let e = compute(c, &clip, 1.0, stances, vec![0, 1], true)?;
-    let kv = query_kv(serde_json::json!({
-        "edit": "jump", "lib": c.lib, "height_m": h, "distance_m": d, "pair": ids,
-        "limits": form.name(), "mu": mu, "active_set": active,
-    }));
+    let kv = query_kv(
+        &c.lib,
+        serde_json::json!({
+            "edit": "jump", "lib": c.lib, "height_m": h, "distance_m": d, "pair": ids,
+            "limits": form.name(), "mu": mu, "active_set": active,
+        }),
+    )?;
     let title = format!("edit jump: apex {h:.2} m, distance {d:.2} m, {ids}");
     finish(c, e, kv, title)
 }

@@ -95,7 +95,7 @@ pub fn run(a: EquilibriumArgs) -> anyhow::Result<Outcome> {
     let count = |s: Status| verdicts.iter().filter(|v| v.status == s).count();
     let n_in = verdicts.iter().filter(|v| v.in_equilibrium).count();
     let failed = count(Status::SolverFailed);
-    println!(
+    crate::say!(
         "equilibrium: {} point(s), {} contact(s) ({} points), m = {} kg: {n_in} in equilibrium; \
          status ok {}, force_closure {}, infeasible {}, solver_failed {failed}; {:.3} s",
         com.len(),
@@ -107,7 +107,12 @@ pub fn run(a: EquilibriumArgs) -> anyhow::Result<Outcome> {
         count(Status::Infeasible),
         elapsed
     );
-    println!("  → {}", a.out.display());
+    crate::say!("  → {}", a.out.display());
+    if let Some(png) = &a.png {
+        let data = slice(&form, &points, &com, &verdicts, &a.contacts);
+        super::write_png(png, |p| crate::plot::equilibrium::equilibrium_png(p, &data))?;
+        crate::say!("  → {}", png.display());
+    }
     Ok(if failed == 0 {
         Outcome::Clean
     } else if failed == verdicts.len() {
@@ -129,4 +134,62 @@ pub(crate) fn split_out(out: &Path) -> anyhow::Result<(&Path, String)> {
         _ => Path::new("."),
     };
     Ok((dir, name))
+}
+
+/// The `--png` slice: the region on a grid over the contacts' box at the median COM
+/// height, zero acceleration.
+fn slice(
+    form: &EqualityForm,
+    points: &[crate::twopac::contact::ContactPoint],
+    com: &[[f64; 3]],
+    verdicts: &[Verdict],
+    file: &Path,
+) -> crate::plot::equilibrium::EquilibriumPlot {
+    use crate::plot::equilibrium::{axis, EquilibriumPlot, DEFAULT_SLICE_CELLS};
+    let span = |k: usize| {
+        points
+            .iter()
+            .map(|p| p.pos[k])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    let ((x0, x1), (y0, y1)) = (span(0), span(1));
+    let mut zs: Vec<f64> = com.iter().map(|c| c[2]).collect();
+    zs.sort_by(f64::total_cmp);
+    let z = zs.get(zs.len() / 2).copied().unwrap_or(1.0);
+    let (xs, ys) = (
+        axis(x0, x1, DEFAULT_SLICE_CELLS),
+        axis(y0, y1, DEFAULT_SLICE_CELLS),
+    );
+    let cells: Vec<[f64; 3]> = ys
+        .iter()
+        .flat_map(|&y| xs.iter().map(move |&x| [x, y, z]))
+        .collect();
+    let margin_n = cells
+        .par_iter()
+        .map(|c| {
+            let v = form.verdict(*c, [0.0; 3]);
+            match v.status {
+                Status::ForceClosure => Some(f64::INFINITY),
+                _ if v.in_equilibrium => v.margin_n,
+                _ => None,
+            }
+        })
+        .collect();
+    EquilibriumPlot {
+        title: format!(
+            "{}: static-equilibrium region at z = {z:.2} m (c̈ = 0)",
+            file.display()
+        ),
+        xs,
+        ys,
+        margin_n,
+        contacts: points.iter().map(|p| p.pos).collect(),
+        points: com
+            .iter()
+            .zip(verdicts)
+            .map(|(c, v)| (*c, v.in_equilibrium))
+            .collect(),
+    }
 }

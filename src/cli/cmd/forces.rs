@@ -20,11 +20,14 @@ pub fn run(a: ForcesArgs) -> anyhow::Result<Outcome> {
         read_force_stances(&table).with_context(|| format!("library {}", a.lib.display()))?;
     let chosen = select_stances(&table, &stances, &a.stances)?;
     let mut df = forces_table(&chosen)?;
-    let kv = query_kv(serde_json::json!({
-        "query": "forces", "lib": a.lib, "stances": a.stances,
-    }));
+    let kv = query_kv(
+        &a.lib,
+        serde_json::json!({
+            "query": "forces", "lib": a.lib, "stances": a.stances,
+        }),
+    )?;
     write_table(&a.out, &mut df, &kv)?;
-    println!(
+    crate::say!(
         "forces: {} stance(s), {} sample(s) → {}",
         chosen.len(),
         df.height(),

@@ -36,7 +36,22 @@ pub fn execute(
     let records = worker_pool(files, threads)?.install(|| ingest_all(files, opts));
     write_all(out, &records, opts.joints)
         .with_context(|| format!("writing tables to {}", out.display()))?;
-    Ok(report(&records, out))
+    let outcome = report(&records, out);
+    crate::cli::summary_json(&summary(&records, out, "frames"));
+    Ok(outcome)
+}
+
+/// The `--json` summary of a batch: `command`, `clips`, `ok`, `skipped`, `failed`, `out`.
+pub fn summary(records: &[ClipRecord], out: &Path, command: &str) -> serde_json::Value {
+    let count = |s: Status| records.iter().filter(|r| r.status == s).count();
+    serde_json::json!({
+        "command": command,
+        "clips": records.len(),
+        "ok": count(Status::Ok),
+        "skipped": count(Status::Skipped),
+        "failed": count(Status::Error),
+        "out": out,
+    })
 }
 
 /// Check there is work, then start the rayon pool with `threads` workers (0 = all cores).
@@ -63,7 +78,10 @@ pub fn report(records: &[ClipRecord], out: &Path) -> Outcome {
     for r in records.iter().filter(|r| r.status == Status::Error) {
         eprintln!("error: {}", r.message.as_deref().unwrap_or("unknown error"));
     }
-    for r in records.iter().filter(|r| r.status == Status::Skipped) {
+    for r in records
+        .iter()
+        .filter(|r| r.status == Status::Skipped && !crate::cli::quiet())
+    {
         eprintln!(
             "skipped: {}: {}",
             r.path,
@@ -71,7 +89,7 @@ pub fn report(records: &[ClipRecord], out: &Path) -> Outcome {
         );
     }
     let failed = count(Status::Error);
-    println!(
+    crate::say!(
         "{} clips: {} ok, {} skipped, {} failed; tables in {}",
         records.len(),
         count(Status::Ok),

@@ -1,6 +1,7 @@
 //! `stancelib map jumps`: the jump feasibility map of a library (spec stance-model §6.10)
 //! as `jump_map.parquet`, `jump_map_pairs.parquet`, `jump_map.json` and `jump_map.png`.
 
+use std::collections::BTreeSet;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -12,7 +13,7 @@ use crate::library::queries::{jump_map_table, jump_pairs_table};
 use crate::library::write::write_atomic;
 use crate::plot::jump_map_png;
 use crate::query::feasibility::LimitForm;
-use crate::query::map::{check_grid, jump_map};
+use crate::query::map::{check_grid, jump_map, JumpMap};
 use crate::query::pool::Prepared;
 
 /// Run `map jumps`.
@@ -46,7 +47,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         "cells_both": map.agreement.both, "iou": iou,
         "limits": form.name(), "mu": mu, "active_set": active,
     });
-    let kv = query_kv(summary.clone());
+    let kv = query_kv(&a.lib, summary.clone())?;
     write_atomic(
         &a.out,
         "jump_map.parquet",
@@ -66,8 +67,40 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         .with_context(|| format!("cannot write {}", json_tmp.display()))?;
     std::fs::rename(&json_tmp, a.out.join("jump_map.json"))
         .context("cannot write jump_map.json")?;
-    super::write_png(&a.out.join("jump_map.png"), |p| jump_map_png(p, &map))?;
-    println!(
+    let recorded = recorded_jumps(&map, &pool);
+    let marks = |ids: Option<&str>| -> Vec<(f64, f64)> {
+        recorded
+            .iter()
+            .filter(|(c, _)| ids.is_none_or(|id| id == c.as_str()))
+            .map(|(_, p)| *p)
+            .collect()
+    };
+    super::write_png(&a.out.join("jump_map.png"), |p| {
+        jump_map_png(p, &map, "all characters", &marks(None))
+    })?;
+    // One map per character when the pool has several.
+    let characters: BTreeSet<&str> = map
+        .pairs
+        .iter()
+        .map(|p| pool[p.liftoff].stance.character_id.as_str())
+        .collect();
+    if characters.len() > 1 {
+        for id in &characters {
+            let mut one = map.clone();
+            one.pairs
+                .retain(|p| pool[p.liftoff].stance.character_id == *id);
+            one.agreement = one.pairs.iter().fold(Default::default(), |mut acc, p| {
+                acc.approx += p.agreement.approx;
+                acc.exact += p.agreement.exact;
+                acc.both += p.agreement.both;
+                acc.either += p.agreement.either;
+                acc
+            });
+            let file = a.out.join(format!("jump_map_{}.png", file_safe(id)));
+            super::write_png(&file, |p| jump_map_png(p, &one, id, &marks(Some(*id))))?;
+        }
+    }
+    crate::say!(
         "map jumps: {} liftoff(s) × {} landing(s) → {} pair(s) of one character, {} × {} cells",
         map.liftoffs.len(),
         map.landings.len(),
@@ -75,10 +108,45 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         heights.len(),
         speeds.len()
     );
-    println!(
+    crate::say!(
         "  cells feasible: approx {}, exact {}, both {}; IoU = {iou:.4}; computed in {elapsed:.3} s",
         map.agreement.approx, map.agreement.exact, map.agreement.both
     );
-    println!("  → {}", a.out.display());
+    crate::say!("  → {}", a.out.display());
     Ok(Outcome::Clean)
+}
+
+/// The recorded jumps of the map's pairs, `(character_id, (distance, height))` in m: a
+/// liftoff and the landing right after it across one flight of the same clip, at the
+/// identity jump's height `(ze₁ + zs₂ + z_c,2 − z_c,1)/2` and distance `x₁ + x₂` (spec
+/// stance-model §6.9).
+pub fn recorded_jumps(map: &JumpMap, pool: &[Prepared]) -> Vec<(String, (f64, f64))> {
+    map.pairs
+        .iter()
+        .filter_map(|p| {
+            let (s1, s2) = (&pool[p.liftoff].stance, &pool[p.landing].stance);
+            let next = pool
+                .iter()
+                .map(|q| &q.stance)
+                .filter(|q| q.clip == s1.clip && q.first_frame > s1.first_frame)
+                .min_by_key(|q| q.first_frame)?;
+            (next.stance_id == s2.stance_id).then(|| {
+                let h = (s1.params.ze + s2.params.zs + s2.z_c - s1.z_c) / 2.0;
+                (s1.character_id.clone(), (s1.params.x + s2.params.x, h))
+            })
+        })
+        .collect()
+}
+
+/// `id` with every character but ASCII letters, digits, `-` and `_` replaced by `_`.
+fn file_safe(id: &str) -> String {
+    id.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }

@@ -5,6 +5,7 @@ pub mod edit;
 pub mod equilibrium;
 pub mod forces;
 pub mod frames;
+pub mod info;
 pub mod map;
 pub mod plot;
 pub mod query;

@@ -3,7 +3,7 @@
 
 use anyhow::Context;
 
-use super::super::args::PlotStanceArgs;
+use super::super::args::{PlotClipArgs, PlotStanceArgs};
 use super::super::Outcome;
 use super::write_png;
 use crate::force_model::export::{kinematic_force, sample_forces};
@@ -88,6 +88,28 @@ pub fn run_stance(a: PlotStanceArgs) -> anyhow::Result<Outcome> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     write_png(&a.out, |p| stance_png(p, &data))?;
-    println!("plot stance: {} → {}", data.stance_id, a.out.display());
+    crate::say!("plot stance: {} → {}", data.stance_id, a.out.display());
+    Ok(Outcome::Clean)
+}
+
+/// Run `plot clip`.
+///
+/// # Errors
+/// An unreadable library, a clip it does not hold (nothing is written), an unwritable
+/// output.
+pub fn run_clip(a: PlotClipArgs) -> anyhow::Result<Outcome> {
+    let view = crate::library::clip_view::read_clip_view(&a.lib, &a.clip)
+        .with_context(|| format!("library {}", a.lib.display()))?;
+    if let Some(dir) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    write_png(&a.out, |p| crate::plot::clip::clip_png(p, &view))?;
+    crate::say!(
+        "plot clip: {} ({} frames, {} flights) → {}",
+        view.clip,
+        view.time_s.len(),
+        view.flights.len(),
+        a.out.display()
+    );
     Ok(Outcome::Clean)
 }

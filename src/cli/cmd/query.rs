@@ -121,15 +121,60 @@ pub fn write_table(out: &Path, df: &mut DataFrame, kv: &[(String, String)]) -> a
     Ok(())
 }
 
-/// Key-value metadata of a query output: the tool version and the query's options.
-pub fn query_kv(options: serde_json::Value) -> Vec<(String, String)> {
-    vec![
-        (
-            "stancelib.tool_version".into(),
-            env!("CARGO_PKG_VERSION").into(),
-        ),
+/// Key-value metadata of a query output: the tool version, the query's options and its
+/// library (the folder as given and the SHA-256 of its `manifest.json`).
+///
+/// # Errors
+/// The library's manifest cannot be read.
+pub fn query_kv(lib: &Path, options: serde_json::Value) -> anyhow::Result<Vec<(String, String)>> {
+    use crate::library::provenance::{
+        manifest_sha256, LIBRARY_MANIFEST_KEY, LIBRARY_PATH_KEY, TOOL_VERSION, TOOL_VERSION_KEY,
+    };
+    let hash = manifest_sha256(lib).with_context(|| format!("library {}", lib.display()))?;
+    Ok(vec![
+        (TOOL_VERSION_KEY.into(), TOOL_VERSION.into()),
         ("stancelib.query".into(), options.to_string()),
-    ]
+        (LIBRARY_PATH_KEY.into(), lib.display().to_string()),
+        (LIBRARY_MANIFEST_KEY.into(), hash),
+    ])
+}
+
+/// The figure's points of `query run` rows (cycle-major within each speed, `n_cycles`
+/// cycles).
+fn run_points(rows: &[RunRow], n_cycles: usize) -> Vec<crate::plot::runs::RunPoint> {
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let solved: Vec<_> = r
+                .candidate
+                .stances
+                .iter()
+                .filter_map(|s| s.as_ref().ok())
+                .collect();
+            let both = solved.len() == 2;
+            let agg = |g: &dyn Fn(&crate::query::run::ScaledStance) -> f64, max: bool| {
+                both.then(|| {
+                    let (a, b) = (g(solved[0]), g(solved[1]));
+                    if max {
+                        a.max(b)
+                    } else {
+                        a.min(b)
+                    }
+                })
+            };
+            crate::plot::runs::RunPoint {
+                cycle: i % n_cycles.max(1),
+                speed_mps: r.candidate.speed,
+                beta_h: solved.iter().map(|s| s.solution.beta[0]).collect(),
+                mu_min: agg(&|s| s.verdict.mu_req, true),
+                ext_min_m: agg(&|s| s.verdict.ext_min, false),
+                ext_max_m: agg(&|s| s.verdict.ext_max, true),
+                limits: (r.limits[0].mu, r.limits[0].chi_min, r.limits[0].chi_max),
+                feasible: r.candidate.feasible(),
+                violated: r.violated(),
+            }
+        })
+        .collect()
 }
 
 /// The clips whose flights say their time base is wrong (`s_eff` outside [0.9, 1.1]).
@@ -195,14 +240,31 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
         }
     }
     let mut df = run_table(&rows)?;
-    let kv = query_kv(serde_json::json!({
-        "query": "run", "lib": a.lib, "speeds_mps": speeds,
-        "length_scale": length, "mass_scale": mass,
-        "limits": form.name(), "mu": mu, "active_set": active,
-    }));
+    let kv = query_kv(
+        &a.lib,
+        serde_json::json!({
+            "query": "run", "lib": a.lib, "speeds_mps": speeds,
+            "length_scale": length, "mass_scale": mass,
+            "limits": form.name(), "mu": mu, "active_set": active,
+        }),
+    )?;
     write_table(&a.out, &mut df, &kv)?;
+    if let Some(png) = &a.png {
+        let points = run_points(&rows, scaled.len());
+        let title = format!(
+            "query run: {} cycle(s), limits {}{}",
+            scaled.len(),
+            form.name(),
+            if (length, mass) == (1.0, 1.0) {
+                String::new()
+            } else {
+                format!(", character L = {length}, M = {mass}")
+            }
+        );
+        super::write_png(png, |p| crate::plot::runs::runs_png(p, &title, &points))?;
+    }
     print_run(&rows);
-    println!(
+    crate::say!(
         "query run: {} cycle(s) × {} speed(s) → {}",
         scaled.len(),
         speeds.len(),
@@ -212,7 +274,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
 }
 
 fn print_run(rows: &[RunRow]) {
-    println!(
+    crate::say!(
         "{:>6} {:<34} {:>6} {:>6} {:>6} {:>7} {:>7} {:>7} {:>8}",
         "v_mps",
         "cycle (first stance)",
@@ -235,7 +297,7 @@ fn print_run(rows: &[RunRow]) {
         let mu = mu
             .collect::<Option<Vec<f64>>>()
             .map(|v| v.into_iter().fold(0.0, f64::max));
-        println!(
+        crate::say!(
             "{:>6.2} {:<34} {:>6} {:>6} {:>6} {:>7} {:>7} {:>7} {:>8}",
             r.candidate.speed,
             r.stances[0].stance.stance_id,
@@ -292,14 +354,25 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         })
     });
     let mut df = jump_table(&rows)?;
-    let kv = query_kv(serde_json::json!({
-        "query": "jump", "lib": a.lib, "height_m": a.height, "distance_m": a.distance,
-        "limits": form.name(), "mu": mu, "active_set": active,
-    }));
+    let kv = query_kv(
+        &a.lib,
+        serde_json::json!({
+            "query": "jump", "lib": a.lib, "height_m": a.height, "distance_m": a.distance,
+            "limits": form.name(), "mu": mu, "active_set": active,
+        }),
+    )?;
     write_table(&a.out, &mut df, &kv)?;
-    println!(
+    crate::say!(
         "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8}",
-        "rank", "liftoff", "landing", "u_apex", "β_h1", "β_v1", "β_h2", "β_v2", "feasible"
+        "rank",
+        "liftoff",
+        "landing",
+        "u_apex",
+        "β_h1",
+        "β_v1",
+        "β_h2",
+        "β_v2",
+        "feasible"
     );
     for (i, r) in rows.iter().take(a.top).enumerate() {
         let b = |k: usize, ax: usize| {
@@ -311,7 +384,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
             .jump
             .as_ref()
             .map_or("-".into(), |j| format!("{:.3}", j.u_apex));
-        println!(
+        crate::say!(
             "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8}",
             i + 1,
             r.liftoff.stance.stance_id,
@@ -328,7 +401,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         .iter()
         .filter(|r| r.jump.as_ref().is_ok_and(|j| j.feasible()))
         .count();
-    println!(
+    crate::say!(
         "query jump: {} pair(s), {} feasible → {}",
         rows.len(),
         n_ok,

@@ -75,6 +75,7 @@ fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> an
                 active_set,
             },
             out: dir.join("runs.parquet"),
+            png: None,
         })?;
     }
     if q.jump_map == Some(true) {

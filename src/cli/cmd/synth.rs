@@ -76,6 +76,6 @@ pub fn run(a: SynthArgs) -> anyhow::Result<Outcome> {
     }
     let truth = a.out.with_extension("truth.csv");
     std::fs::write(&truth, csv).with_context(|| format!("writing {}", truth.display()))?;
-    println!("wrote {} and {}", a.out.display(), truth.display());
+    crate::say!("wrote {} and {}", a.out.display(), truth.display());
     Ok(Outcome::Clean)
 }

@@ -89,7 +89,15 @@ pub(crate) fn character_polytopes(
 }
 
 /// The core's phases with every kinematic polytope resolved (inline, or from `--lib`).
-fn resolve(file: &PhasesFile, path: &Path, a: &TwopacArgs) -> anyhow::Result<Vec<Phase>> {
+///
+/// With `--clip` and no `--character`, the clip's own character is used (see
+/// [`clip_character`]).
+fn resolve(
+    file: &PhasesFile,
+    path: &Path,
+    a: &TwopacArgs,
+    clip_id: Option<&str>,
+) -> anyhow::Result<Vec<Phase>> {
     let named = file.named_kinematics();
     let library = if named.is_empty() {
         if let Some(lib) = &a.lib {
@@ -109,7 +117,13 @@ fn resolve(file: &PhasesFile, path: &Path, a: &TwopacArgs) -> anyhow::Result<Vec
                 named.join(", ")
             )
         })?;
-        character_polytopes(&read_library_polytopes(lib)?, a.character.as_deref(), lib)?
+        let all = read_library_polytopes(lib)?;
+        let character = match (&a.character, &a.clip) {
+            (Some(c), _) => Some(c.clone()),
+            (None, Some(clip)) => clip_character(clip, clip_id, lib, &all),
+            (None, None) => None,
+        };
+        character_polytopes(&all, character.as_deref(), lib)?
     };
     let lookup = |name: &str| library.get(name).cloned();
     file.to_phases(&lookup)
@@ -280,6 +294,12 @@ fn plot_data(
         quasi_static: qs.knots.iter().map(|k| k.1).collect(),
         transitions: p.transitions.iter().map(|t| t.point.com).collect(),
         phase_states: p.phase_states.iter().map(|s| s.com).collect(),
+        recorded: Vec::new(),
+        invalid: curve
+            .iter()
+            .filter(|r| !r.valid)
+            .map(|r| r.state.pos)
+            .collect(),
     }
 }
 
@@ -289,6 +309,8 @@ struct Recorded {
     time_s: Vec<f64>,
     com: Vec<[f64; 3]>,
     start_s: f64,
+    /// The clip's own `character_id` (skeleton id under default options).
+    character_id: Option<String>,
 }
 
 /// Phases from a clip (two-pac §1.1 `--clip`): ingest with the static / multi-contact
@@ -305,7 +327,9 @@ fn clip_phases(clip: &Path, has_lib: bool) -> anyhow::Result<(PhasesFile, Record
     opts.contacts.static_mode = true;
     let outcome = crate::ingest::ingest(&bvh, &opts).with_context(|| clip.display().to_string())?;
     let crate::ingest::ClipOutcome::Body {
-        frames, contacts, ..
+        frames,
+        contacts,
+        summary,
     } = outcome
     else {
         anyhow::bail!("{}: not a body or too short to plan", clip.display());
@@ -348,8 +372,36 @@ fn clip_phases(clip: &Path, has_lib: bool) -> anyhow::Result<(PhasesFile, Record
         time_s: frames.time_s,
         com: frames.com,
         start_s,
+        character_id: summary.character_id,
     };
     Ok((file, rec))
+}
+
+/// The character of a `--clip` in the library `lib`: that of the library's clip with the
+/// same content (SHA-256, `clips.parquet`), else the clip's own skeleton id when the
+/// library has polytopes for it; `None` leaves the choice to `--character`.
+fn clip_character(
+    clip: &Path,
+    own_id: Option<&str>,
+    lib: &Path,
+    all: &BTreeMap<(String, String), Polytope>,
+) -> Option<String> {
+    let has = |id: &str| all.keys().any(|(c, _)| c == id);
+    let sha = crate::pipeline::batch::file_sha256(clip);
+    let clips = crate::library::read::Table::open_columns(
+        &lib.join(crate::library::schema::CLIPS_FILE),
+        &["content_sha256", "character_id"],
+    )
+    .ok();
+    let from_library = sha.zip(clips).and_then(|(sha, t)| {
+        let shas = t.strings("content_sha256").ok()?;
+        let ids = t.df.column("character_id").ok()?.str().ok()?.clone();
+        let row = shas.iter().position(|s| *s == sha)?;
+        ids.get(row).map(str::to_string)
+    });
+    from_library
+        .filter(|id| has(id))
+        .or_else(|| own_id.filter(|id| has(id)).map(str::to_string))
 }
 
 /// Friction coefficient of contacts taken from a clip (two-pac §1 default).
@@ -377,7 +429,8 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
             (file, path, None)
         }
     };
-    let phases = resolve(&file, &path, &a)?;
+    let clip_id = recorded.as_ref().and_then(|r| r.character_id.as_deref());
+    let phases = resolve(&file, &path, &a, clip_id)?;
     let opts = PlanOptions {
         form,
         ..PlanOptions::default()
@@ -463,7 +516,19 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
         "timings.json",
         &(serde_json::to_string_pretty(&timings)? + "\n"),
     )?;
-    let data = plot_data(&phases, &p, &curve_rows, &qs);
+    let mut data = plot_data(&phases, &p, &curve_rows, &qs);
+    if let (Some(rec), Some(first), Some(last)) = (&recorded, curve_rows.first(), curve_rows.last())
+    {
+        // The recorded COM over the planned span (plan time 0 = clip time start_s).
+        let (t0, t1) = (rec.start_s + first.t_s, rec.start_s + last.t_s);
+        data.recorded = rec
+            .time_s
+            .iter()
+            .zip(&rec.com)
+            .filter(|(t, _)| (t0..=t1).contains(*t))
+            .map(|(_, c)| *c)
+            .collect();
+    }
     super::write_png(&a.out.join("trajectory.png"), |path| {
         trajectory_png(path, &data)
     })?;
@@ -485,7 +550,7 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
             "recorded.json",
             &(serde_json::to_string_pretty(&cmp)? + "\n"),
         )?;
-        println!(
+        crate::say!(
             "  recorded COM vs 2PAC COM over the planned span: RMS {} m",
             rms.map_or("-".into(), |v| format!("{v:.4}"))
         );
@@ -497,7 +562,7 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
         .filter(|t| t.point.is_static(1e-6))
         .count();
     let n_viol: usize = p.windows.iter().map(|w| w.violations.len()).sum();
-    println!(
+    crate::say!(
         "twopac: {} phase(s), {} transition(s) ({n_static} statically feasible), {} window(s), \
          {n_viol} kinematic guarantee violation(s); planned in {:.3} ms",
         phases.len(),
@@ -506,7 +571,7 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
         plan_s * 1e3
     );
     for (name, v) in [("2pac", &v_curve), ("quasi-static", &v_qs)] {
-        println!(
+        crate::say!(
             "  {name}: {} samples, point_valid_rate {:.3}, trajectory_valid {}, max s* {:.3} N at {:.2} s",
             v.samples.len(),
             v.point_valid_rate,
@@ -515,7 +580,7 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
             v.worst_t_s
         );
     }
-    println!("  → {}", a.out.display());
+    crate::say!("  → {}", a.out.display());
     Ok(Outcome::Clean)
 }
 
@@ -551,5 +616,38 @@ mod tests {
         assert_eq!(got["left_foot"], all[&("b".into(), "left_foot".into())]);
         assert!(character_polytopes(&all, Some("z"), Path::new("L")).is_err());
         assert!(character_polytopes(&BTreeMap::new(), None, Path::new("L")).is_err());
+    }
+
+    // See: issue 17 item 6 — `twopac --clip` made the user look up the clip's character.
+    #[test]
+    fn a_clip_finds_its_own_character() {
+        use polars::prelude::{Column, DataFrame};
+        let dir = tempfile::tempdir().unwrap();
+        let clip = dir.path().join("walk.bvh");
+        std::fs::write(&clip, "not parsed here: only its bytes are hashed").unwrap();
+        let other = dir.path().join("other.bvh");
+        std::fs::write(&other, "another clip").unwrap();
+        let sha = crate::pipeline::batch::file_sha256(&clip).unwrap();
+        let mut df = DataFrame::new_infer_height(vec![
+            Column::new("content_sha256".into(), vec![sha, "0".repeat(64)]),
+            Column::new("character_id".into(), ["sk-b", "sk-c"]),
+        ])
+        .unwrap();
+        crate::library::write::write_atomic(
+            dir.path(),
+            crate::library::schema::CLIPS_FILE,
+            &mut df,
+            &[],
+        )
+        .unwrap();
+        let all = lib(&[("sk-a", "left_foot"), ("sk-b", "left_foot")]);
+        // The library's clip of the same content wins over the clip's own skeleton id.
+        let got = clip_character(&clip, Some("sk-a"), dir.path(), &all);
+        assert_eq!(got.as_deref(), Some("sk-b"));
+        // A clip the library does not hold: its own id, when the library has polytopes for it.
+        let got = clip_character(&other, Some("sk-a"), dir.path(), &all);
+        assert_eq!(got.as_deref(), Some("sk-a"));
+        assert_eq!(clip_character(&other, Some("sk-z"), dir.path(), &all), None);
+        assert_eq!(clip_character(&other, None, dir.path(), &all), None);
     }
 }

@@ -1,0 +1,170 @@
+//! What a library holds, in one screen (`stancelib info LIB`): its clips and characters,
+//! stances by label and boundary kind, failures by stage, the build's options and
+//! per-character limits, and its provenance (tool and schema version, date, command line).
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::provenance::manifest_sha256;
+use super::read::Table;
+use super::schema::{CLIPS_FILE, ERRORS_FILE, MANIFEST_FILE, STANCES_FILE};
+use crate::error::{Error, Result};
+
+/// Counts of each distinct value, sorted by value.
+pub type Counts = BTreeMap<String, usize>;
+
+/// The summary of one library.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LibraryInfo {
+    /// The library folder as given.
+    pub library: PathBuf,
+    /// SHA-256 of `manifest.json` (what query outputs record).
+    pub manifest_sha256: String,
+    /// `schema_version` of the manifest.
+    pub schema_version: Option<String>,
+    /// Version of the tool that built it.
+    pub tool_version: Option<String>,
+    /// When it was built (RFC 3339 UTC); absent in libraries of older versions.
+    pub created_utc: Option<String>,
+    /// The command line that built it; absent in libraries of older versions.
+    pub command_line: Option<Vec<String>>,
+    /// Input files by `status` (`ok`, `skipped`, `error`).
+    pub clips_by_status: Counts,
+    /// Clips of each character (`character_id`; clips that failed have none).
+    pub clips_by_character: Counts,
+    /// Stances by `label` (`L`, `R`, `LR`, …).
+    pub stances_by_label: Counts,
+    /// Stance starts by boundary kind (`flight`, `no_flight`, `rest`, …).
+    pub boundary_start: Counts,
+    /// Stance ends by boundary kind.
+    pub boundary_end: Counts,
+    /// Stances by force model (`ratio`, `fourier`).
+    pub stances_by_force_model: Counts,
+    /// Failed inputs by `stage` of `errors.parquet`.
+    pub failures_by_stage: Counts,
+    /// The build options (manifest `options`).
+    pub options: serde_json::Value,
+    /// Per-character limits (manifest `limits`).
+    pub limits: serde_json::Value,
+}
+
+impl LibraryInfo {
+    /// Number of stances.
+    pub fn stances(&self) -> usize {
+        self.stances_by_label.values().sum()
+    }
+}
+
+fn counts<'a>(values: impl IntoIterator<Item = Option<&'a str>>) -> Counts {
+    let mut c = Counts::new();
+    for v in values.into_iter().flatten() {
+        *c.entry(v.to_string()).or_default() += 1;
+    }
+    c
+}
+
+/// Counts of the string column `name` of `t` (nulls not counted).
+fn column_counts(t: &Table, name: &str) -> Result<Counts> {
+    let c =
+        t.df.column(name)
+            .map_err(|_| Error::column(&t.path, name, None, "missing"))?;
+    let s = c
+        .str()
+        .map_err(|_| Error::column(&t.path, name, None, "expected string"))?;
+    Ok(counts(s.iter()))
+}
+
+/// Reads the summary of the library `lib`.
+///
+/// # Errors
+/// A missing or malformed `manifest.json`, `clips.parquet`, `stances.parquet` or
+/// `errors.parquet` (the error names the file and column).
+pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
+    let mpath = lib.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&mpath).map_err(|e| Error::io(&mpath, "cannot read", e))?;
+    let m: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::invalid(mpath.display().to_string(), e.to_string()))?;
+    let s = |k: &str| m.get(k).and_then(|v| v.as_str()).map(str::to_string);
+    let clips = Table::open_columns(&lib.join(CLIPS_FILE), &["status", "character_id"])?;
+    let stances = Table::open_columns(
+        &lib.join(STANCES_FILE),
+        &["label", "boundary_start", "boundary_end", "force_model"],
+    )?;
+    let errors = Table::open_columns(&lib.join(ERRORS_FILE), &["stage"])?;
+    Ok(LibraryInfo {
+        library: lib.to_path_buf(),
+        manifest_sha256: manifest_sha256(lib)?,
+        schema_version: s("schema_version"),
+        tool_version: s("tool_version"),
+        created_utc: s("created_utc"),
+        command_line: m
+            .get("command_line")
+            .and_then(|v| serde_json::from_value(v.clone()).ok()),
+        clips_by_status: column_counts(&clips, "status")?,
+        clips_by_character: column_counts(&clips, "character_id")?,
+        stances_by_label: column_counts(&stances, "label")?,
+        boundary_start: column_counts(&stances, "boundary_start")?,
+        boundary_end: column_counts(&stances, "boundary_end")?,
+        stances_by_force_model: column_counts(&stances, "force_model")?,
+        failures_by_stage: column_counts(&errors, "stage")?,
+        options: m.get("options").cloned().unwrap_or_default(),
+        limits: m.get("limits").cloned().unwrap_or_default(),
+    })
+}
+
+fn write_counts(f: &mut fmt::Formatter<'_>, title: &str, c: &Counts) -> fmt::Result {
+    let total: usize = c.values().sum();
+    let parts: Vec<String> = c.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    let list = if parts.is_empty() {
+        "none".to_string()
+    } else {
+        parts.join(", ")
+    };
+    writeln!(f, "{title:<20} {total:>6}   {list}")
+}
+
+impl fmt::Display for LibraryInfo {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let or = |v: &Option<String>| v.clone().unwrap_or_else(|| "(not recorded)".into());
+        writeln!(f, "library {}", self.library.display())?;
+        writeln!(
+            f,
+            "  tool {}, schema {}, built {}",
+            or(&self.tool_version),
+            or(&self.schema_version),
+            or(&self.created_utc)
+        )?;
+        if let Some(cmd) = &self.command_line {
+            writeln!(f, "  command: {}", cmd.join(" "))?;
+        }
+        writeln!(f, "  manifest sha256 {}", self.manifest_sha256)?;
+        write_counts(f, "clips", &self.clips_by_status)?;
+        write_counts(f, "characters (clips)", &self.clips_by_character)?;
+        write_counts(f, "stances by label", &self.stances_by_label)?;
+        write_counts(f, "  starting at", &self.boundary_start)?;
+        write_counts(f, "  ending at", &self.boundary_end)?;
+        write_counts(f, "  force model", &self.stances_by_force_model)?;
+        write_counts(f, "failures by stage", &self.failures_by_stage)?;
+        if let Some(chars) = self.limits.as_object() {
+            writeln!(f, "per-character limits:")?;
+            for (id, l) in chars {
+                let g = |k: &str| l.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+                let from = l.get("source").and_then(|v| v.as_str()).unwrap_or("?");
+                let n = l.get("n_stances").and_then(|v| v.as_u64()).unwrap_or(0);
+                writeln!(
+                    f,
+                    "  {id}: mu {:.2}, F_max {:.0} N, chi_min {:.3} m, chi_max {:.3} m \
+                     ({n} stances, from the {from})",
+                    g("mu"),
+                    g("f_max_n"),
+                    g("chi_min_m"),
+                    g("chi_max_m")
+                )?;
+            }
+        }
+        write!(f, "options: {}", self.options)
+    }
+}
