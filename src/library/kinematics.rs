@@ -267,28 +267,7 @@ impl SampleStore {
             .iter()
             .flat_map(|(k, g)| g.iter().map(move |s| (k, s)))
             .collect();
-        let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
-        DataFrame::new_infer_height(vec![
-            col(
-                "character_id",
-                rows.iter().map(|(k, _)| k.0.as_str()).collect::<Vec<_>>(),
-            ),
-            col(
-                "effector",
-                rows.iter().map(|(k, _)| k.1.as_str()).collect::<Vec<_>>(),
-            ),
-            col(
-                "clip",
-                rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
-            ),
-            col(
-                "frame",
-                rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
-            ),
-            col("x", p(0)),
-            col("y", p(1)),
-            col("z", p(2)),
-        ])
+        points_table(&rows)
     }
 
     /// The two kinematics tables (`(facets, points)`) with each character's leg length (m).
@@ -391,28 +370,7 @@ fn kinematics_from_groups(
         .iter()
         .flat_map(|(k, g)| g.iter().map(move |s| (*k, *s)))
         .collect();
-    let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
-    let points_df = DataFrame::new_infer_height(vec![
-        col(
-            "character_id",
-            rows.iter().map(|(k, _)| k.0.clone()).collect::<Vec<_>>(),
-        ),
-        col(
-            "effector",
-            rows.iter().map(|(k, _)| k.1.clone()).collect::<Vec<_>>(),
-        ),
-        col(
-            "clip",
-            rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
-        ),
-        col(
-            "frame",
-            rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
-        ),
-        col("x", p(0)),
-        col("y", p(1)),
-        col("z", p(2)),
-    ])?;
+    let points_df = points_table(&rows)?;
     Ok((facet_df, points_df))
 }
 
@@ -446,4 +404,31 @@ pub fn read_polytopes(lib_dir: &Path) -> Result<BTreeMap<(String, String), Polyt
         .into_iter()
         .map(|(k, p)| (k, Polytope::new(p.a, p.b)))
         .collect())
+}
+
+/// The contact samples behind the polytopes, one row per sample: `character_id`,
+/// `effector`, `clip`, `frame`, `x`, `y`, `z` (m).
+fn points_table(rows: &[(&(String, String), &Sample)]) -> PolarsResult<DataFrame> {
+    let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
+    DataFrame::new_infer_height(vec![
+        col(
+            "character_id",
+            rows.iter().map(|(k, _)| k.0.as_str()).collect::<Vec<_>>(),
+        ),
+        col(
+            "effector",
+            rows.iter().map(|(k, _)| k.1.as_str()).collect::<Vec<_>>(),
+        ),
+        col(
+            "clip",
+            rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
+        ),
+        col(
+            "frame",
+            rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
+        ),
+        col("x", p(0)),
+        col("y", p(1)),
+        col("z", p(2)),
+    ])
 }
