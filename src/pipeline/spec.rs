@@ -706,8 +706,8 @@ mod tests {
         let p = Path::new("pipelines/demo.toml");
         assert_eq!(relative_to(p, "../out/demo"), PathBuf::from("out/demo"));
         assert_eq!(
-            relative_to(p, "../../shared/x"),
-            PathBuf::from("../shared/x")
+            relative_to(p, "../../elsewhere/x"),
+            PathBuf::from("../elsewhere/x")
         );
         assert_eq!(
             relative_to(Path::new("demo.toml"), "out"),
