@@ -510,6 +510,14 @@ fn infeasible_run_is_refused_naming_the_constraint_and_writes_nothing() {
     assert!(v > 0, "violated column names the failing constraint");
 }
 
+/// The first liftoff stance followed by a landing stance: their indices.
+fn first_jump(s: &[stancelib::query::pool::PoolStance]) -> Option<(usize, usize)> {
+    (1..s.len()).find_map(|i| {
+        (stancelib::query::jump::is_liftoff(&s[i - 1]) && stancelib::query::jump::is_landing(&s[i]))
+            .then_some((i - 1, i))
+    })
+}
+
 #[test]
 fn edited_jumps_reach_the_requested_apex_and_round_trip() {
     let dir = tmp();
@@ -517,13 +525,7 @@ fn edited_jumps_reach_the_requested_apex_and_round_trip() {
     let lib = library(dir.path(), std::slice::from_ref(&src));
     let l = open_library(&lib).unwrap();
     let s = &l.stances;
-    let (i, j) = (1..s.len())
-        .find_map(|i| {
-            (stancelib::query::jump::is_liftoff(&s[i - 1])
-                && stancelib::query::jump::is_landing(&s[i]))
-            .then_some((i - 1, i))
-        })
-        .expect("a recorded jump");
+    let (i, j) = first_jump(s).expect("a recorded jump");
     let (h0, d0) = stancelib::query::jump::recorded_jump(&s[i], &s[j]);
     // Known miss (measured 2026-12-02): at 1.2 × the recorded apex the support feet are out
     // of reach at the end of the push and start of the landing (11 frames reported): the
@@ -547,13 +549,7 @@ fn edited_jumps_reach_the_requested_apex_and_round_trip() {
         let rl = library(sub.path(), std::slice::from_ref(&out));
         let r = open_library(&rl).unwrap();
         let rs = &r.stances;
-        let (a, b) = (1..rs.len())
-            .find_map(|k| {
-                (stancelib::query::jump::is_liftoff(&rs[k - 1])
-                    && stancelib::query::jump::is_landing(&rs[k]))
-                .then_some((k - 1, k))
-            })
-            .expect("the rebuilt clip has a jump");
+        let (a, b) = first_jump(rs).expect("the rebuilt clip has a jump");
         let (h, d) = stancelib::query::jump::recorded_jump(&rs[a], &rs[b]);
         eprintln!(
             "jump ×{scale}: apex {h:.4} m (asked {:.4}), distance {d:.4} m (asked {d0:.4})",

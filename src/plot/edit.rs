@@ -6,7 +6,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, register_font, PlotError};
+use super::{draw_legend, err, register_font, PlotError};
 
 /// What the edit plot shows (world frame, m).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -89,14 +89,7 @@ fn view(
         .map_err(|e| err(path, e))?
         .label("footprints (planned contact points)")
         .legend(|(x, y)| Cross::new((x + 8, y), 6, RED.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| err(path, e))?;
+    draw_legend(&mut chart, path)?;
     Ok(())
 }
 

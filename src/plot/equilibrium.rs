@@ -17,7 +17,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{err, register_font, PlotError};
+use super::{draw_legend, err, register_font, PlotError};
 
 /// Cells per axis of the slice.
 pub const DEFAULT_SLICE_CELLS: usize = 80;
@@ -138,14 +138,7 @@ pub fn equilibrium_png(path: &Path, d: &EquilibriumPlot) -> Result<(), PlotError
         .map_err(|e| err(path, e))?
         .label("COM state not in equilibrium")
         .legend(|(x, y)| Circle::new((x + 6, y), 3, RED.filled()));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| err(path, e))?;
+    draw_legend(&mut chart, path)?;
     root.present().map_err(|e| err(path, e))?;
     Ok(())
 }
