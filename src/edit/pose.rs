@@ -14,7 +14,7 @@
 //!            knee: rotate the shank about n = (H − K) × (A − K) to |A − H| = |ankle* − H|
 //!            hip:  the smallest rotation taking A − H onto ankle* − H
 //! root       t_root ← t_root + to_file(c_plan − COM(q))  (COM is affine in t_root)
-//!            repeat IK and root until |c_plan − COM| ≤ tol, at most max_iterations
+//!            repeat IK and root until |c_plan − COM| ≤ solve tol (10 µm), at most max_iterations
 //! ```
 //! `c` is the contact point (COM at touchdown plus the stance's contact point `cp`), so the
 //! reference foot's motion about its contact point, heel–toe roll included, is kept and
@@ -610,7 +610,7 @@ pub fn pose_frame(
         com_pose = body.com(&ws.pts);
         let e = sub(com_plan, com_pose);
         err_m = norm(e);
-        if err_m <= opts.com_tol_m {
+        if err_m <= opts.com_solve_tol_m {
             break;
         }
         let d = body.to_file(e);
@@ -620,7 +620,7 @@ pub fn pose_frame(
             }
         }
     }
-    if err_m > opts.com_tol_m {
+    if err_m > opts.com_solve_tol_m {
         // The last root shift is not yet seen by FK: measure the pose as written.
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
         com_pose = body.com(&ws.pts);
