@@ -33,6 +33,7 @@ import os
 import shutil
 import subprocess
 import sys
+import time
 
 # Longest tail of a failed shard's stderr carried back to the driver, characters.
 MAX_ERROR_CHARS = 2000
@@ -99,8 +100,17 @@ def shard_task(spec):
     return index, r.returncode, r.stderr[-MAX_ERROR_CHARS:]
 
 
+def report_phases(phases, count, master):
+    """One line on stderr: where the wall time went (Spark start, shards, merge), s."""
+    total = sum(t for _, t in phases)
+    parts = ", ".join("%s %.2f s" % (name, t) for name, t in phases)
+    sys.stderr.write("stancelib-spark: %s; total %.2f s (%d shards on %s)\n"
+                     % (parts, total, count, master or "spark-submit's master"))
+
+
 def main(argv):
     args = parse_args(argv)
+    t0 = time.monotonic()
     os.environ.setdefault("PYSPARK_PYTHON", sys.executable)
     from pyspark.sql import SparkSession
 
@@ -118,6 +128,7 @@ def main(argv):
                          .config("spark.ui.enabled", "false")
     spark = builder.getOrCreate()
     sc = spark.sparkContext
+    t_session = time.monotonic()
     count = args.shards or sc.defaultParallelism
     out = os.path.abspath(args.out)
     work = os.path.abspath(args.work or os.path.join(
@@ -130,6 +141,7 @@ def main(argv):
              for i in range(1, count + 1)]
     # One partition per shard: Spark runs each shard as one task, retrying lost executors.
     results = sc.parallelize(specs, count).map(shard_task).collect()
+    t_shards = time.monotonic()
     spark.stop()
     # 0: every clip ok; 1: some clips failed (their rows say why); anything else: the build
     # of the shard did not finish.
@@ -140,7 +152,12 @@ def main(argv):
         sys.stderr.write("nothing merged; %s is unchanged\n" % out)
         return 2
     shards = [os.path.join(work, "shard-%d" % i) for i in range(1, count + 1)]
+    t_merge0 = time.monotonic()
     merge = subprocess.run([resolve_binary(args.stancelib), "merge", *shards, "--out", out])
+    t_end = time.monotonic()
+    report_phases([("Spark start", t_session - t0), ("shards", t_shards - t_session),
+                   ("Spark stop", t_merge0 - t_shards), ("merge", t_end - t_merge0)],
+                  count, master)
     if merge.returncode in (0, 1) and not (args.keep_shards or args.incremental):
         shutil.rmtree(work, ignore_errors=True)
     return merge.returncode
