@@ -99,9 +99,13 @@ pub fn write_writer<W: Write>(mut w: W, h: &Hierarchy, m: &Motion) -> Result<()>
     }
     let io = |e: std::io::Error| Error::io(Path::new("<bvh>"), "cannot write", e);
     w.write_all(hierarchy_text(h).as_bytes()).map_err(io)?;
-    let mut s = format!("MOTION\nFrames: {}\nFrame Time: ", m.n_frames());
-    num(&mut s, m.frame_time_s);
-    s.push('\n');
+    // The frame time in full (Rust's shortest round-trip form): a clip written here reads
+    // back with its source's exact clock, and 10 digits would drift by 3e-13 s a frame.
+    let mut s = format!(
+        "MOTION\nFrames: {}\nFrame Time: {}\n",
+        m.n_frames(),
+        m.frame_time_s
+    );
     for f in 0..m.n_frames() {
         for (k, &v) in m.row(f).iter().enumerate() {
             if k > 0 {

@@ -93,6 +93,48 @@ pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
     ]
 }
 
+/// Most refinements of `k` by [`refine_run_k`].
+pub const MAX_SPEED_ITERATIONS: usize = 8;
+/// Relative tolerance on the planned cycle speed of [`refine_run_k`].
+pub const SPEED_TOL: f64 = 1e-4;
+
+/// Mean speed of a solved run cycle, m/s: `Σ x_k / Σ T_k` (heading distance and
+/// apex-to-apex time of each stance, as `v_orig` is defined).
+pub fn cycle_speed(stances: &[EditStance]) -> f64 {
+    let x: f64 = stances.iter().map(|e| e.request.x).sum();
+    let t: f64 = stances.iter().map(|e| e.scaled.solution.t_e).sum();
+    x / t
+}
+
+/// The run policy's `k` refined so that the solved periodic cycle runs at `speed` (m/s).
+///
+/// `k = v / v_orig` scales `x` and the edge speeds, but the periodic requests (module docs)
+/// keep `vp` and average the joins, so the solved times `T_k` move and the planned mean
+/// speed `Σ x_k / Σ T_k` is not exactly `v` (1.89 m/s for a 2 m/s request on the
+/// 3.5 m/s fixture run). Fixed point `k ← k · v / cycle_speed(k)`, at most
+/// [`MAX_SPEED_ITERATIONS`] times, until within [`SPEED_TOL`]; the last `k` whose cycle
+/// solves is kept (the first one's error is returned when `k0` itself does not solve).
+pub fn refine_run_k(
+    speed: f64,
+    k0: f64,
+    mut solve: impl FnMut(f64) -> Result<Vec<EditStance>, String>,
+) -> (f64, Result<Vec<EditStance>, String>) {
+    let (mut k, mut best) = (k0, solve(k0));
+    for _ in 0..MAX_SPEED_ITERATIONS {
+        let Ok(cycle) = &best else { break };
+        let v = cycle_speed(cycle);
+        if !(v.is_finite() && v > 0.0) || (v - speed).abs() <= SPEED_TOL * speed {
+            break;
+        }
+        let next = k * speed / v;
+        match solve(next) {
+            Ok(c) => (k, best) = (next, Ok(c)),
+            Err(_) => break,
+        }
+    }
+    (k, best)
+}
+
 /// Solves and checks one request of an edit.
 ///
 /// # Errors

@@ -697,23 +697,25 @@ fn write_angles(r: &Reference, ws: &mut PoseWorkspace) {
     prev.copy_from_slice(&ws.pose.row);
 }
 
-/// Poses every output frame `t = t_start + i/fps` of the plan.
+/// Poses every output frame `t = t_start + i·Δt` of the plan (`frame_time_s` = Δt, s: the
+/// source clip's own value unless `--fps`, so that the written `Frame Time` is the source's).
 pub fn pose_motion(
     r: &Reference,
     path: &ComPath,
     src: &[StanceSource],
     opts: &EditOptions,
-    fps: f64,
+    frame_time_s: f64,
 ) -> EditedMotion {
-    let n = ((path.t_end - path.t_start) * fps + 1e-9).floor() as usize + 1;
+    let dt = frame_time_s;
+    let n = ((path.t_end - path.t_start) / dt + 1e-9).floor() as usize + 1;
     let nc = r.body.skeleton.n_channels;
     let mut values = Vec::with_capacity(n * nc);
     let mut frames = Vec::with_capacity(n);
     let mut ws = PoseWorkspace::new(r);
     for i in 0..n {
-        let t = path.t_start + i as f64 / fps;
+        let t = path.t_start + i as f64 * dt;
         let mut f = pose_frame(r, path, src, opts, t, &mut ws);
-        f.time_s = i as f64 / fps;
+        f.time_s = i as f64 * dt;
         write_angles(r, &mut ws);
         values.extend_from_slice(&ws.pose.row);
         frames.push(f);
@@ -721,7 +723,7 @@ pub fn pose_motion(
     EditedMotion {
         motion: Motion {
             frames_header: Some(n as u64),
-            frame_time_s: 1.0 / fps,
+            frame_time_s: dt,
             n_channels: nc,
             values,
         },

@@ -13,6 +13,8 @@
 //! FK in file units and axes; [`BodyModel::points`] and [`BodyModel::com`] in metres,
 //! internal Z-up frame.
 
+use std::collections::BTreeMap;
+
 use super::kinematics::{choose_toe, facing, fk_frames, side_points, toe_tip};
 use crate::bvh::Bvh;
 use crate::error::{Error, Result};
@@ -47,14 +49,22 @@ pub struct BodyModel {
 
 impl BodyModel {
     /// The body of a parsed clip with a known unit and up axis (as `clips.parquet` records
-    /// them); the toe rules are chosen on the clip's frames as the ingest chooses them.
+    /// them), de Leva column `sex` and landmark overrides `landmarks` (as the library's
+    /// manifest records them); the toe rules are chosen on the clip's frames as the ingest
+    /// chooses them.
     ///
     /// # Errors
     /// The skeleton maps onto no body (`ErrorKind::Skeleton`).
-    pub fn new(bvh: &Bvh, unit_m: f64, up: UpAxis, sex: Sex) -> Result<BodyModel> {
+    pub fn new(
+        bvh: &Bvh,
+        unit_m: f64,
+        up: UpAxis,
+        sex: Sex,
+        landmarks: &BTreeMap<String, String>,
+    ) -> Result<BodyModel> {
         let skel = Skeleton::from_bvh(bvh);
         let rest_file = fk::rest_pose(&skel);
-        let lm = match landmarks::map(&skel, &rest_file, &Default::default())? {
+        let lm = match landmarks::map(&skel, &rest_file, landmarks)? {
             Mapping::Found(lm) => lm,
             Mapping::NotABody => return Err(Error::skeleton("no body landmark found")),
         };

@@ -8,6 +8,7 @@
 //! names its library by [`LIBRARY_MANIFEST_KEY`]: the SHA-256 of that library's
 //! `manifest.json` bytes, so `sha256sum LIB/manifest.json` tells which build it came from.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -15,6 +16,7 @@ use sha2::{Digest, Sha256};
 
 use super::schema::MANIFEST_FILE;
 use crate::error::{Error, Result};
+use crate::skeleton::com::Sex;
 
 /// Key-value metadata key of a query output: SHA-256 (hex) of its library's
 /// `manifest.json`.
@@ -85,6 +87,41 @@ pub fn manifest_sha256(lib: &Path) -> Result<String> {
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect())
+}
+
+/// The body a library was built with: the de Leva column and the landmark overrides
+/// (manifest `options.ingest.sex`, `options.ingest.landmarks`), so that an edit poses its
+/// motion with the same segment model the library's COM was measured with. A manifest
+/// without them (older libraries) gives the defaults (male, no overrides).
+///
+/// # Errors
+/// The manifest cannot be read or parsed, or names an unknown sex (the field is named).
+pub fn library_body(lib: &Path) -> Result<(Sex, BTreeMap<String, String>)> {
+    let path = lib.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, "cannot read", e))?;
+    let m: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::config(Some(path.clone()), None, e.to_string()))?;
+    let ingest = &m["options"]["ingest"];
+    let sex = match ingest["sex"].as_str() {
+        None | Some("Male") => Sex::Male,
+        Some("Female") => Sex::Female,
+        Some(other) => {
+            return Err(Error::config(
+                Some(path),
+                None,
+                format!("options.ingest.sex: unknown value {other:?} (Male or Female)"),
+            ))
+        }
+    };
+    let landmarks = ingest["landmarks"]
+        .as_object()
+        .map(|o| {
+            o.iter()
+                .filter_map(|(k, v)| v.as_str().map(|v| (k.clone(), v.to_string())))
+                .collect()
+        })
+        .unwrap_or_default();
+    Ok((sex, landmarks))
 }
 
 #[cfg(test)]

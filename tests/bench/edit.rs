@@ -59,7 +59,14 @@ fn edit_one_second(c: &mut Criterion) {
         stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).expect("clips");
     let src = &info[&l.stances[cy.stances[0]].clip];
     let up = UpAxis::parse(src.up_axis.as_deref().unwrap()).unwrap();
-    let body = BodyModel::new(&bvh, src.unit_scale.unwrap(), up, Sex::Male).expect("body");
+    let body = BodyModel::new(
+        &bvh,
+        src.unit_scale.unwrap(),
+        up,
+        Sex::Male,
+        &Default::default(),
+    )
+    .expect("body");
     assert_eq!(body.skeleton.n_joints(), 31, "the CMU mb skeleton");
     let reference = Reference::new(body, bvh.motion.clone()).expect("reference");
     let order: Vec<usize> = (0..4).flat_map(|_| [0, 1]).collect();
@@ -68,7 +75,7 @@ fn edit_one_second(c: &mut Criterion) {
     let opts = EditOptions::default();
     let mut g = c.benchmark_group("edit");
     g.bench_function("one_second_120hz_31_joints", |b| {
-        b.iter(|| black_box(pose_motion(&reference, &path, &sources, &opts, 120.0)))
+        b.iter(|| black_box(pose_motion(&reference, &path, &sources, &opts, 1.0 / 120.0)))
     });
     g.finish();
 }

@@ -13,10 +13,13 @@ use super::query::{absolute_limits, load_pool, query_kv, stance_limits, time_sca
 use super::write_png;
 use crate::bvh::{parse_file, write_file, Bvh};
 use crate::edit::path::Phase;
-use crate::edit::plan::{place, run_requests, solve_stance, EditStance, StanceTiming};
+use crate::edit::plan::{
+    place, refine_run_k, run_requests, solve_stance, EditStance, StanceTiming,
+};
 use crate::edit::pose::{pose_motion, EditedMotion, Reference};
 use crate::edit::{EditOptions, MAX_CYCLES, MAX_FPS, MIN_FPS};
 use crate::ingest::body::BodyModel;
+use crate::library::provenance::library_body;
 use crate::library::read::{read_clip_sources, read_stance_timing, StanceLibrary};
 use crate::library::schema::{CLIPS_FILE, STANCES_FILE};
 use crate::pipeline::batch::file_sha256;
@@ -25,7 +28,6 @@ use crate::query::feasibility::LimitForm;
 use crate::query::jump::{is_landing, is_liftoff, jump, recorded_jump};
 use crate::query::pool::Prepared;
 use crate::query::run::{check_scale, check_speed, run_cycles};
-use crate::skeleton::com::Sex;
 use crate::skeleton::units::UpAxis;
 
 /// Stick figures in the plot, s apart.
@@ -144,12 +146,20 @@ fn compute(
 ) -> anyhow::Result<Edit> {
     let (bvh, unit, up) = source_clip(&c.lib, clip, c.source.as_deref())?;
     let bvh = scale_source(bvh, length);
-    let body = BodyModel::new(&bvh, unit, up, Sex::Male).with_context(|| format!("clip {clip}"))?;
-    let fps = c.fps.unwrap_or(1.0 / bvh.motion.frame_time_s);
+    let (sex, landmarks) = library_body(&c.lib)?;
+    let body =
+        BodyModel::new(&bvh, unit, up, sex, &landmarks).with_context(|| format!("clip {clip}"))?;
+    let frame_time_s = c.fps.map_or(bvh.motion.frame_time_s, |f| 1.0 / f);
     let reference =
         Reference::new(body, bvh.motion.clone()).with_context(|| format!("clip {clip}"))?;
     let (path, sources) = place(&stances, &order, &reference, jump, jump);
-    let edited = pose_motion(&reference, &path, &sources, &EditOptions::default(), fps);
+    let edited = pose_motion(
+        &reference,
+        &path,
+        &sources,
+        &EditOptions::default(),
+        frame_time_s,
+    );
     let footprints = path.stances.iter().map(|s| s.contact_point()).collect();
     let violated = stances.iter().filter_map(EditStance::violated).collect();
     Ok(Edit {
@@ -355,16 +365,17 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
             let prep = cy.stances.map(|i| {
                 Prepared::with_active_fraction(pool[i].stance.scaled(length, mass), active)
             });
-            let k = a.speed / (cy.v_orig * length.sqrt());
-            let req = run_requests([&prep[0].stance, &prep[1].stance], k);
-            let out = (0..2)
-                .map(|n| {
-                    let lim = stance_limits(&prep[n], form, &limits, mu);
-                    let i = cy.stances[n];
-                    solve_stance(&lib.stances[i], times[i], &prep[n], req[n], &lim)
-                })
-                .collect::<Result<Vec<_>, _>>();
-            (k, out)
+            let k0 = a.speed / (cy.v_orig * length.sqrt());
+            refine_run_k(a.speed, k0, |k| {
+                let req = run_requests([&prep[0].stance, &prep[1].stance], k);
+                (0..2)
+                    .map(|n| {
+                        let lim = stance_limits(&prep[n], form, &limits, mu);
+                        let i = cy.stances[n];
+                        solve_stance(&lib.stances[i], times[i], &prep[n], req[n], &lim)
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+            })
         })
         .collect();
     // Feasible first, then the least change of the recorded speed; ties by stance id.
