@@ -14,6 +14,8 @@
 //! - `edit_motion`: issue 14 — `edit run`/`edit jump` BVH re-ingested: COM on the plan,
 //!   planted feet, contact timing, speed, jump apex, flight curvature, joint steps, identity.
 //! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
+//! - `golden`: issue 13 — the demo job's outputs equal `fixtures/golden/demo/` (library
+//!   Parquet byte for byte, manifest without volatile fields, query outputs by content).
 //! - `regression`: one test per review finding, named after it.
 //! - `safety_outputs`: issue 11 — `--out` never destroys what the tool did not write; input
 //!   links, cycles and special files; per-input errors; stale temporaries; the build lock.
@@ -46,6 +48,7 @@ mod fixtures;
 mod force_export;
 mod forceplate;
 mod forceplate_stances;
+mod golden;
 mod kinematics;
 mod multicontact;
 mod props;

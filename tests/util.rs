@@ -234,3 +234,113 @@ pub fn ok(args: &[&str]) -> String {
     assert_eq!(code, 0, "stancelib {args:?}:\n{out}\n{err}");
     out
 }
+
+/// A scratch folder laid out like a checkout after `make demo`: `fixtures` (a link to the
+/// repository's), `pipelines/demo.toml` (a copy) and `out/demo`, built by
+/// `stancelib run pipelines/demo.toml` from inside it, as `make demo` does.
+pub struct Demo {
+    /// The scratch folder (removed on drop).
+    pub dir: tempfile::TempDir,
+}
+
+impl Demo {
+    /// The folder with `out/demo` built by the demo pipeline (library and query stages).
+    pub fn build() -> Demo {
+        let demo = Demo::empty();
+        let (code, out, err) = demo.sh("stancelib run pipelines/demo.toml");
+        assert_eq!(code, 0, "make demo's command failed:\n{out}\n{err}");
+        demo
+    }
+
+    /// The folder with `out/demo` a plain library of the fixtures (no query stages).
+    pub fn library() -> Demo {
+        let demo = Demo::empty();
+        let (code, out, err) = demo.sh("stancelib build fixtures/bvh/*.bvh --out out/demo");
+        assert_eq!(code, 0, "{out}\n{err}");
+        demo
+    }
+
+    /// The folder without any output yet.
+    pub fn empty() -> Demo {
+        let dir = tempfile::tempdir().unwrap();
+        std::os::unix::fs::symlink(root().join("fixtures"), dir.path().join("fixtures")).unwrap();
+        std::fs::create_dir(dir.path().join("pipelines")).unwrap();
+        std::fs::copy(
+            root().join("pipelines/demo.toml"),
+            dir.path().join("pipelines/demo.toml"),
+        )
+        .unwrap();
+        Demo { dir }
+    }
+
+    /// `out/demo` inside the folder.
+    pub fn lib(&self) -> PathBuf {
+        self.dir.path().join("out/demo")
+    }
+
+    /// Runs `line` with `sh -c` in the demo folder, the binary under test first on PATH.
+    pub fn sh(&self, line: &str) -> (i32, String, String) {
+        let bin = Path::new(env!("CARGO_BIN_EXE_stancelib"));
+        let path = format!(
+            "{}:{}",
+            bin.parent().unwrap().display(),
+            std::env::var("PATH").unwrap_or_default()
+        );
+        let o = std::process::Command::new("sh")
+            .args(["-c", line])
+            .current_dir(self.dir.path())
+            .env("PATH", path)
+            .output()
+            .unwrap();
+        (
+            o.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&o.stdout).into(),
+            String::from_utf8_lossy(&o.stderr).into(),
+        )
+    }
+}
+
+/// Manifest keys (at any depth) that change from one build to the next: build date,
+/// command line, wall time.
+pub const MANIFEST_VOLATILE_KEYS: [&str; 3] = ["created_utc", "command_line", "wall_time_s"];
+
+/// `v` without [`MANIFEST_VOLATILE_KEYS`], at every depth.
+pub fn without_volatile(v: serde_json::Value) -> serde_json::Value {
+    use serde_json::Value;
+    match v {
+        Value::Object(m) => Value::Object(
+            m.into_iter()
+                .filter(|(k, _)| !MANIFEST_VOLATILE_KEYS.contains(&k.as_str()))
+                .map(|(k, v)| (k, without_volatile(v)))
+                .collect(),
+        ),
+        Value::Array(a) => Value::Array(a.into_iter().map(without_volatile).collect()),
+        other => other,
+    }
+}
+
+/// `manifest.json` of a library (or any such file) without what changes from run to run.
+pub fn stable_manifest(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let v = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    without_volatile(v)
+}
+
+/// Every file below `dir`, relative to it, sorted (empty when `dir` does not exist).
+pub fn files_below(dir: &Path) -> std::collections::BTreeSet<PathBuf> {
+    fn walk(base: &Path, dir: &Path, out: &mut std::collections::BTreeSet<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(base, &p, out);
+            } else {
+                out.insert(p.strip_prefix(base).unwrap().to_path_buf());
+            }
+        }
+    }
+    let mut out = std::collections::BTreeSet::new();
+    if dir.is_dir() {
+        walk(dir, dir, &mut out);
+    }
+    out
+}
