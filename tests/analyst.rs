@@ -304,7 +304,11 @@ fn pyarrow_schema_metadata_shows_the_stancelib_keys() {
         .output()
         .is_ok_and(|o| o.status.success());
     if !has {
-        eprintln!("SKIPPED pyarrow_schema_metadata_shows_the_stancelib_keys: no pyarrow");
+        // .ci/run installs pyarrow: there, its absence is a failure.
+        crate::util::skip_or_fail(
+            "pyarrow_schema_metadata_shows_the_stancelib_keys",
+            "no pyarrow",
+        );
         return;
     }
     let demo = Demo::build();

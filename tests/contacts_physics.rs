@@ -13,15 +13,7 @@ use serde_json::Value;
 use stancelib::ingest::{ingest, ClipFrames, ClipOutcome, ClipSummary, ContactRun, IngestOptions};
 use stancelib::synth::{generate, SynthOptions};
 
-use crate::util;
-
-/// `writeln!` into a per-test buffer, printed in one piece.
-macro_rules! outln {
-    ($buf:expr, $($t:tt)*) => {{
-        use std::fmt::Write as _;
-        writeln!($buf, $($t)*).unwrap();
-    }};
-}
+use crate::util::{self, outln};
 
 type Ingested = (ClipSummary, ClipFrames, Vec<ContactRun>);
 

@@ -9,16 +9,7 @@ use serde_json::Value;
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
 use stancelib::math::savgol::{window_for_rate, SavGol};
 
-use crate::util;
-
-/// `writeln!` into a per-test buffer, printed in one piece so that the output of tests
-/// running in parallel does not interleave.
-macro_rules! outln {
-    ($buf:expr, $($t:tt)*) => {{
-        use std::fmt::Write as _;
-        writeln!($buf, $($t)*).unwrap();
-    }};
-}
+use crate::util::{self, outln};
 
 const CLIPS: [&str; 2] = ["hamner_s02_run_4ms", "opencap_s4_DJ1_dropjump"];
 /// g used by the data (meta.json `g_mps2`) and by the flight fits, m/s².

@@ -22,18 +22,10 @@ use serde_json::Value;
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
 use stancelib::stances::{build_clip, Stance, StanceOptions};
 
-/// `writeln!` into a per-test buffer, printed in one piece (tests run in parallel).
-macro_rules! outln {
-    ($buf:expr, $($t:tt)*) => {{
-        use std::fmt::Write as _;
-        writeln!($buf, $($t)*).unwrap();
-    }};
-}
-
 /// (clip, mean vertical RMSE target in BW): issue 12 (the Fourier model's floor,
 /// c0 + 3 harmonics fitted to the plate force itself, is 0.05 BW on the run and 0.17 on the
 /// drop jump).
-use crate::util;
+use crate::util::{self, outln};
 
 /// The asserted bounds are the issue's targets (measured: 0.126 BW on the run with
 /// sub-frame stance edges and the soft position target, 0.285 BW on the drop jump).
