@@ -6,7 +6,7 @@
 //! `data/forceplate/SOURCES.md`.
 
 use serde_json::Value;
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 use stancelib::math::savgol::{window_for_rate, SavGol};
 
 use crate::util::{self, outln};
@@ -59,14 +59,7 @@ fn contact_events_and_kinematic_force_match_the_force_plates() {
             mass_kg: mass,
             ..Default::default()
         };
-        let (summary, frames, contacts) = match ingest(&bvh, &opts).expect("ingest") {
-            ClipOutcome::Body {
-                summary,
-                frames,
-                contacts,
-            } => (summary, frames, contacts),
-            ClipOutcome::Skipped { reason, .. } => panic!("{clip}: skipped: {reason}"),
-        };
+        let (summary, frames, contacts) = util::ingest_body(&bvh, &opts, clip);
         let dt = summary.frame_time_s;
         let n = frames.time_s.len();
         let (t_first, t_last) = (frames.time_s[0], frames.time_s[n - 1]);

@@ -19,7 +19,7 @@
 //! CORRECTIONS issue 3 item 4; spec stance-model §1, §2, §4.3, §11; `data/forceplate/SOURCES.md`.
 
 use serde_json::Value;
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 use stancelib::stances::{build_clip, Stance, StanceOptions};
 
 /// (clip, mean vertical RMSE target in BW): issue 12 (the Fourier model's floor,
@@ -115,14 +115,7 @@ impl PlateClip {
             mass_kg: mass,
             ..Default::default()
         };
-        let (summary, frames, contacts) = match ingest(&bvh, &ingest_opts).expect("ingest") {
-            ClipOutcome::Body {
-                summary,
-                frames,
-                contacts,
-            } => (summary, frames, contacts),
-            ClipOutcome::Skipped { reason, .. } => panic!("{clip}: skipped: {reason}"),
-        };
+        let (summary, frames, contacts) = util::ingest_body(&bvh, &ingest_opts, clip);
         // The force mapping below assumes the documented +Y-up file (SOURCES.md).
         assert_eq!(summary.up_axis.as_deref(), Some("+Y"), "{clip}: up axis");
         let (stances, _) = build_clip(clip, &frames, &summary, &contacts, mass, opts);

@@ -6,7 +6,7 @@
 //! spec com-from-bvh §2 (rotation convention), §3.2 (file to internal axes).
 
 use stancelib::bvh::{Bvh, Channel};
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 
 use super::real_data::load;
 use crate::util;
@@ -113,12 +113,8 @@ fn translation_and_yaw_invariance() {
     let mut failures = Vec::new();
     for (label, psi, d, expect) in &cases {
         let b2 = transformed(&base.bvh, skip, *psi, *d);
-        let c2 = match ingest(&b2, &IngestOptions::default()).expect("ingest") {
-            ClipOutcome::Body {
-                summary, frames, ..
-            } => (summary, frames),
-            ClipOutcome::Skipped { reason, .. } => panic!("{label}: skipped: {reason}"),
-        };
+        let (s2, f2, _) = util::ingest_body(&b2, &IngestOptions::default(), label);
+        let c2 = (s2, f2);
         // Precondition: lead-in detection (spec §2.1) sees the untouched rows.
         assert_eq!(
             c2.0.leadin_dropped, base.summary.leadin_dropped,

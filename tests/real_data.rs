@@ -53,20 +53,12 @@ pub(super) struct Clip {
 pub(super) fn load(data: &Path, clip: &str) -> Clip {
     let path = data.join("bvh").join(format!("{clip}.bvh"));
     let bvh = parse_file(&path).unwrap_or_else(|e| panic!("{clip}: parse error: {e}"));
-    match ingest(&bvh, &IngestOptions::default())
-        .unwrap_or_else(|e| panic!("{clip}: ingest error: {e}"))
-    {
-        ClipOutcome::Body {
-            summary,
-            frames,
-            contacts,
-        } => Clip {
-            bvh,
-            summary,
-            frames,
-            contacts,
-        },
-        ClipOutcome::Skipped { reason, .. } => panic!("{clip}: unexpectedly skipped: {reason}"),
+    let (summary, frames, contacts) = util::ingest_body(&bvh, &IngestOptions::default(), clip);
+    Clip {
+        bvh,
+        summary,
+        frames,
+        contacts,
     }
 }
 

@@ -262,25 +262,34 @@ pub fn forceplate_clip(data: &Path, clip: &str) -> ForcePlateClip {
     }
 }
 
-/// Ingest a committed fixture with default options: summary, frames and contact runs.
-pub fn ingest_fixture(
-    c: &FixtureCase,
-) -> (
+/// What ingest makes of a body clip: summary, frames and contact runs.
+pub type Ingested = (
     stancelib::ingest::ClipSummary,
     stancelib::ingest::ClipFrames,
     Vec<stancelib::ingest::ContactRun>,
-) {
-    let bvh = stancelib::bvh::parse_file(&fixture_path(c)).unwrap();
-    match stancelib::ingest::ingest(&bvh, &stancelib::ingest::IngestOptions::default()).unwrap() {
-        stancelib::ingest::ClipOutcome::Body {
+);
+
+/// Ingest a clip that must be a body (panics naming `what` on an error or a skip).
+pub fn ingest_body(
+    bvh: &stancelib::bvh::Bvh,
+    opts: &stancelib::ingest::IngestOptions,
+    what: &str,
+) -> Ingested {
+    use stancelib::ingest::{ingest, ClipOutcome};
+    match ingest(bvh, opts).unwrap_or_else(|e| panic!("{what}: {e}")) {
+        ClipOutcome::Body {
             summary,
             frames,
             contacts,
         } => (summary, frames, contacts),
-        stancelib::ingest::ClipOutcome::Skipped { reason, .. } => {
-            panic!("{} skipped: {reason}", c.file)
-        }
+        ClipOutcome::Skipped { reason, .. } => panic!("{what}: skipped: {reason}"),
     }
+}
+
+/// Ingest a committed fixture with default options: summary, frames and contact runs.
+pub fn ingest_fixture(c: &FixtureCase) -> Ingested {
+    let bvh = stancelib::bvh::parse_file(&fixture_path(c)).unwrap();
+    ingest_body(&bvh, &Default::default(), c.file)
 }
 
 /// The checkout's root (the crate folder).
