@@ -1,7 +1,7 @@
 # stancelib: the two commands a newcomer needs are `make demo` and `make test`.
 CARGO ?= cargo
 
-.PHONY: demo test lint bench nightly build install doc fixtures fuzz spark-demo
+.PHONY: demo test golden lint bench nightly build install doc fixtures fuzz spark-demo
 
 DEMO_EDITS = out/demo/edits
 RUN_CLIP = fixtures/bvh/run_120hz_m_yup.bvh
@@ -25,6 +25,11 @@ demo:
 test:
 	$(CARGO) test --all-targets
 	$(CARGO) test --doc
+
+## Rewrite fixtures/golden/demo/ (the demo job's outputs that `make test` compares byte for
+## byte) from the current build; review `git diff fixtures/golden` before committing it.
+golden:
+	UPDATE_GOLDEN=1 $(CARGO) test --test integration golden
 
 ## Formatting and clippy, warnings as errors.
 lint:

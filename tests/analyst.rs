@@ -4,73 +4,10 @@
 //! and the options a newcomer tries first.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-use crate::util::root;
-
-/// A scratch folder laid out like a checkout after `make demo`: `fixtures` (a link to the
-/// repository's), `pipelines/demo.toml` (a copy) and `out/demo`, built by
-/// `stancelib run pipelines/demo.toml` from inside it, as `make demo` does.
-struct Demo {
-    dir: tempfile::TempDir,
-}
-
-impl Demo {
-    /// The folder with `out/demo` built by the demo pipeline (library and query stages).
-    fn build() -> Demo {
-        let demo = Demo::empty();
-        let (code, out, err) = demo.sh("stancelib run pipelines/demo.toml");
-        assert_eq!(code, 0, "make demo's command failed:\n{out}\n{err}");
-        demo
-    }
-
-    /// The folder with `out/demo` a plain library of the fixtures (no query stages).
-    fn library() -> Demo {
-        let demo = Demo::empty();
-        let (code, out, err) = demo.sh("stancelib build fixtures/bvh/*.bvh --out out/demo");
-        assert_eq!(code, 0, "{out}\n{err}");
-        demo
-    }
-
-    /// The folder without any output yet.
-    fn empty() -> Demo {
-        let dir = tempfile::tempdir().unwrap();
-        std::os::unix::fs::symlink(root().join("fixtures"), dir.path().join("fixtures")).unwrap();
-        std::fs::create_dir(dir.path().join("pipelines")).unwrap();
-        std::fs::copy(
-            root().join("pipelines/demo.toml"),
-            dir.path().join("pipelines/demo.toml"),
-        )
-        .unwrap();
-        Demo { dir }
-    }
-
-    fn lib(&self) -> PathBuf {
-        self.dir.path().join("out/demo")
-    }
-
-    /// Runs `line` with `sh -c` in the demo folder, the binary under test first on PATH.
-    fn sh(&self, line: &str) -> (i32, String, String) {
-        let bin = Path::new(env!("CARGO_BIN_EXE_stancelib"));
-        let path = format!(
-            "{}:{}",
-            bin.parent().unwrap().display(),
-            std::env::var("PATH").unwrap_or_default()
-        );
-        let o = Command::new("sh")
-            .args(["-c", line])
-            .current_dir(self.dir.path())
-            .env("PATH", path)
-            .output()
-            .unwrap();
-        (
-            o.status.code().unwrap_or(-1),
-            String::from_utf8_lossy(&o.stdout).into(),
-            String::from_utf8_lossy(&o.stderr).into(),
-        )
-    }
-}
+use crate::util::{root, Demo};
 
 fn readme() -> String {
     std::fs::read_to_string(root().join("README.md")).unwrap()
@@ -367,7 +304,11 @@ fn pyarrow_schema_metadata_shows_the_stancelib_keys() {
         .output()
         .is_ok_and(|o| o.status.success());
     if !has {
-        eprintln!("SKIPPED pyarrow_schema_metadata_shows_the_stancelib_keys: no pyarrow");
+        // .ci/run installs pyarrow: there, its absence is a failure.
+        crate::util::skip_or_fail(
+            "pyarrow_schema_metadata_shows_the_stancelib_keys",
+            "no pyarrow",
+        );
         return;
     }
     let demo = Demo::build();

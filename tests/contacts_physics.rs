@@ -10,31 +10,10 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
-use stancelib::ingest::{ingest, ClipFrames, ClipOutcome, ClipSummary, ContactRun, IngestOptions};
+use stancelib::ingest::{ingest, ClipOutcome, ContactRun, IngestOptions};
 use stancelib::synth::{generate, SynthOptions};
 
-use crate::util;
-
-/// `writeln!` into a per-test buffer, printed in one piece.
-macro_rules! outln {
-    ($buf:expr, $($t:tt)*) => {{
-        use std::fmt::Write as _;
-        writeln!($buf, $($t)*).unwrap();
-    }};
-}
-
-type Ingested = (ClipSummary, ClipFrames, Vec<ContactRun>);
-
-fn body(bvh: &stancelib::bvh::Bvh, opts: &IngestOptions, what: &str) -> Ingested {
-    match ingest(bvh, opts).unwrap_or_else(|e| panic!("{what}: {e}")) {
-        ClipOutcome::Body {
-            summary,
-            frames,
-            contacts,
-        } => (summary, frames, contacts),
-        ClipOutcome::Skipped { reason, .. } => panic!("{what}: skipped: {reason}"),
-    }
-}
+use crate::util::{self, outln};
 
 /// Signed errors (detected − plate) of one foot and event type: each plate event is
 /// matched to the nearest detected event within 0.15 s (CORRECTIONS issue 2 item 4);
@@ -75,7 +54,7 @@ fn subframe_contact_events_are_within_half_a_frame_of_the_force_plates() {
             mass_kg: fp.mass,
             ..Default::default()
         };
-        let (summary, frames, contacts) = body(&fp.bvh, &opts, clip);
+        let (summary, frames, contacts) = util::ingest_body(&fp.bvh, &opts, clip);
         let dt = summary.frame_time_s;
         let n = frames.time_s.len();
         let (t_first, t_last) = (frames.time_s[0], frames.time_s[n - 1]);
@@ -299,7 +278,7 @@ fn stance_on_a_platform_is_recovered_by_the_speed_led_rule() {
     // "flight" over it curves upwards.
     let mut off = IngestOptions::default();
     off.contacts.support_check = false;
-    let (s_off, _, c_off) = body(&bvh, &off, "platform run, check off");
+    let (s_off, _, c_off) = util::ingest_body(&bvh, &off, "platform run, check off");
     println!(
         "truth right {truth:?}; check off: flights {:?}; runs {:?}",
         s_off
@@ -328,7 +307,7 @@ fn stance_on_a_platform_is_recovered_by_the_speed_led_rule() {
     assert!(overlaps(&c_off).is_empty());
     assert!(stancelib::contacts::support::is_missed_support(lost));
 
-    let (s_on, _, c_on) = body(&bvh, &IngestOptions::default(), "platform run");
+    let (s_on, _, c_on) = util::ingest_body(&bvh, &IngestOptions::default(), "platform run");
     let found = overlaps(&c_on);
     println!(
         "check on: right-foot runs {found:?}; warnings {:?}",
@@ -499,8 +478,9 @@ fn skeleton_without_a_head_takes_its_head_from_the_neck_chain() {
     let orig = stancelib::bvh::parse_reader(text.as_bytes()).expect("original parses");
     let bvh = stancelib::bvh::parse_reader(edited.as_bytes()).expect("edited BVH parses");
     assert_eq!(bvh.motion.n_frames(), orig.motion.n_frames());
-    let (s0, f0, _) = body(&orig, &IngestOptions::default(), "cmu_09_01");
-    let (s1, f1, c1) = body(&bvh, &IngestOptions::default(), "cmu_09_01 without a head");
+    let (s0, f0, _) = util::ingest_body(&orig, &IngestOptions::default(), "cmu_09_01");
+    let (s1, f1, c1) =
+        util::ingest_body(&bvh, &IngestOptions::default(), "cmu_09_01 without a head");
     println!("skeleton: {:?}\nwarnings: {:?}", s1.skeleton, s1.warnings);
     assert!(
         s1.warnings.iter().any(|w| w.starts_with("no head joint")),
@@ -546,7 +526,8 @@ fn subframe_events_of_the_fixtures_are_within_a_frame_and_15_ms_of_the_truth() {
     for case in &util::FIXTURES {
         let clip = generate(&util::fixture_opts(case));
         let bvh = stancelib::bvh::parse_file(&util::fixture_path(case)).expect("fixture parses");
-        let (summary, frames, contacts) = body(&bvh, &IngestOptions::default(), case.file);
+        let (summary, frames, contacts) =
+            util::ingest_body(&bvh, &IngestOptions::default(), case.file);
         let dt = summary.frame_time_s;
         let mut worst: f64 = 0.0;
         for (flags, effector) in [

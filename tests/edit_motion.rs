@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use stancelib::bvh::parse_file;
 use stancelib::edit::rotation::{angle_deg, from_euler, Quat};
-use stancelib::ingest::{ingest, ClipFrames, ClipOutcome, ClipSummary, ContactRun, IngestOptions};
+use stancelib::ingest::{ClipFrames, ClipSummary, ContactRun, IngestOptions};
 use stancelib::library::read::{open_library, read_parquet};
 use stancelib::query::run::run_cycles;
 use stancelib::skeleton::Skeleton;
@@ -95,14 +95,7 @@ fn read_plan(out: &Path) -> Plan {
 
 fn reingest(out: &Path) -> (ClipSummary, ClipFrames, Vec<ContactRun>) {
     let bvh = parse_file(out).unwrap();
-    match ingest(&bvh, &IngestOptions::default()).unwrap() {
-        ClipOutcome::Body {
-            summary,
-            frames,
-            contacts,
-        } => (summary, frames, contacts),
-        ClipOutcome::Skipped { reason, .. } => panic!("{} skipped: {reason}", out.display()),
-    }
+    super::util::ingest_body(&bvh, &IngestOptions::default(), &out.display().to_string())
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -3,9 +3,8 @@
 //! frames; unknown stances exit 2 and write nothing; the stance plot is a real PNG, with
 //! and without the plates of the shared treadmill run.
 
-use crate::util::{ok, root, stancelib};
+use crate::util::{fixture_library, ok, s, shared_or_skip, stancelib};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 use stancelib::force_model::export::StanceTimes;
 use stancelib::library::forces::{read_force_stances, read_up_axis, FORCES_COLUMNS};
@@ -13,46 +12,6 @@ use stancelib::library::plates::{read_plates, PlateFoot};
 use stancelib::library::read::Table;
 use stancelib::plot::stance::STANCE_PLOT_PX;
 use stancelib::skeleton::units::UpAxis;
-
-fn s(p: &Path) -> String {
-    p.display().to_string()
-}
-
-/// The demo library: every generated fixture, default options (what `make demo` builds).
-fn demo_library() -> &'static Path {
-    static LIB: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    let (_, lib) = LIB.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let lib = dir.path().join("lib");
-        let mut files: Vec<String> = std::fs::read_dir(root().join("fixtures/bvh"))
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
-            .map(|p| s(&p))
-            .collect();
-        files.sort();
-        let mut args = vec!["build"];
-        args.extend(files.iter().map(String::as_str));
-        let out = s(&lib);
-        args.extend(["--out", &out]);
-        ok(&args);
-        (dir, lib)
-    });
-    lib
-}
-
-/// `../shared/data`: in CI (`CI=true`) its absence fails the test; elsewhere it skips.
-fn shared_or_fail_in_ci(test: &str) -> Option<PathBuf> {
-    let d = crate::util::shared_data();
-    if d.is_none() {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "{test}: ../shared/data is absent, and CI requires it"
-        );
-        eprintln!("SKIPPED {test}: ../shared/data is absent (CI always has it)");
-    }
-    d
-}
 
 fn kv_metadata(path: &Path) -> Vec<(String, String)> {
     let mut f = std::fs::File::open(path).unwrap();
@@ -71,7 +30,7 @@ fn norm(v: [f64; 3]) -> f64 {
 
 #[test]
 fn force_export_is_the_model_on_its_grid_and_integrates_to_the_impulse() {
-    let lib = demo_library();
+    let lib = fixture_library();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("f.parquet");
     ok(&["forces", "--lib", &s(lib), "--out", &s(&out)]);
@@ -171,7 +130,7 @@ fn force_export_is_the_model_on_its_grid_and_integrates_to_the_impulse() {
 
 #[test]
 fn force_export_of_named_stances_holds_only_those() {
-    let lib = demo_library();
+    let lib = fixture_library();
     let stances = read_force_stances(&lib.join("stances.parquet")).unwrap();
     let (a, b) = (
         &stances[stances.len() - 1].stance.stance_id,
@@ -209,7 +168,7 @@ fn force_export_of_named_stances_holds_only_those() {
 
 #[test]
 fn an_unknown_stance_id_exits_2_and_writes_nothing() {
-    let lib = demo_library();
+    let lib = fixture_library();
     let dir = tempfile::tempdir().unwrap();
     let good = read_force_stances(&lib.join("stances.parquet")).unwrap()[0]
         .stance
@@ -277,7 +236,7 @@ fn png_size(path: &Path) -> (u32, u32) {
 
 #[test]
 fn plot_stance_writes_a_png_of_the_stated_size() {
-    let lib = demo_library();
+    let lib = fixture_library();
     let stances = read_force_stances(&lib.join("stances.parquet")).unwrap();
     let run = stances
         .iter()
@@ -310,8 +269,7 @@ fn hamner_library(data: &Path, dir: &Path) -> PathBuf {
 
 #[test]
 fn plot_stance_with_plates_renders_on_the_treadmill_run() {
-    let Some(data) = shared_or_fail_in_ci("plot_stance_with_plates_renders_on_the_treadmill_run")
-    else {
+    let Some(data) = shared_or_skip("plot_stance_with_plates_renders_on_the_treadmill_run") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();

@@ -6,19 +6,10 @@
 //! `data/forceplate/SOURCES.md`.
 
 use serde_json::Value;
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 use stancelib::math::savgol::{window_for_rate, SavGol};
 
-use crate::util;
-
-/// `writeln!` into a per-test buffer, printed in one piece so that the output of tests
-/// running in parallel does not interleave.
-macro_rules! outln {
-    ($buf:expr, $($t:tt)*) => {{
-        use std::fmt::Write as _;
-        writeln!($buf, $($t)*).unwrap();
-    }};
-}
+use crate::util::{self, outln};
 
 const CLIPS: [&str; 2] = ["hamner_s02_run_4ms", "opencap_s4_DJ1_dropjump"];
 /// g used by the data (meta.json `g_mps2`) and by the flight fits, m/s².
@@ -68,14 +59,7 @@ fn contact_events_and_kinematic_force_match_the_force_plates() {
             mass_kg: mass,
             ..Default::default()
         };
-        let (summary, frames, contacts) = match ingest(&bvh, &opts).expect("ingest") {
-            ClipOutcome::Body {
-                summary,
-                frames,
-                contacts,
-            } => (summary, frames, contacts),
-            ClipOutcome::Skipped { reason, .. } => panic!("{clip}: skipped: {reason}"),
-        };
+        let (summary, frames, contacts) = util::ingest_body(&bvh, &opts, clip);
         let dt = summary.frame_time_s;
         let n = frames.time_s.len();
         let (t_first, t_last) = (frames.time_s[0], frames.time_s[n - 1]);

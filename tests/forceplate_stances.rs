@@ -19,21 +19,13 @@
 //! CORRECTIONS issue 3 item 4; spec stance-model §1, §2, §4.3, §11; `data/forceplate/SOURCES.md`.
 
 use serde_json::Value;
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 use stancelib::stances::{build_clip, Stance, StanceOptions};
-
-/// `writeln!` into a per-test buffer, printed in one piece (tests run in parallel).
-macro_rules! outln {
-    ($buf:expr, $($t:tt)*) => {{
-        use std::fmt::Write as _;
-        writeln!($buf, $($t)*).unwrap();
-    }};
-}
 
 /// (clip, mean vertical RMSE target in BW): issue 12 (the Fourier model's floor,
 /// c0 + 3 harmonics fitted to the plate force itself, is 0.05 BW on the run and 0.17 on the
 /// drop jump).
-use crate::util;
+use crate::util::{self, outln};
 
 /// The asserted bounds are the issue's targets (measured: 0.126 BW on the run with
 /// sub-frame stance edges and the soft position target, 0.285 BW on the drop jump).
@@ -123,14 +115,7 @@ impl PlateClip {
             mass_kg: mass,
             ..Default::default()
         };
-        let (summary, frames, contacts) = match ingest(&bvh, &ingest_opts).expect("ingest") {
-            ClipOutcome::Body {
-                summary,
-                frames,
-                contacts,
-            } => (summary, frames, contacts),
-            ClipOutcome::Skipped { reason, .. } => panic!("{clip}: skipped: {reason}"),
-        };
+        let (summary, frames, contacts) = util::ingest_body(&bvh, &ingest_opts, clip);
         // The force mapping below assumes the documented +Y-up file (SOURCES.md).
         assert_eq!(summary.up_axis.as_deref(), Some("+Y"), "{clip}: up axis");
         let (stances, _) = build_clip(clip, &frames, &summary, &contacts, mass, opts);

@@ -1,7 +1,7 @@
 //! Static (elevated) contacts on the multi-contact clips (spec com-from-bvh §7.4).
 
 use stancelib::contacts::{runs, EFFECTORS};
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 
 use crate::util;
 
@@ -16,12 +16,8 @@ fn load(
     let bvh = stancelib::bvh::parse_file(&data.join("bvh").join(rel)).unwrap();
     let mut o = IngestOptions::default();
     o.contacts.static_mode = static_mode;
-    match ingest(&bvh, &o).unwrap() {
-        ClipOutcome::Body {
-            frames, contacts, ..
-        } => Some((frames, contacts)),
-        ClipOutcome::Skipped { reason, .. } => panic!("{rel}: {reason}"),
-    }
+    let (_, frames, contacts) = util::ingest_body(&bvh, &o, rel);
+    Some((frames, contacts))
 }
 
 #[test]

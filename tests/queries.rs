@@ -4,7 +4,6 @@
 //! `../shared` is absent.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use stancelib::library::read::Table;
@@ -12,7 +11,7 @@ use stancelib::pipeline::batch::discover;
 use stancelib::pipeline::build::{build_and_write, BuildOptions};
 use stancelib::query::jump::{is_landing, is_liftoff, recorded_jump};
 
-use crate::util::shared_or_skip;
+use crate::util::{ok, shared_or_skip, stancelib};
 
 /// The shared library, built once per test binary into a folder that lives as long.
 fn shared_library() -> Option<&'static Path> {
@@ -29,20 +28,6 @@ fn shared_library() -> Option<&'static Path> {
     .map(|(_, p)| p.as_path())
 }
 
-fn stancelib(args: &[&str]) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_stancelib"))
-        .args(args)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(
-        o.status.success(),
-        "stancelib {args:?} failed:\n{out}\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    out
-}
-
 fn list_f64(t: &Table, name: &str) -> Vec<Vec<f64>> {
     t.f64_lists(name, Some(2)).unwrap()
 }
@@ -51,7 +36,7 @@ fn list_f64(t: &Table, name: &str) -> Vec<Vec<f64>> {
 fn run_sweep_reproduces_table_one_pattern() {
     let Some(lib) = shared_library() else { return };
     let out = lib.parent().unwrap().join("runs.parquet");
-    let printed = stancelib(&[
+    let printed = ok(&[
         "query",
         "run",
         "--lib",
@@ -114,7 +99,7 @@ fn run_sweep_reproduces_table_one_pattern() {
     // With the ratio force model (issue 12) the recorded cycle also meets the absolute
     // μ = 0.7 (the Fourier model's edge ringing gave μ_req 1.42 and failed it).
     for (form, want) in [("relative", true), ("absolute", true)] {
-        stancelib(&[
+        ok(&[
             "query",
             "run",
             "--lib",
@@ -173,7 +158,7 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
         }
         let (h, d) = recorded_jump(s1, s2);
         let out = lib.parent().unwrap().join(format!("jump{n}.parquet"));
-        stancelib(&[
+        ok(&[
             "query",
             "jump",
             "--lib",
@@ -250,7 +235,7 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
 fn jump_map_has_a_feasible_region_and_reports_agreement() {
     let Some(lib) = shared_library() else { return };
     let out = lib.parent().unwrap().join("map");
-    let printed = stancelib(&[
+    let printed = ok(&[
         "map",
         "jumps",
         "--lib",
@@ -297,7 +282,7 @@ fn active_set_option_acts_on_the_friction_check() {
             .parent()
             .unwrap()
             .join(format!("runs_active_{frac}.parquet"));
-        stancelib(&[
+        ok(&[
             "query",
             "run",
             "--lib",
@@ -326,28 +311,25 @@ fn active_set_option_acts_on_the_friction_check() {
         pairs.iter().any(|(w, r)| w - r > 0.01),
         "the option changed nothing"
     );
-    let bad = Command::new(env!("CARGO_BIN_EXE_stancelib"))
-        .args([
-            "query",
-            "run",
-            "--lib",
-            &l,
-            "--speed",
-            "3",
-            "--active-set",
-            "1.5",
-        ])
-        .args([
-            "--out",
-            &lib.parent()
-                .unwrap()
-                .join("x.parquet")
-                .display()
-                .to_string(),
-        ])
-        .output()
-        .unwrap();
-    assert_eq!(bad.status.code(), Some(2));
+    let x = lib
+        .parent()
+        .unwrap()
+        .join("x.parquet")
+        .display()
+        .to_string();
+    let (code, _, _) = stancelib(&[
+        "query",
+        "run",
+        "--lib",
+        &l,
+        "--speed",
+        "3",
+        "--active-set",
+        "1.5",
+        "--out",
+        &x,
+    ]);
+    assert_eq!(code, 2);
 }
 
 /// The nightly set's library (shared clips, bulk CMU set, force-plate clips), built once.
@@ -380,7 +362,7 @@ fn run_cycles_of_real_clips_are_feasible_over_most_speeds() {
     let out = lib.parent().unwrap().join("nightly_runs.parquet");
     let l = lib.display().to_string();
     let o = out.display().to_string();
-    stancelib(&[
+    ok(&[
         "query", "run", "--lib", &l, "--speeds", "0:6:0.5", "--out", &o,
     ]);
     let t = Table::open(&out).unwrap();

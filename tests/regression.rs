@@ -1,6 +1,6 @@
 //! Regression tests, one per finding, with the failing input inline where it is small.
 
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 use stancelib::stances::segment::Boundary;
 use stancelib::stances::{build_clip, StanceOptions};
 
@@ -8,10 +8,7 @@ use crate::util;
 
 fn summary_of(text: &str) -> stancelib::ingest::ClipSummary {
     let bvh = stancelib::bvh::parse_reader(text.as_bytes()).unwrap();
-    match ingest(&bvh, &IngestOptions::default()).unwrap() {
-        ClipOutcome::Body { summary, .. } => summary,
-        ClipOutcome::Skipped { reason, .. } => panic!("skipped: {reason}"),
-    }
+    util::ingest_body(&bvh, &IngestOptions::default(), "the inline clip").0
 }
 
 // See: review of issue 2 — the MASS right hand has a 161.8-unit End Site (spec §4.2 assumed
@@ -73,14 +70,8 @@ fn a_walking_stance_is_supported_by_its_labelled_foot_only() {
         return;
     };
     let bvh = stancelib::bvh::parse_file(&data.join("bvh/walk/cmu_07_01_walk_mb.bvh")).unwrap();
-    let ClipOutcome::Body {
-        summary,
-        frames,
-        contacts,
-    } = ingest(&bvh, &IngestOptions::default()).unwrap()
-    else {
-        panic!()
-    };
+    let (summary, frames, contacts) =
+        util::ingest_body(&bvh, &IngestOptions::default(), "cmu_07_01_walk_mb");
     let (stances, _) = build_clip(
         "w",
         &frames,

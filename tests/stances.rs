@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
+use stancelib::ingest::IngestOptions;
 use stancelib::stances::segment::Boundary;
 use stancelib::stances::{build_clip, Stance, StanceOptions};
 
@@ -15,14 +15,7 @@ const G: f64 = 9.81;
 fn stances_and_flights(rel: &str) -> Option<(Vec<Stance>, usize)> {
     let data = util::shared_or_skip("stances")?;
     let bvh = stancelib::bvh::parse_file(&data.join("bvh").join(rel)).unwrap();
-    let ClipOutcome::Body {
-        summary,
-        frames,
-        contacts,
-    } = ingest(&bvh, &IngestOptions::default()).unwrap()
-    else {
-        panic!("{rel} skipped")
-    };
+    let (summary, frames, contacts) = util::ingest_body(&bvh, &IngestOptions::default(), rel);
     let clip = std::path::Path::new(rel)
         .file_stem()
         .unwrap()

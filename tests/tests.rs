@@ -1,63 +1,113 @@
-//! The one integration-test binary. Table of contents:
+//! The one integration-test binary. Table of contents, by stage (a module per line; the
+//! `mod` lines below follow the same order). Tests that read `../shared/data` go through
+//! `util::shared_or_skip`: in CI (`CI=true`) a missing folder fails them, elsewhere they
+//! skip with a `SKIPPED` line that `cargo test` shows (see `util::skip_or_fail`).
 //!
+//! # Reading BVH
+//! - `bvh_oracle`: differential test of the BVH reader against the `bvh_anim` crate on every
+//!   shared clip it reads (f32 precision), and a write-and-reread round trip.
+//! - `bad_input`: malformed files name file and line; a 300 MB stream loads.
+//! - `props`: property tests: mutated and extreme inputs never panic the reader or the ingest.
+//!
+//! # Ingest: skeleton, COM, contacts
+//! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
+//! - `real_data`: every shared BVH loads; flight physics, walk/run contact patterns.
+//! - `invariance`: translating and turning a real clip moves its COM alike, contacts unchanged.
+//! - `contacts_physics`: sub-frame contact events against the plates, no non-ballistic
+//!   no-contact interval on real clips, a stance on a platform, a skeleton without a head.
+//! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
+//! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
+//!
+//! # Stances and force models
+//! - `stances`: stances of real clips: flights on both sides, impulse–momentum, walks, running forces.
+//! - `stances_truth`: stances of the fixtures against the generator's truth (segmentation,
+//!   the six parameters against the exact flights).
+//! - `force_truth`: Stage A force models of the fixtures against the true applied force;
+//!   the force model's Parquet round trip.
+//! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
+//!
+//! # Library: tables, readers, scale
+//! - `golden`: issue 13 — the demo job's outputs equal `fixtures/golden/demo/` (library
+//!   Parquet byte for byte, manifest without volatile fields, query outputs by content).
+//! - `readers`: pyarrow and DuckDB open the library (row counts, metadata, values).
+//! - `force_export`: `forces` (the model on its grid, impulse, norms) and `plot stance` (PNG,
+//!   plates of the treadmill run); unknown stances exit 2 and write nothing.
+//! - `scale`: issue 16 — streaming build (any batch size and thread count), `--shard I/N`
+//!   and `merge` equal to one build byte for byte, merge refusals, the Spark driver.
+//!
+//! # Queries
+//! - `queries`: the run-at-speed sweep, recorded jumps feasible as recorded, the jump map and
+//!   the issue 12 targets on the libraries of the shared clips.
+//!
+//! # 2PAC: kinematics and trajectories
+//! - `kinematics`: kinematic polytopes of the shared clips hold their points, the COM sits
+//!   above the feet, the tables read back.
+//! - `twopac`: `equilibrium` and `twopac` on `fixtures/twopac/`: reference margins, boundary
+//!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
+//!
+//! # Edited motion
+//! - `edit_motion`: issue 14 — `edit run`/`edit jump` BVH re-ingested: COM on the plan,
+//!   planted feet, contact timing, speed, jump apex, flight curvature, joint steps, identity.
+//!
+//! # Command line and documentation
+//! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `analyst`: issue 17 — the README's demo commands run and its column tables are the
 //!   written schemas; manifest date and command line, query outputs naming their library,
 //!   `info`, negative numbers, `--help` limits, `--quiet` and `--json`.
-//! - `bad_input`: malformed files name file and line; a 300 MB stream loads.
-//! - `bvh_oracle`: differential test of the BVH reader against the `bvh_anim` crate on every
-//!   shared clip it reads (f32 precision), and a write-and-reread round trip.
-//! - `contacts_physics`: sub-frame contact events against the plates, no non-ballistic
-//!   no-contact interval on real clips, a stance on a platform, a skeleton without a head.
-//! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
-//! - `force_export`: `forces` (the model on its grid, impulse, norms) and `plot stance` (PNG,
-//!   plates of the treadmill run); unknown stances exit 2 and write nothing.
-//! - `edit_motion`: issue 14 — `edit run`/`edit jump` BVH re-ingested: COM on the plan,
-//!   planted feet, contact timing, speed, jump apex, flight curvature, joint steps, identity.
-//! - `fixtures`: generated clips equal the generator; ingest recovers their COM, contacts, unit, axis.
+//!
+//! # Safety (issue 11)
+//! - `safety_inputs`: reader and numeric items: SG window bound, no silent NaN, 100k-joint
+//!   and 100k-deep files, and the mutation fuzzer (bounded; `make fuzz` runs it for a time budget).
+//! - `safety_messages`: escaped short error messages, the line bound, CR-only and empty files.
+//! - `safety_limits`: item 6: every documented work limit refused before work (exit 2,
+//!   field and limit named).
+//! - `safety_options`: items 10–12: pipelines validated before the library is touched, no
+//!   option accepted and ignored, duplicate JSON/TOML keys refused.
+//! - `safety_outputs`: `--out` never destroys what the tool did not write; input links,
+//!   cycles and special files; per-input errors; stale temporaries; the build lock.
+//!
+//! # Regressions and helpers
 //! - `regression`: one test per review finding, named after it.
-//! - `safety_outputs`: issue 11 — `--out` never destroys what the tool did not write; input
-//!   links, cycles and special files; per-input errors; stale temporaries; the build lock.
-//! - `stances`: stances of real clips: flights on both sides, impulse–momentum, walks, running forces.
-//! - `util`: shared helpers (paths to `../shared`, skip messages, temp dirs, running the binary).
-//! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
-//! - `props`: property tests: mutated and extreme inputs never panic the reader or the ingest.
-//! - `readers`: pyarrow and DuckDB open the library (row counts, metadata, values).
-//! - `safety_inputs`: issue 11 reader and numeric items: SG window bound, no silent NaN,
-//!   100k-joint and 100k-deep files, escaped short messages, line bound, CR-only files, and
-//!   the mutation fuzzer (bounded; `make fuzz` runs it for a time budget).
-//! - `real_data`: every shared BVH loads; flight physics, walk/run contact patterns, invariance.
-//! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
-//! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
-//! - `stances_truth`: stances of the fixtures against the generator's truth; Parquet round trip.
-//! - `scale`: issue 16 — streaming build (any batch size and thread count), `--shard I/N`
-//!   and `merge` equal to one build byte for byte, merge refusals, the Spark driver.
-//! - `safety_limits`: issue 11 items 6, 10, 11, 12: every documented work limit refused
-//!   before work (exit 2, field and limit named), pipelines validated before the library
-//!   is touched, no option accepted and ignored, duplicate JSON/TOML keys refused.
-//! - `twopac`: `equilibrium` and `twopac` on `fixtures/twopac/`: reference margins, boundary
-//!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
-mod analyst;
+//! - `util`: shared helpers: the shared-data gate and skips, fixtures and their library, the
+//!   demo folder, running the binary, manifests without volatile fields, file snapshots.
+
+// Reading BVH
 mod bad_input;
 mod bvh_oracle;
-mod cli;
-mod contacts_physics;
-mod edit_motion;
-mod fixtures;
-mod force_export;
-mod forceplate;
-mod forceplate_stances;
-mod kinematics;
-mod multicontact;
 mod props;
-mod queries;
-mod readers;
+// Ingest
+mod contacts_physics;
+mod fixtures;
+mod forceplate;
+mod invariance;
+mod multicontact;
 mod real_data;
-mod regression;
-mod safety_inputs;
-mod safety_limits;
-mod safety_outputs;
-mod scale;
+// Stances and force models
+mod force_truth;
+mod forceplate_stances;
 mod stances;
 mod stances_truth;
+// Library
+mod force_export;
+mod golden;
+mod readers;
+mod scale;
+// Queries
+mod queries;
+// 2PAC
+mod kinematics;
 mod twopac;
+// Edited motion
+mod edit_motion;
+// Command line and documentation
+mod analyst;
+mod cli;
+// Safety
+mod safety_inputs;
+mod safety_limits;
+mod safety_messages;
+mod safety_options;
+mod safety_outputs;
+// Regressions and helpers
+mod regression;
 mod util;

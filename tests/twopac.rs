@@ -5,41 +5,16 @@
 //! written).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use polars::prelude::*;
 use stancelib::library::read::Table;
+
+use crate::util::{fails, ok};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures/twopac")
         .join(name)
-}
-
-fn stancelib(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_stancelib"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = stancelib(args);
-    let out = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(
-        o.status.success(),
-        "stancelib {args:?} failed:\n{out}\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    out
-}
-
-/// Runs a command that must fail with exit code 2; returns stderr.
-fn fails(args: &[&str]) -> String {
-    let o = stancelib(args);
-    let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert_eq!(o.status.code(), Some(2), "stancelib {args:?}: {err}");
-    err
 }
 
 fn s(p: &Path) -> String {
@@ -460,11 +435,12 @@ fn twopac_eq6_and_eq13_agree_when_static() {
 /// inside the world-frame polytopes of its phase (kinematic feasibility never violated).
 #[test]
 fn twopac_plans_a_recorded_walk_with_the_library_polytopes() {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bvh");
-    if !data.is_dir() {
-        eprintln!("SKIPPED twopac_plans_a_recorded_walk_with_the_library_polytopes: ../shared/data is absent");
+    let Some(data) =
+        crate::util::shared_or_skip("twopac_plans_a_recorded_walk_with_the_library_polytopes")
+    else {
         return;
-    }
+    };
+    let data = data.join("bvh");
     let dir = tempfile::tempdir().unwrap();
     let lib = dir.path().join("lib");
     let clip = "cmu_07_01_walk_mb";

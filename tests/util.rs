@@ -5,19 +5,92 @@ use std::path::{Path, PathBuf};
 
 use stancelib::synth::{SynthMotion, SynthOptions, SynthUp};
 
-/// `../shared/data` beside the checkout, if present.
+/// `writeln!` into a per-test buffer, printed in one piece so that the output of tests
+/// running in parallel does not interleave.
+macro_rules! outln {
+    ($buf:expr, $($t:tt)*) => {{
+        use std::fmt::Write as _;
+        writeln!($buf, $($t)*).unwrap();
+    }};
+}
+pub(crate) use outln;
+
+/// Environment variable that names the shared data folder in place of `../shared/data`
+/// beside the checkout (tests only). Point it to a missing folder to run the suite as a
+/// clone without the data runs (`STANCELIB_SHARED_DATA=/nonexistent cargo test`).
+pub const SHARED_DATA_ENV: &str = "STANCELIB_SHARED_DATA";
+
+/// The shared data folder: `$STANCELIB_SHARED_DATA` if set, else `../shared/data` beside
+/// the checkout.
+pub fn shared_data_dir() -> PathBuf {
+    match std::env::var_os(SHARED_DATA_ENV) {
+        Some(p) => PathBuf::from(p),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
+    }
+}
+
+/// The shared data folder, if present.
 pub fn shared_data() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    let p = shared_data_dir();
     p.is_dir().then_some(p)
 }
 
-/// The shared data folder, or print why a test is skipped and return `None`.
+/// Running in CI: `CI` set to anything but empty, `0` or `false` (CI services set
+/// `CI=true`). There every test input must be present.
+pub fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !matches!(v.as_str(), "" | "0" | "false"))
+}
+
+/// The one way a test skips: in CI ([`in_ci`]) it fails with `why`; elsewhere it writes
+/// `SKIPPED <test>: <why>` and the caller returns.
+///
+/// The line goes straight to the process's stderr through the `std::io::stderr()` handle.
+/// The test harness captures only what `print!`/`eprint!` write (and shows that for
+/// failing tests only), so an `eprintln!` skip vanishes from a passing run; a write to the
+/// handle is not captured and appears in the `cargo test` output, where the user sees it.
+pub fn skip_or_fail(test: &str, why: &str) {
+    // The harness names each test's thread after the test (`module::name`); `test` labels
+    // the helper that asked (a library shared by several tests, say).
+    let thread = std::thread::current();
+    let test = match thread.name() {
+        Some(name) if name != "main" && !name.ends_with(test) => format!("{name} ({test})"),
+        Some(name) if name != "main" => name.to_string(),
+        _ => test.to_string(),
+    };
+    assert!(!in_ci(), "{test}: {why}, and CI requires it");
+    use std::io::Write;
+    let line = format!("SKIPPED {test}: {why} (in CI this fails)\n");
+    let _ = std::io::stderr().write_all(line.as_bytes());
+}
+
+/// The shared data folder for test `test`, the gate of every test that reads it: `None`
+/// (after [`skip_or_fail`]: a failure in CI, a printed skip elsewhere) when it is absent.
 pub fn shared_or_skip(test: &str) -> Option<PathBuf> {
     let d = shared_data();
     if d.is_none() {
-        eprintln!("SKIPPED {test}: ../shared/data is absent (CI always has it)");
+        let why = format!(
+            "the shared data folder {} is absent",
+            shared_data_dir().display()
+        );
+        skip_or_fail(test, &why);
     }
     d
+}
+
+/// The layout of the shared data that the tests read: in CI the data must be there (one
+/// failure that names the folder); elsewhere its absence is reported once by the gate.
+#[test]
+fn shared_data_present() {
+    let Some(data) = shared_or_skip("shared_data_present") else {
+        return;
+    };
+    for sub in ["bvh", "bvh-bulk/cmu", "forceplate"] {
+        assert!(
+            data.join(sub).is_dir(),
+            "{}: no {sub}/ folder, which the shared-data tests read",
+            data.display()
+        );
+    }
 }
 
 /// One committed fixture: the generator options and what ingest must detect.
@@ -189,25 +262,34 @@ pub fn forceplate_clip(data: &Path, clip: &str) -> ForcePlateClip {
     }
 }
 
-/// Ingest a committed fixture with default options: summary, frames and contact runs.
-pub fn ingest_fixture(
-    c: &FixtureCase,
-) -> (
+/// What ingest makes of a body clip: summary, frames and contact runs.
+pub type Ingested = (
     stancelib::ingest::ClipSummary,
     stancelib::ingest::ClipFrames,
     Vec<stancelib::ingest::ContactRun>,
-) {
-    let bvh = stancelib::bvh::parse_file(&fixture_path(c)).unwrap();
-    match stancelib::ingest::ingest(&bvh, &stancelib::ingest::IngestOptions::default()).unwrap() {
-        stancelib::ingest::ClipOutcome::Body {
+);
+
+/// Ingest a clip that must be a body (panics naming `what` on an error or a skip).
+pub fn ingest_body(
+    bvh: &stancelib::bvh::Bvh,
+    opts: &stancelib::ingest::IngestOptions,
+    what: &str,
+) -> Ingested {
+    use stancelib::ingest::{ingest, ClipOutcome};
+    match ingest(bvh, opts).unwrap_or_else(|e| panic!("{what}: {e}")) {
+        ClipOutcome::Body {
             summary,
             frames,
             contacts,
         } => (summary, frames, contacts),
-        stancelib::ingest::ClipOutcome::Skipped { reason, .. } => {
-            panic!("{} skipped: {reason}", c.file)
-        }
+        ClipOutcome::Skipped { reason, .. } => panic!("{what}: skipped: {reason}"),
     }
+}
+
+/// Ingest a committed fixture with default options: summary, frames and contact runs.
+pub fn ingest_fixture(c: &FixtureCase) -> Ingested {
+    let bvh = stancelib::bvh::parse_file(&fixture_path(c)).unwrap();
+    ingest_body(&bvh, &Default::default(), c.file)
 }
 
 /// The checkout's root (the crate folder).
@@ -233,4 +315,192 @@ pub fn ok(args: &[&str]) -> String {
     let (code, out, err) = stancelib(args);
     assert_eq!(code, 0, "stancelib {args:?}:\n{out}\n{err}");
     out
+}
+
+/// Runs a command that must fail with exit code 2 (fatal); returns stderr.
+pub fn fails(args: &[&str]) -> String {
+    let (code, out, err) = stancelib(args);
+    assert_eq!(code, 2, "stancelib {args:?} must exit 2:\n{out}\n{err}");
+    err
+}
+
+/// A path as an argument string.
+pub fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// The generated clips `fixtures/bvh/*.bvh`, sorted.
+pub fn fixture_clips() -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(root().join("fixtures/bvh"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
+        .map(|p| s(&p))
+        .collect();
+    v.sort();
+    v
+}
+
+/// The library of every generated clip with default options (`stancelib build
+/// fixtures/bvh/*.bvh`, the demo's library without its query stages), built once per test
+/// binary; read-only for the tests.
+pub fn fixture_library() -> &'static Path {
+    static LIB: std::sync::OnceLock<(tempfile::TempDir, PathBuf)> = std::sync::OnceLock::new();
+    let (_, lib) = LIB.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let lib = dir.path().join("lib");
+        let clips = fixture_clips();
+        let mut args = vec!["build"];
+        args.extend(clips.iter().map(String::as_str));
+        let lib_s = s(&lib);
+        args.extend(["--out", &lib_s]);
+        ok(&args);
+        (dir, lib)
+    });
+    lib
+}
+
+/// Manifest keys (at any depth) that change from one build to the next: build date,
+/// command line, wall time.
+pub const MANIFEST_VOLATILE_KEYS: [&str; 3] = ["created_utc", "command_line", "wall_time_s"];
+
+/// `v` without [`MANIFEST_VOLATILE_KEYS`], at every depth.
+pub fn without_volatile(v: serde_json::Value) -> serde_json::Value {
+    use serde_json::Value;
+    match v {
+        Value::Object(m) => Value::Object(
+            m.into_iter()
+                .filter(|(k, _)| !MANIFEST_VOLATILE_KEYS.contains(&k.as_str()))
+                .map(|(k, v)| (k, without_volatile(v)))
+                .collect(),
+        ),
+        Value::Array(a) => Value::Array(a.into_iter().map(without_volatile).collect()),
+        other => other,
+    }
+}
+
+/// `manifest.json` of a library (or any such file) without what changes from run to run.
+pub fn stable_manifest(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let v = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    without_volatile(v)
+}
+
+/// Every file below `dir`, relative to it, sorted (empty when `dir` does not exist).
+pub fn files_below(dir: &Path) -> std::collections::BTreeSet<PathBuf> {
+    fn walk(base: &Path, dir: &Path, out: &mut std::collections::BTreeSet<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(base, &p, out);
+            } else {
+                out.insert(p.strip_prefix(base).unwrap().to_path_buf());
+            }
+        }
+    }
+    let mut out = std::collections::BTreeSet::new();
+    if dir.is_dir() {
+        walk(dir, dir, &mut out);
+    }
+    out
+}
+
+/// Every file below `dir` with its bytes (relative paths).
+pub fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+    files_below(dir)
+        .into_iter()
+        .map(|rel| {
+            let bytes = std::fs::read(dir.join(&rel)).unwrap();
+            (rel, bytes)
+        })
+        .collect()
+}
+
+/// A scratch folder laid out like a checkout after `make demo`: `fixtures` (a link to the
+/// repository's), `pipelines/demo.toml` (a copy) and `out/demo`, built by
+/// `stancelib run pipelines/demo.toml` from inside it, as `make demo` does.
+pub struct Demo {
+    /// The scratch folder (removed on drop).
+    pub dir: tempfile::TempDir,
+}
+
+impl Demo {
+    /// The folder with `out/demo` built by the demo pipeline (library and query stages).
+    pub fn build() -> Demo {
+        let demo = Demo::empty();
+        let (code, out, err) = demo.sh("stancelib run pipelines/demo.toml");
+        assert_eq!(code, 0, "make demo's command failed:\n{out}\n{err}");
+        demo
+    }
+
+    /// The folder with `out/demo` a plain library of the fixtures (no query stages).
+    pub fn library() -> Demo {
+        let demo = Demo::empty();
+        let (code, out, err) = demo.sh("stancelib build fixtures/bvh/*.bvh --out out/demo");
+        assert_eq!(code, 0, "{out}\n{err}");
+        demo
+    }
+
+    /// The folder without any output yet.
+    pub fn empty() -> Demo {
+        let dir = tempfile::tempdir().unwrap();
+        std::os::unix::fs::symlink(root().join("fixtures"), dir.path().join("fixtures")).unwrap();
+        std::fs::create_dir(dir.path().join("pipelines")).unwrap();
+        std::fs::copy(
+            root().join("pipelines/demo.toml"),
+            dir.path().join("pipelines/demo.toml"),
+        )
+        .unwrap();
+        Demo { dir }
+    }
+
+    /// `out/demo` inside the folder.
+    pub fn lib(&self) -> PathBuf {
+        self.dir.path().join("out/demo")
+    }
+
+    /// Runs `line` with `sh -c` in the demo folder, the binary under test first on PATH.
+    pub fn sh(&self, line: &str) -> (i32, String, String) {
+        let bin = Path::new(env!("CARGO_BIN_EXE_stancelib"));
+        let path = format!(
+            "{}:{}",
+            bin.parent().unwrap().display(),
+            std::env::var("PATH").unwrap_or_default()
+        );
+        let o = std::process::Command::new("sh")
+            .args(["-c", line])
+            .current_dir(self.dir.path())
+            .env("PATH", path)
+            .output()
+            .unwrap();
+        (
+            o.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&o.stdout).into(),
+            String::from_utf8_lossy(&o.stderr).into(),
+        )
+    }
+}
+
+/// Runs a command that must exit 2 with every one of `needles` in its stderr; returns it.
+pub fn refused(args: &[&str], needles: &[&str]) -> String {
+    let err = fails(args);
+    for n in needles {
+        assert!(
+            err.contains(n),
+            "stancelib {args:?}: stderr lacks {n:?}:\n{err}"
+        );
+    }
+    err
+}
+
+/// The names in a folder (empty when it does not exist).
+pub fn listing(dir: &Path) -> Vec<String> {
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut v: Vec<String> = rd
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
 }

@@ -231,26 +231,12 @@ mod tests {
     use crate::force_model::basis::simpson;
     use std::f64::consts::TAU;
 
-    /// A small deterministic generator (xorshift64*), uniform in [0, 1).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::testkit::{Harmonics, Rng};
 
+    /// A random axis: DC in [−450, 1050) N plus 1–6 cosines of harmonics 1–8, up to 800 N.
     fn random_axis(rng: &mut Rng) -> AxisModel {
-        let n = 1 + (rng.next() * 6.0) as usize;
-        let mut m = AxisModel::constant(1500.0 * (rng.next() - 0.3));
-        for _ in 0..n {
-            m.harmonics.push(1 + (rng.next() * 8.0) as u32);
-            m.amps.push(800.0 * rng.next());
-            m.phases.push(TAU * (rng.next() - 0.5));
-        }
-        m
+        let c0 = 1500.0 * (rng.next_f64() - 0.3);
+        crate::testkit::random_axis(rng, c0, 800.0, Harmonics { terms: 6, max_j: 8 })
     }
 
     #[test]
@@ -258,7 +244,7 @@ mod tests {
         // 4000 Simpson intervals: error ≤ h⁴/180·Σc·Ω⁴ ≈ 3e-9 N for Σc ≤ 4800 N, Ω ≤ 2π·8;
         // the tolerance uses that bound per model, plus 1e-10 of O(1e3 N) roundoff.
         let n = 4000;
-        let mut rng = Rng(0x5eed_1234_abcd_0001);
+        let mut rng = Rng::new(0x5eed_1234_abcd_0001);
         for _ in 0..50 {
             let m = random_axis(&mut rng);
             let om = basis::omega_of(m.j_max());
@@ -283,10 +269,10 @@ mod tests {
     fn mixed_fourier_and_polynomial_parts_match_simpson() {
         // The polynomial part (degree 7, O(1e3 N) coefficients) adds to the Fourier part in
         // every closed form; Simpson with 4000 intervals is exact to ~1e-8 N here.
-        let mut rng = Rng(0xfeed_0042);
+        let mut rng = Rng::new(0xfeed_0042);
         for _ in 0..20 {
             let mut m = random_axis(&mut rng);
-            m.poly = (0..8).map(|_| 2000.0 * (rng.next() - 0.5)).collect();
+            m.poly = (0..8).map(|_| 2000.0 * (rng.next_f64() - 0.5)).collect();
             let n = 4000;
             for &tau in &[0.0, 0.37, 1.0] {
                 assert!((m.f1(tau) - simpson(|u| m.eval(u), 0.0, tau, n)).abs() < 1e-7);
@@ -302,11 +288,11 @@ mod tests {
     #[test]
     fn j_k_p_identities() {
         // Identities hold to roundoff: 1e-12 relative to the O(1) m, m/s values.
-        let mut rng = Rng(77);
+        let mut rng = Rng::new(77);
         for _ in 0..50 {
             let fm = ForceModel {
-                mass_kg: 40.0 + 60.0 * rng.next(),
-                dt_s: 0.1 + 0.5 * rng.next(),
+                mass_kg: 40.0 + 60.0 * rng.next_f64(),
+                dt_s: 0.1 + 0.5 * rng.next_f64(),
                 axes: [
                     random_axis(&mut rng),
                     random_axis(&mut rng),

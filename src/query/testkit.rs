@@ -1,48 +1,31 @@
-//! Shared test tools of the query modules: a seeded generator, random force models and an
-//! independent forward simulation (RK4 on the model force, no closed form).
-
-use std::f64::consts::{PI, TAU};
+//! Shared test tools of the query modules: random force models (on `crate::testkit`'s
+//! generator and builder) and an independent forward simulation (RK4 on the model force,
+//! no closed form).
 
 use super::solve::{Request, Solution};
 use crate::force_model::{AxisModel, ForceModel, GRAVITY};
 use crate::stances::segment::Boundary;
+use crate::testkit::Harmonics;
+pub(crate) use crate::testkit::Rng;
 
-/// A seeded linear congruential generator (Knuth MMIX constants), uniform in [0, 1).
-pub struct Lcg(pub u64);
-impl Lcg {
-    pub fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
+/// The harmonic content of the query tests' random axes: 1–3 cosines of harmonics 1–4.
+const HARMONICS: Harmonics = Harmonics { terms: 3, max_j: 4 };
 
-/// A DC term plus 1–3 cosines of harmonics 1–4.
-pub fn random_axis(rng: &mut Lcg, c0: f64, amp: f64) -> AxisModel {
-    let mut a = AxisModel::constant(c0);
-    for _ in 0..1 + (rng.next() * 3.0) as usize {
-        a.harmonics.push(1 + (rng.next() * 4.0) as u32);
-        a.amps.push(amp * rng.next());
-        a.phases.push(TAU * (rng.next() - 0.5));
-    }
-    a
+/// A DC term plus 1–3 cosines of harmonics 1–4 (`testkit::random_axis`).
+pub fn random_axis(rng: &mut Rng, c0: f64, amp: f64) -> AxisModel {
+    crate::testkit::random_axis(rng, c0, amp, HARMONICS)
 }
 
 /// A runner-like model: |c0_h| ∈ [20, 300] N, J_v > 0 (c0_v ∈ [1.3, 3]·m g).
-pub fn random_model(rng: &mut Lcg) -> ForceModel {
-    let m = rng.range(45.0, 95.0);
-    let sign = if rng.next() < 0.5 { -1.0 } else { 1.0 };
-    let c0_h = sign * rng.range(20.0, 300.0);
-    let c0_p = rng.range(-100.0, 100.0);
-    let c0_v = rng.range(1.3, 3.0) * m * GRAVITY;
+pub fn random_model(rng: &mut Rng) -> ForceModel {
+    let m = rng.uniform(45.0, 95.0);
+    let sign = if rng.next_f64() < 0.5 { -1.0 } else { 1.0 };
+    let c0_h = sign * rng.uniform(20.0, 300.0);
+    let c0_p = rng.uniform(-100.0, 100.0);
+    let c0_v = rng.uniform(1.3, 3.0) * m * GRAVITY;
     ForceModel {
         mass_kg: m,
-        dt_s: rng.range(0.1, 0.35),
+        dt_s: rng.uniform(0.1, 0.35),
         axes: [
             random_axis(rng, c0_h, 300.0),
             random_axis(rng, c0_p, 100.0),
@@ -112,26 +95,10 @@ pub fn simulate(m: &ForceModel, req: &Request, s: &Solution) -> State {
     rk4(m, [0.0; 3], s.t_td, y, s.t_lo, s.t_e, 4)
 }
 
-/// A stance-like model: vertical bell `A(1 − cos 2πτ)` plus small ringing, random
-/// horizontal forces.
-pub fn bell_model(rng: &mut Lcg) -> ForceModel {
-    let mass_kg = rng.range(40.0, 100.0);
-    let weight = mass_kg * GRAVITY;
-    let bell = rng.range(1.0, 3.0) * weight;
-    let mut v = random_axis(rng, bell, 0.04 * weight);
-    v.harmonics.push(1);
-    v.amps.push(bell);
-    v.phases.push(PI);
-    let (h_dc, p_dc) = (rng.range(-0.3, 0.3), rng.range(-0.1, 0.1));
-    ForceModel {
-        mass_kg,
-        dt_s: rng.range(0.15, 0.5),
-        axes: [
-            random_axis(rng, h_dc * weight, 0.5 * weight),
-            random_axis(rng, p_dc * weight, 0.2 * weight),
-            v,
-        ],
-    }
+/// A stance-like model (`testkit::bell_model`): vertical bell `A(1 − cos 2πτ)` plus small
+/// ringing (up to 0.04 body weights), random horizontal forces.
+pub fn bell_model(rng: &mut Rng) -> ForceModel {
+    crate::testkit::bell_model(rng, 0.04, HARMONICS)
 }
 
 /// A library stance made from a model and a touchdown state (model-consistent parameters,
@@ -172,7 +139,7 @@ pub fn pool_stance(
 
 /// A bell model with no perpendicular force and a horizontal force dominated by its DC
 /// term `push · m g` (a straight jump: push off forward, or brake on landing).
-pub fn jump_model(rng: &mut Lcg, push: f64) -> ForceModel {
+pub fn jump_model(rng: &mut Rng, push: f64) -> ForceModel {
     let mut m = bell_model(rng);
     let weight = m.mass_kg * GRAVITY;
     m.axes[1] = AxisModel::constant(0.0);
@@ -182,18 +149,18 @@ pub fn jump_model(rng: &mut Lcg, push: f64) -> ForceModel {
 }
 
 /// A recorded jump: a liftoff stance and the landing stance after the same flight.
-pub fn recorded_pair(rng: &mut Lcg) -> (super::pool::Prepared, super::pool::Prepared) {
+pub fn recorded_pair(rng: &mut Rng) -> (super::pool::Prepared, super::pool::Prepared) {
     let s1 = loop {
-        let v_td1 = [rng.range(0.0, 1.5), 0.0, -rng.range(0.0, 0.3)];
-        let push = rng.range(0.1, 0.3);
+        let v_td1 = [rng.uniform(0.0, 1.5), 0.0, -rng.uniform(0.0, 0.3)];
+        let push = rng.uniform(0.1, 0.3);
         let s = pool_stance(
             "up",
             jump_model(rng, push),
             v_td1,
-            rng.range(0.8, 1.0),
+            rng.uniform(0.8, 1.0),
             (Boundary::Rest, Boundary::Flight),
             "LR",
-            [rng.range(-0.1, 0.2), 0.0],
+            [rng.uniform(-0.1, 0.2), 0.0],
         );
         if s.params.t_e >= s.params.t_lo {
             break s; // lifts off rising: a real flight follows
@@ -201,10 +168,10 @@ pub fn recorded_pair(rng: &mut Lcg) -> (super::pool::Prepared, super::pool::Prep
     };
     // The landing touches down t_TD2 after the flight's apex, where S1's end apex is.
     let q1 = s1.params;
-    let t_td2 = rng.range(0.2, 0.4);
+    let t_td2 = rng.uniform(0.2, 0.4);
     let v_td2 = [q1.ve, q1.vp, -GRAVITY * t_td2];
     let z_td2 = q1.ze - 0.5 * GRAVITY * t_td2 * t_td2;
-    let brake = -rng.range(0.1, 0.3);
+    let brake = -rng.uniform(0.1, 0.3);
     let s2 = pool_stance(
         "down",
         jump_model(rng, brake),
@@ -212,7 +179,7 @@ pub fn recorded_pair(rng: &mut Lcg) -> (super::pool::Prepared, super::pool::Prep
         z_td2,
         (Boundary::Flight, Boundary::Rest),
         "LR",
-        [rng.range(-0.1, 0.2), 0.0],
+        [rng.uniform(-0.1, 0.2), 0.0],
     );
     (
         super::pool::Prepared::new(s1),

@@ -118,7 +118,7 @@ fn degenerate_models_do_not_panic() {
             axis(vec![3], vec![f64::NAN], vec![f64::INFINITY]),
         ),
     ];
-    for (mass_kg, dt_s, ax) in cases {
+    for (i, (mass_kg, dt_s, ax)) in cases.into_iter().enumerate() {
         let model = ForceModel {
             mass_kg,
             dt_s,
@@ -129,12 +129,37 @@ fn degenerate_models_do_not_panic() {
             ..StanceContext::default()
         };
         let c = precompute(&model, &ctx);
-        let _ = (
-            c,
-            com_offset(&model, &ctx, [1.0; 3], 0.5),
-            angular_impulse(&model, &ctx),
+        let r = com_offset(&model, &ctx, [1.0; 3], 0.5);
+        let (h, _) = angular_impulse(&model, &ctx);
+        // precompute stores angular_impulse's H, degenerate or not (NaN bits included).
+        assert_eq!(
+            c.ang_impulse.map(f64::to_bits),
+            h.map(f64::to_bits),
+            "case {i}"
         );
+        // The NaN start speed reaches the offset `vs·Δt·τ + …`: never a finite value.
+        assert!(r[0].is_nan(), "case {i}: offset {r:?}");
+        // Without a positive vertical impulse (Δt = 0, or NaN inputs) no support.
+        if i >= 4 {
+            assert!(!c.support_ok, "case {i}: supported");
+        }
+        // A NaN force model never passes the unilateral check.
+        if i == 5 {
+            assert!(!c.unilateral_ok, "case {i}: unilateral");
+        }
     }
+    // Case 0 is the constant force 1 N on every axis: its coefficients in closed form.
+    let constant = ForceModel {
+        mass_kg: 70.0,
+        dt_s: 0.2,
+        axes: std::array::from_fn(|_| axis(vec![], vec![], vec![])),
+    };
+    let c = precompute(&constant, &StanceContext::default());
+    assert_eq!(c.a_f, [1.0; 3]);
+    assert_eq!(c.min_f_v, 1.0);
+    assert!((c.f_peak - 3f64.sqrt()).abs() < 1e-15, "{}", c.f_peak);
+    assert!((c.mu_req - 2f64.sqrt()).abs() < 1e-15, "{}", c.mu_req);
+    assert!(c.support_ok && c.unilateral_ok);
 }
 
 #[test]

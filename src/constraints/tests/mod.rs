@@ -9,45 +9,14 @@ mod force;
 mod impulse;
 
 use super::StanceContext;
-use crate::force_model::{AxisModel, ForceModel, GRAVITY};
+use crate::force_model::ForceModel;
+use crate::testkit::Harmonics;
 pub(super) use crate::testkit::Rng;
-use std::f64::consts::PI;
 
-/// A random axis: DC `c0` plus 1–4 harmonics `j ∈ 1..=6` of amplitude up to `amp` (N).
-fn random_axis(rng: &mut Rng, c0: f64, amp: f64) -> AxisModel {
-    let n = rng.int(1, 4) as usize;
-    let harmonics: Vec<u32> = (0..n).map(|_| rng.int(1, 6)).collect();
-    AxisModel {
-        c0,
-        amps: (0..n).map(|_| rng.uniform(0.0, amp)).collect(),
-        phases: (0..n).map(|_| rng.uniform(-PI, PI)).collect(),
-        harmonics,
-        poly: Vec::new(),
-        fit_rms: 0.0,
-    }
-}
-
-/// A random stance-like model: a vertical bell `A(1 − cos 2πτ)` plus ringing, and
-/// horizontal forces with random harmonics (repeated `j` allowed).
+/// A random stance-like model (`testkit::bell_model`): ringing up to 0.1 body weights,
+/// 1–4 harmonics `j ∈ 1..=6` per axis.
 pub(super) fn random_model(rng: &mut Rng) -> ForceModel {
-    let mass_kg = rng.uniform(40.0, 100.0);
-    let weight = mass_kg * GRAVITY;
-    let bell = rng.uniform(1.0, 3.0) * weight;
-    let mut v = random_axis(rng, bell, 0.1 * weight);
-    v.harmonics.push(1);
-    v.amps.push(bell);
-    v.phases.push(PI);
-    let h_dc = rng.uniform(-0.3, 0.3) * weight;
-    let p_dc = rng.uniform(-0.1, 0.1) * weight;
-    ForceModel {
-        mass_kg,
-        dt_s: rng.uniform(0.15, 0.5),
-        axes: [
-            random_axis(rng, h_dc, 0.5 * weight),
-            random_axis(rng, p_dc, 0.2 * weight),
-            v,
-        ],
-    }
+    crate::testkit::bell_model(rng, 0.1, Harmonics { terms: 4, max_j: 6 })
 }
 
 /// A random original context: running-like speeds, heights, contact points.

@@ -4,22 +4,22 @@
 use super::*;
 use crate::constraints::{com_offset, precompute};
 use crate::force_model::AxisModel;
-use crate::query::testkit::{bell_model as random_model, Lcg};
+use crate::query::testkit::{bell_model as random_model, Rng};
 use std::f64::consts::PI;
 
 /// A running-like context.
-fn random_context(rng: &mut Lcg) -> QueryContext {
+fn random_context(rng: &mut Rng) -> QueryContext {
     QueryContext {
-        vs: rng.range(0.0, 6.0),
-        vps: rng.range(-0.5, 0.5),
-        t_td: rng.range(0.05, 0.4),
-        z_td: rng.range(0.8, 1.1),
-        cp: [rng.range(-0.3, 0.5), rng.range(-0.2, 0.2)],
+        vs: rng.uniform(0.0, 6.0),
+        vps: rng.uniform(-0.5, 0.5),
+        t_td: rng.uniform(0.05, 0.4),
+        z_td: rng.uniform(0.8, 1.1),
+        cp: [rng.uniform(-0.3, 0.5), rng.uniform(-0.2, 0.2)],
     }
 }
 
-fn beta_in(rng: &mut Lcg, lo: f64, hi: f64) -> [f64; 3] {
-    [0; 3].map(|_| rng.range(lo, hi))
+fn beta_in(rng: &mut Rng, lo: f64, hi: f64) -> [f64; 3] {
+    [0; 3].map(|_| rng.uniform(lo, hi))
 }
 
 /// `|x − y| ≤ tol · max(1, |y|)`.
@@ -29,7 +29,7 @@ fn close(x: f64, y: f64, tol: f64) -> bool {
 
 #[test]
 fn approx_never_accepts_what_exact_rejects() {
-    let mut rng = Lcg(7);
+    let mut rng = Rng::new(7);
     let (mut accepted, mut conservative_rejects) = (0, 0);
     for _ in 0..30 {
         let model = random_model(&mut rng);
@@ -39,8 +39,8 @@ fn approx_never_accepts_what_exact_rejects() {
         let base = relative_limits(&coef);
         for _ in 0..100 {
             let lim = Limits {
-                mu: base.mu * rng.range(0.5, 2.0),
-                f_max: base.f_max * rng.range(0.5, 3.0),
+                mu: base.mu * rng.uniform(0.5, 2.0),
+                f_max: base.f_max * rng.uniform(0.5, 3.0),
                 ..base
             };
             let beta = beta_in(&mut rng, 0.0, 3.0);
@@ -86,7 +86,7 @@ fn approx_rejects_negative_beta_and_limits() {
 
 #[test]
 fn identity_query_is_feasible_and_reports_original_extremes() {
-    let mut rng = Lcg(11);
+    let mut rng = Rng::new(11);
     let mut n_ok = 0;
     for _ in 0..40 {
         let model = random_model(&mut rng);
@@ -158,7 +158,7 @@ fn pulling_dip_is_infeasible_for_every_beta() {
         chi_min: 0.0,
         chi_max: 1e12,
     };
-    let mut rng = Lcg(3);
+    let mut rng = Rng::new(3);
     let mut betas = vec![[0.0; 3], [1.0; 3], [0.0, 0.0, 1.0], [3.0, 0.0, 0.0]];
     betas.extend((0..500).map(|_| beta_in(&mut rng, 0.0, 3.0)));
     for beta in betas {
@@ -187,7 +187,7 @@ fn exact_never_panics_on_bad_input() {
         &lim,
     );
     assert_eq!(empty.violated, Some(Violation::Friction));
-    let mut rng = Lcg(5);
+    let mut rng = Rng::new(5);
     let model = random_model(&mut rng);
     let tables = SampledTables::new(&model);
     let nan = exact(&tables, &model, &ctx, [f64::NAN, 1.0, 1.0], &lim);
@@ -279,7 +279,7 @@ fn brute_force_cp(z_td: f64, ih: &[[f64; 3]; 2], h_des: [f64; 3]) -> [f64; 2] {
 
 #[test]
 fn contact_point_identity_and_brute_force() {
-    let mut rng = Lcg(23);
+    let mut rng = Rng::new(23);
     for case in 0..12 {
         let model = random_model(&mut rng);
         let ctx = random_context(&mut rng);
@@ -328,14 +328,14 @@ fn scale_model(model: &ForceModel, l: f64, m: f64) -> ForceModel {
 
 #[test]
 fn verdicts_are_invariant_under_dynamic_similarity() {
-    let mut rng = Lcg(31);
+    let mut rng = Rng::new(31);
     let (mut feasible, mut infeasible) = (0, 0);
     for _ in 0..40 {
         let model = random_model(&mut rng);
         let ctx = random_context(&mut rng);
         let coef = precompute(&model, &ctx);
         let base = relative_limits(&coef);
-        let (l, m) = (rng.range(0.5, 2.0), rng.range(0.3, 4.0));
+        let (l, m) = (rng.uniform(0.5, 2.0), rng.uniform(0.3, 4.0));
         let (sl, s_model) = (l.sqrt(), scale_model(&model, l, m));
         let s_ctx = QueryContext {
             vs: ctx.vs * sl,
@@ -350,10 +350,10 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
         for _ in 0..25 {
             let beta = beta_in(&mut rng, 0.5, 1.6);
             let lim = Limits {
-                mu: base.mu * rng.range(0.8, 1.5),
-                f_max: base.f_max * rng.range(0.8, 1.5),
-                chi_min: base.chi_min * rng.range(0.7, 1.2),
-                chi_max: base.chi_max * rng.range(0.9, 1.2),
+                mu: base.mu * rng.uniform(0.8, 1.5),
+                f_max: base.f_max * rng.uniform(0.8, 1.5),
+                chi_min: base.chi_min * rng.uniform(0.7, 1.2),
+                chi_max: base.chi_max * rng.uniform(0.9, 1.2),
             };
             let s_lim = Limits {
                 mu: lim.mu,
@@ -393,7 +393,7 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
 
 #[test]
 fn exact_at_resolved_contact_point() {
-    let mut rng = Lcg(41);
+    let mut rng = Rng::new(41);
     for _ in 0..10 {
         let model = random_model(&mut rng);
         let ctx = random_context(&mut rng);

@@ -3,11 +3,11 @@
 
 use super::*;
 use crate::query::jump::{jump, recorded_jump, JumpFailure};
-use crate::query::testkit::{recorded_pair, Lcg};
+use crate::query::testkit::{recorded_pair, Rng};
 
 #[test]
 fn cells_agree_with_direct_jump_solves() {
-    let mut rng = Lcg(0x5eed_0601);
+    let mut rng = Rng::new(0x5eed_0601);
     let mut pool = Vec::new();
     for _ in 0..3 {
         let (a, b) = recorded_pair(&mut rng);

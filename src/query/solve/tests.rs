@@ -1,6 +1,6 @@
 use super::*;
 use crate::force_model::AxisModel;
-use crate::query::testkit::{random_model, rk4, scaled, simulate, Lcg, RK4_STEPS};
+use crate::query::testkit::{random_model, rk4, scaled, simulate, Rng, RK4_STEPS};
 use crate::stances::params::{from_states, model_consistent, StanceParams};
 
 fn request_of(p: &StanceParams) -> Request {
@@ -31,11 +31,11 @@ fn params_by_simulation(m: &ForceModel, v_td: [f64; 3], z_td: f64) -> StancePara
 
 #[test]
 fn identity_query_returns_beta_one_and_original_times() {
-    let mut rng = Lcg(0x5eed_0001);
+    let mut rng = Rng::new(0x5eed_0001);
     for i in 0..200 {
         let m = random_model(&mut rng);
-        let v_td = [rng.range(1.0, 6.0), 0.0, rng.range(-2.0, 0.5)];
-        let z_td = rng.range(0.8, 1.0);
+        let v_td = [rng.uniform(1.0, 6.0), 0.0, rng.uniform(-2.0, 0.5)];
+        let z_td = rng.uniform(0.8, 1.0);
         let p = params_by_simulation(&m, v_td, z_td);
         // RK4 vs the closed form (§3): ≲ 1e-12 stepping error on O(1) values.
         let pc = model_consistent(v_td, z_td, m.j(), m.p(), m.dt_s);
@@ -103,21 +103,21 @@ fn check_by_simulation(m: &ForceModel, req: &Request, s: &Solution, what: &str) 
 
 #[test]
 fn forward_simulation_reproduces_random_requests() {
-    let mut rng = Lcg(0x5eed_0002);
+    let mut rng = Rng::new(0x5eed_0002);
     let (mut scaled_ok, mut random_ok) = (0, 0);
     for i in 0..300 {
         let m = random_model(&mut rng);
         // (a) a scaled stance's own outcome (always feasible; vps ≠ 0 as with the
         // facing fallback of §2), (b) a random request.
         let beta = [
-            rng.range(0.5, 1.6),
-            rng.range(0.5, 1.6),
-            rng.range(0.6, 1.5),
+            rng.uniform(0.5, 1.6),
+            rng.uniform(0.5, 1.6),
+            rng.uniform(0.6, 1.5),
         ];
         let v_td = [
-            rng.range(0.5, 6.0),
-            rng.range(-0.3, 0.3),
-            rng.range(-2.0, 0.5),
+            rng.uniform(0.5, 6.0),
+            rng.uniform(-0.3, 0.3),
+            rng.uniform(-2.0, 0.5),
         ];
         let p = model_consistent(
             v_td,
@@ -135,13 +135,13 @@ fn forward_simulation_reproduces_random_requests() {
         scaled_ok += 1;
 
         let req = Request {
-            zs: rng.range(0.8, 1.2),
-            vs: rng.range(0.0, 6.0),
-            ze: rng.range(0.8, 1.2),
-            ve: rng.range(0.0, 6.0),
-            vp: rng.range(-0.3, 0.3),
+            zs: rng.uniform(0.8, 1.2),
+            vs: rng.uniform(0.0, 6.0),
+            ze: rng.uniform(0.8, 1.2),
+            ve: rng.uniform(0.0, 6.0),
+            vp: rng.uniform(-0.3, 0.3),
             vps: 0.0,
-            x: rng.range(0.0, 4.0),
+            x: rng.uniform(0.0, 4.0),
         };
         let shape = StanceShape::from_model(&m, true, true, None);
         if let Ok(s) = solve(&shape, &req, &Refs::default(), None) {
@@ -326,19 +326,19 @@ fn negative_discriminant_is_reported_not_nan() {
 
 #[test]
 fn at_most_one_root_satisfies_the_centroid_rule() {
-    let mut rng = Lcg(0x5eed_0005);
+    let mut rng = Rng::new(0x5eed_0005);
     let (mut real, mut two_positive) = (0, 0);
     for i in 0..500 {
         let m = random_model(&mut rng);
         let shape = StanceShape::from_model(&m, false, false, None);
         let req = Request {
-            zs: rng.range(0.7, 1.3),
-            vs: rng.range(0.0, 6.0),
-            ze: rng.range(0.7, 1.3),
-            ve: rng.range(0.0, 6.0),
+            zs: rng.uniform(0.7, 1.3),
+            vs: rng.uniform(0.0, 6.0),
+            ze: rng.uniform(0.7, 1.3),
+            ve: rng.uniform(0.0, 6.0),
             vp: 0.0,
             vps: 0.0,
-            x: rng.range(-0.5, 4.0),
+            x: rng.uniform(-0.5, 4.0),
         };
         let Ok((cands, _)) = candidates(&shape, &req, &Refs::default(), &SolveOptions::default())
         else {
@@ -364,19 +364,19 @@ fn at_most_one_root_satisfies_the_centroid_rule() {
 #[test]
 fn root_choice_follows_t_orig_when_two_are_admissible() {
     // A reversal (vs > 0, ve < 0) can make both roots admissible (§6.5): search for one.
-    let mut rng = Lcg(0x5eed_0006);
+    let mut rng = Rng::new(0x5eed_0006);
     let mut found = 0;
     for _ in 0..4000 {
         let m = random_model(&mut rng);
         let shape = StanceShape::from_model(&m, false, false, None);
         let req = Request {
-            zs: rng.range(0.7, 1.3),
-            vs: rng.range(0.0, 3.0),
-            ze: rng.range(0.7, 1.3),
-            ve: rng.range(-3.0, 0.0),
+            zs: rng.uniform(0.7, 1.3),
+            vs: rng.uniform(0.0, 3.0),
+            ze: rng.uniform(0.7, 1.3),
+            ve: rng.uniform(-3.0, 0.0),
             vp: 0.0,
             vps: 0.0,
-            x: rng.range(-2.0, 2.0),
+            x: rng.uniform(-2.0, 2.0),
         };
         let Ok(s) = solve(&shape, &req, &Refs::default(), None) else {
             continue;
@@ -395,7 +395,7 @@ fn root_choice_follows_t_orig_when_two_are_admissible() {
 
 #[test]
 fn never_nan_on_hostile_inputs() {
-    let mut rng = Lcg(0x5eed_0007);
+    let mut rng = Rng::new(0x5eed_0007);
     let pool = [
         0.0,
         -0.0,
@@ -410,14 +410,15 @@ fn never_nan_on_hostile_inputs() {
         3.0,
         0.5,
     ];
-    let pick = |rng: &mut Lcg| pool[(rng.next() * pool.len() as f64) as usize];
+    let pick = |rng: &mut Rng| pool[(rng.next_f64() * pool.len() as f64) as usize];
     for _ in 0..20_000 {
         let m = random_model(&mut rng);
-        let mut shape = StanceShape::from_model(&m, rng.next() < 0.5, rng.next() < 0.5, None);
-        if rng.next() < 0.3 {
-            shape.j[(rng.next() * 3.0) as usize] = pick(&mut rng);
+        let mut shape =
+            StanceShape::from_model(&m, rng.next_f64() < 0.5, rng.next_f64() < 0.5, None);
+        if rng.next_f64() < 0.3 {
+            shape.j[(rng.next_f64() * 3.0) as usize] = pick(&mut rng);
         }
-        if rng.next() < 0.3 {
+        if rng.next_f64() < 0.3 {
             shape.ref_signs = Some((pick(&mut rng), pick(&mut rng)));
         }
         let req = Request {
@@ -467,7 +468,7 @@ fn ties_go_to_the_smaller_t() {
 fn shape_from_a_library_stance() {
     use crate::constraints::{precompute, StanceContext};
     use crate::stances::params::{Heading, HeadingFrom};
-    let mut rng = Lcg(0x5eed_0008);
+    let mut rng = Rng::new(0x5eed_0008);
     let model = random_model(&mut rng);
     let v_td = [3.0, 0.0, -0.8];
     let p = model_consistent(v_td, 0.9, model.j(), model.p(), model.dt_s);
