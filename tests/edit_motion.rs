@@ -10,7 +10,7 @@ use stancelib::library::read::{open_library, read_parquet};
 use stancelib::query::run::run_cycles;
 use stancelib::skeleton::Skeleton;
 
-use super::util::{ok, root, shared_or_skip, stancelib};
+use super::util::{ingest_body, ok, root, shared_or_skip, stancelib};
 
 const G: f64 = 9.81;
 
@@ -622,17 +622,11 @@ fn edited_run_of_a_longer_heavier_character_scales_by_dynamic_similarity() {
         out.to_str().unwrap(),
     ]);
     assert_bounds_except(&measure(&out), &[]);
-    let (src_summary, _, _) = {
-        let bvh = parse_file(&src).unwrap();
-        match ingest(&bvh, &IngestOptions::default()).unwrap() {
-            ClipOutcome::Body {
-                summary,
-                frames,
-                contacts,
-            } => (summary, frames, contacts),
-            ClipOutcome::Skipped { reason, .. } => panic!("source skipped: {reason}"),
-        }
-    };
+    let (src_summary, _, _) = ingest_body(
+        &parse_file(&src).unwrap(),
+        &IngestOptions::default(),
+        "source",
+    );
     let (summary, _, _) = reingest(&out);
     let leg_ratio = summary.leg_length_m.unwrap() / src_summary.leg_length_m.unwrap();
     assert!(
@@ -708,9 +702,7 @@ fn edit_of_a_female_library_poses_with_the_female_segment_model() {
             sex,
             ..IngestOptions::default()
         };
-        let ClipOutcome::Body { frames, .. } = ingest(&bvh, &opts).unwrap() else {
-            panic!("{} skipped", out.display());
-        };
+        let (_, frames, _) = ingest_body(&bvh, &opts, &out.display().to_string());
         (0..plan.com.len())
             .map(|i| dist(frames.com[i], plan.com[i]))
             .fold(0.0, f64::max)
