@@ -36,6 +36,39 @@ pub const MANIFEST_FILE: &str = "manifest.json";
 /// a folder a stancelib library, which `build` may replace.
 pub const MANIFEST_SCHEMA_PREFIX: &str = "stancelib.library/";
 
+/// Key-value metadata key of every library table: [`SCHEMA_VERSION`].
+pub const SCHEMA_VERSION_KEY: &str = "stancelib.schema_version";
+/// Key-value metadata key of every output: the tool version ([`TOOL_VERSION`]).
+pub const TOOL_VERSION_KEY: &str = "stancelib.tool_version";
+/// The tool version recorded everywhere (`CARGO_PKG_VERSION`).
+pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// Key-value metadata key of a library table: the fingerprint of the build options.
+pub const OPTIONS_KEY: &str = "stancelib.options";
+/// Key-value metadata key of a library table: the inputs' content hashes (JSON).
+pub const INPUTS_KEY: &str = "stancelib.inputs";
+/// Key-value metadata key of a library table: the per-character limits (JSON).
+pub const LIMITS_KEY: &str = "stancelib.limits";
+/// Key-value metadata key of a query output: the query's options (JSON).
+pub const QUERY_KEY: &str = "stancelib.query";
+/// Key-value metadata key of an `equilibrium` output: its options (JSON).
+pub const EQUILIBRIUM_KEY: &str = "stancelib.equilibrium";
+/// Key-value metadata key of a `twopac` output: its options (JSON).
+pub const TWOPAC_KEY: &str = "stancelib.twopac";
+/// Key-value metadata key of a query output: SHA-256 (hex) of its library's
+/// `manifest.json`.
+pub const LIBRARY_MANIFEST_KEY: &str = "stancelib.library_manifest_sha256";
+/// Key-value metadata key of a query output: the library folder as given.
+pub const LIBRARY_PATH_KEY: &str = "stancelib.library";
+
+/// The key-value metadata of a command's output: the tool version, then the command's
+/// options as JSON under `key` (one of [`QUERY_KEY`], [`EQUILIBRIUM_KEY`], [`TWOPAC_KEY`]).
+pub fn command_kv(key: &str, options: &serde_json::Value) -> Vec<(String, String)> {
+    vec![
+        (TOOL_VERSION_KEY.to_string(), TOOL_VERSION.to_string()),
+        (key.to_string(), options.to_string()),
+    ]
+}
+
 /// Columns of `clips.parquet`, in order.
 pub const CLIPS_COLUMNS: [&str; 24] = [
     "path",
