@@ -17,7 +17,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, register_font, PlotError};
+use super::{err, register_font, value_mesh, PlotError};
 use crate::force_model::GRAVITY as G;
 use crate::library::clip_view::{ClipView, EFFECTORS};
 
@@ -121,18 +121,6 @@ fn time_chart<'a, 'b>(
         .map_err(|e| err(path, e))
 }
 
-/// The mesh of a value panel: clip time against `y_desc`.
-fn value_mesh(chart: &mut TimeChart<'_, '_>, path: &Path, y_desc: &str) -> Result<(), PlotError> {
-    chart
-        .configure_mesh()
-        .x_desc("clip time (s)")
-        .y_desc(y_desc)
-        .light_line_style(WHITE.mix(0.0))
-        .label_style(("sans-serif", 13))
-        .draw()
-        .map_err(|e| err(path, e))
-}
-
 /// (a) COM height and the flights.
 fn height_panel(
     area: &Area<'_>,
@@ -149,7 +137,7 @@ fn height_panel(
         t,
         (z_lo - pad)..(z_hi + pad),
     )?;
-    value_mesh(&mut a, path, "COM z (m)")?;
+    value_mesh(&mut a, path, "clip time (s)", "COM z (m)")?;
     let com: Vec<(f64, f64)> = view
         .time_s
         .iter()
@@ -197,7 +185,7 @@ fn speed_panel(
         t,
         0.0..(v_hi.max(0.1) * 1.1),
     )?;
-    value_mesh(&mut b, path, "speed (m/s)")?;
+    value_mesh(&mut b, path, "clip time (s)", "speed (m/s)")?;
     let speed: Vec<(f64, f64)> = view
         .time_s
         .iter()

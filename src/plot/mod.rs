@@ -77,6 +77,23 @@ fn draw_legend<'a, 'b: 'a>(
         .map_err(|e| err(path, e))
 }
 
+/// The mesh of a value panel: `x_desc` against `y_desc`, no light grid lines, 13 px labels.
+fn value_mesh(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    x_desc: &str,
+    y_desc: &str,
+) -> Result<(), PlotError> {
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .light_line_style(WHITE.mix(0.0))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| err(path, e))
+}
+
 /// Per (distance bin, height row): pairs feasible by both, approx only, exact only.
 struct Binned {
     d0: f64,

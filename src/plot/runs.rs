@@ -9,7 +9,7 @@ use std::path::Path;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::{err, register_font, PlotError};
+use super::{err, register_font, value_mesh, PlotError};
 
 /// One cycle at one speed, as the figure needs it.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -187,14 +187,7 @@ pub fn runs_png(path: &Path, title: &str, points: &[RunPoint]) -> Result<(), Plo
             .y_label_area_size(65)
             .build_cartesian_2d(speeds.clone(), ys.clone())
             .map_err(|e| err(path, e))?;
-        chart
-            .configure_mesh()
-            .x_desc("target speed (m/s)")
-            .y_desc(ylabel)
-            .light_line_style(WHITE.mix(0.0))
-            .label_style(("sans-serif", 13))
-            .draw()
-            .map_err(|e| err(path, e))?;
+        value_mesh(&mut chart, path, "target speed (m/s)", ylabel)?;
         for c in 0..n_cycles {
             draw_cycle(&mut chart, path, points, c, get, lim)?;
         }

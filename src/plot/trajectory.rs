@@ -152,24 +152,26 @@ fn view(
         .draw()
         .map_err(|e| err(path, e))?;
     draw_contacts(&mut chart, path, d, k)?;
-    let orange = RGBColor(255, 140, 0);
-    chart
-        .draw_series(LineSeries::new(
-            d.quasi_static.iter().map(pr),
-            orange.stroke_width(2),
-        ))
-        .map_err(|e| err(path, e))?
-        .label("quasi-static polyline")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
-    let blue = RGBColor(30, 90, 200);
-    chart
-        .draw_series(LineSeries::new(
-            d.curve.iter().map(pr),
-            blue.stroke_width(3),
-        ))
-        .map_err(|e| err(path, e))?
-        .label("2PAC COM curve")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue.stroke_width(3)));
+    for (pts, colour, width, label) in [
+        (
+            &d.quasi_static,
+            RGBColor(255, 140, 0),
+            2,
+            "quasi-static polyline",
+        ),
+        (&d.curve, RGBColor(30, 90, 200), 3, "2PAC COM curve"),
+    ] {
+        chart
+            .draw_series(LineSeries::new(
+                pts.iter().map(pr),
+                colour.stroke_width(width),
+            ))
+            .map_err(|e| err(path, e))?
+            .label(label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(width))
+            });
+    }
     draw_markers(&mut chart, path, d, k)?;
     chart
         .configure_series_labels()
