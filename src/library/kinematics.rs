@@ -382,3 +382,26 @@ fn points_table(rows: &[(&(String, String), &Sample)]) -> PolarsResult<DataFrame
         col("z", p(2)),
     ])
 }
+
+#[cfg(test)]
+mod schema_tests {
+    use super::*;
+    use crate::library::schema::{KINEMATICS_COLUMNS, KINEMATICS_POINTS_COLUMNS};
+
+    #[test]
+    fn the_kinematic_tables_have_the_schema_columns() {
+        let names = |df: &DataFrame| -> Vec<String> {
+            df.get_column_names()
+                .iter()
+                .map(|n| n.to_string())
+                .collect()
+        };
+        let (facets, points) = kinematics_tables(Vec::new(), &[]).unwrap();
+        assert_eq!(names(&facets), KINEMATICS_COLUMNS);
+        assert_eq!(names(&points), KINEMATICS_POINTS_COLUMNS);
+        assert_eq!(
+            names(&SampleStore::default().table().unwrap()),
+            KINEMATICS_POINTS_COLUMNS
+        );
+    }
+}

@@ -592,3 +592,36 @@ pub fn errors_table(rows: &[ErrorRow]) -> PolarsResult<DataFrame> {
         ),
     ])
 }
+
+#[cfg(test)]
+mod schema_tests {
+    use super::*;
+    use crate::library::schema::{ERRORS_COLUMNS, STANCES_COLUMNS};
+
+    fn names(df: &DataFrame) -> Vec<String> {
+        df.get_column_names()
+            .iter()
+            .map(|n| n.to_string())
+            .collect()
+    }
+
+    // See: issue 13 item 2 — stance column names were literals in the writer and the reader.
+    #[test]
+    fn the_writers_columns_are_the_schema_and_the_reader_reads_only_those() {
+        assert_eq!(names(&stances_table(&[]).unwrap()), STANCES_COLUMNS);
+        assert_eq!(names(&errors_table(&[]).unwrap()), ERRORS_COLUMNS);
+        let read: Vec<String> = SCALAR_COLUMNS
+            .iter()
+            .map(|c| c.to_string())
+            .chain(AXES.iter().flat_map(|a| {
+                ["c0", "harmonic", "amp", "phase", "fit_rms", "poly"].map(|p| format!("{p}_{a}"))
+            }))
+            .collect();
+        for c in &read {
+            assert!(
+                STANCES_COLUMNS.contains(&c.as_str()),
+                "reader column {c} not written"
+            );
+        }
+    }
+}
