@@ -66,6 +66,10 @@
 //! - `safety_outputs`: `--out` never destroys what the tool did not write; input links,
 //!   cycles and special files; per-input errors; stale temporaries; the build lock.
 //!
+//! # Structure (issue 13)
+//! - `structure_edges`: enumerated options parsed (any case) and refused before work;
+//!   outputs of every kind leave no temporary behind.
+//!
 //! # Regressions and helpers
 //! - `regression`: one test per review finding, named after it.
 //! - `util`: shared helpers: the shared-data gate and skips, fixtures and their library, the
@@ -108,6 +112,8 @@ mod safety_limits;
 mod safety_messages;
 mod safety_options;
 mod safety_outputs;
+// Structure (issue 13)
+mod structure_edges;
 // Regressions and helpers
 mod regression;
 mod util;

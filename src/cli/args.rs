@@ -3,14 +3,130 @@
 use crate::force_model::ForceModelKind;
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use crate::pipeline::queries::{speed_range, LimitOptions};
 use crate::pipeline::shard::Shard;
 use crate::pipeline::spec::Overrides;
-use crate::query::feasibility::{check_mu, LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
+use crate::query::feasibility::LimitForm;
 use crate::query::map::Axis;
 use crate::query::run::check_speed;
 use crate::skeleton::units::{parse_unit, UpAxis};
+use crate::synth::{SynthMotion, SynthUp};
+use crate::twopac::transition::QpForm;
+
+/// `--limits`: the limit form (§7.5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LimitFormArg {
+    /// Per character.
+    Absolute,
+    /// Per stance.
+    Relative,
+}
+
+impl From<LimitFormArg> for LimitForm {
+    fn from(f: LimitFormArg) -> Self {
+        match f {
+            LimitFormArg::Absolute => LimitForm::Absolute,
+            LimitFormArg::Relative => LimitForm::Relative,
+        }
+    }
+}
+
+/// `--up-axis`: the files' up axis (`X` = `+X`; any case).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[value(rename_all = "verbatim")]
+pub enum UpAxisArg {
+    /// +X.
+    #[value(name = "+X", alias = "X")]
+    PosX,
+    /// −X.
+    #[value(name = "-X")]
+    NegX,
+    /// +Y.
+    #[value(name = "+Y", alias = "Y")]
+    PosY,
+    /// −Y.
+    #[value(name = "-Y")]
+    NegY,
+    /// +Z.
+    #[value(name = "+Z", alias = "Z")]
+    PosZ,
+    /// −Z.
+    #[value(name = "-Z")]
+    NegZ,
+}
+
+impl From<UpAxisArg> for UpAxis {
+    fn from(a: UpAxisArg) -> Self {
+        match a {
+            UpAxisArg::PosX => UpAxis::PosX,
+            UpAxisArg::NegX => UpAxis::NegX,
+            UpAxisArg::PosY => UpAxis::PosY,
+            UpAxisArg::NegY => UpAxis::NegY,
+            UpAxisArg::PosZ => UpAxis::PosZ,
+            UpAxisArg::NegZ => UpAxis::NegZ,
+        }
+    }
+}
+
+/// `synth --motion`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MotionArg {
+    /// Running: alternating single-foot stances and flights.
+    Run,
+    /// A countermovement jump in place.
+    Jump,
+}
+
+impl From<MotionArg> for SynthMotion {
+    fn from(m: MotionArg) -> Self {
+        match m {
+            MotionArg::Run => SynthMotion::Run,
+            MotionArg::Jump => SynthMotion::Jump,
+        }
+    }
+}
+
+/// `synth --up`: the generated file's up axis (`+Y` = `Y`; any case).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[value(rename_all = "verbatim")]
+pub enum SynthUpArg {
+    /// Y up.
+    #[value(alias = "+Y")]
+    Y,
+    /// Z up.
+    #[value(alias = "+Z")]
+    Z,
+}
+
+impl From<SynthUpArg> for SynthUp {
+    fn from(u: SynthUpArg) -> Self {
+        match u {
+            SynthUpArg::Y => SynthUp::Y,
+            SynthUpArg::Z => SynthUp::Z,
+        }
+    }
+}
+
+/// `twopac --form`: the transition QP form.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[value(rename_all = "lower")]
+pub enum QpFormArg {
+    /// Equality form with wrench slack (eq 13).
+    Eq13,
+    /// Inequality form on the H-representation (eq 6).
+    Eq6,
+}
+
+impl From<QpFormArg> for QpForm {
+    fn from(f: QpFormArg) -> Self {
+        match f {
+            QpFormArg::Eq13 => QpForm::Eq13,
+            QpFormArg::Eq6 => QpForm::Eq6,
+        }
+    }
+}
 
 /// stancelib: physically grounded stance libraries from motion-capture clips.
 #[derive(Debug, Parser)]
@@ -264,8 +380,8 @@ pub fn parse_range(flag: &str, s: &str) -> anyhow::Result<Axis> {
 #[derive(Debug, Args, Clone, Default)]
 pub struct LimitArgs {
     /// Limit form: absolute (per character) or relative (per stance) (§7.5).
-    #[arg(long, value_parser = ["absolute", "relative"])]
-    pub limits: Option<String>,
+    #[arg(long, value_enum)]
+    pub limits: Option<LimitFormArg>,
     /// Friction limit μ, under either form: it replaces the absolute 0.7 and the
     /// relative 1.05 × the stance's own μ_req (force and extension limits keep the form).
     #[arg(long)]
@@ -277,30 +393,31 @@ pub struct LimitArgs {
 }
 
 impl LimitArgs {
+    /// The typed limit options (checked where they are used: [`LimitOptions::form`],
+    /// [`LimitOptions::active_fraction`]).
+    pub fn options(&self) -> LimitOptions {
+        LimitOptions {
+            form: self.limits.map(LimitForm::from),
+            mu: self.mu,
+            active_set: self.active_set,
+        }
+    }
+
     /// The limit form (`--limits`, else the query's `default`) and the given μ.
     ///
     /// # Errors
     /// A μ that is not a positive finite number.
     pub fn form(&self, default: LimitForm) -> anyhow::Result<(LimitForm, Option<f64>)> {
-        if let Some(m) = self.mu {
-            check_mu(m).map_err(|msg| crate::error::Error::invalid("--mu", msg))?;
-        }
-        let form = self.limits.as_deref().and_then(LimitForm::parse);
-        Ok((form.unwrap_or(default), self.mu))
+        self.options().form(default)
     }
 
     /// The friction check's active fraction `λ_act` (`--active-set`, else
-    /// [`DEFAULT_QUERY_ACTIVE_FRACTION`]).
+    /// [`DEFAULT_QUERY_ACTIVE_FRACTION`](crate::query::feasibility::DEFAULT_QUERY_ACTIVE_FRACTION)).
     ///
     /// # Errors
     /// A fraction outside `[0, 1)` or not finite.
     pub fn active_fraction(&self) -> anyhow::Result<f64> {
-        let v = self.active_set.unwrap_or(DEFAULT_QUERY_ACTIVE_FRACTION);
-        anyhow::ensure!(
-            v.is_finite() && (0.0..1.0).contains(&v),
-            "--active-set must lie in [0, 1), found {v}"
-        );
-        Ok(v)
+        self.options().active_fraction()
     }
 }
 
@@ -340,15 +457,11 @@ impl RunQueryArgs {
     /// # Errors
     /// Neither option, a bad range, or a negative or non-finite speed.
     pub fn speeds(&self) -> anyhow::Result<Vec<f64>> {
-        let (flag, v) = match (&self.speeds, self.speed) {
-            (Some(r), _) => ("--speeds", parse_range("--speeds", r)?.values()),
-            (None, Some(v)) => ("--speed", vec![v]),
+        match (&self.speeds, self.speed) {
+            (Some(r), _) => speed_range("--speeds", r),
+            (None, Some(v)) => Ok(vec![check_speed("--speed", v)?]),
             (None, None) => anyhow::bail!("give --speed V or --speeds start:stop:step"),
-        };
-        for s in &v {
-            check_speed(flag, *s)?;
         }
-        Ok(v)
     }
 }
 
@@ -432,8 +545,13 @@ pub struct BodyArgs {
     #[arg(long)]
     pub unit: Option<String>,
     /// Up axis of the files: +X, -X, +Y, -Y, +Z, -Z (default: detected).
-    #[arg(long = "up-axis", allow_hyphen_values = true)]
-    pub up_axis: Option<String>,
+    #[arg(
+        long = "up-axis",
+        allow_hyphen_values = true,
+        value_enum,
+        ignore_case = true
+    )]
+    pub up_axis: Option<UpAxisArg>,
     /// Static / elevated contacts (multi-contact clips).
     #[arg(long = "static-contacts")]
     pub static_contacts: bool,
@@ -476,12 +594,7 @@ impl BodyArgs {
             })?),
             None => None,
         };
-        let up_axis = match &self.up_axis {
-            Some(a) => Some(UpAxis::parse(a).ok_or_else(|| {
-                anyhow::anyhow!("--up-axis: '{a}' is not one of +X -X +Y -Y +Z -Z")
-            })?),
-            None => None,
-        };
+        let up_axis = self.up_axis.map(UpAxis::from);
         Ok(Overrides {
             mass_kg,
             unit_m,
@@ -578,8 +691,8 @@ pub struct RunArgs {
 #[derive(Debug, Args)]
 pub struct SynthArgs {
     /// `run` or `jump`.
-    #[arg(long, default_value = "run")]
-    pub motion: String,
+    #[arg(long, value_enum, ignore_case = true, default_value = "run")]
+    pub motion: MotionArg,
     /// Frame rate, Hz.
     #[arg(long, default_value_t = 120.0)]
     pub rate: f64,
@@ -590,8 +703,8 @@ pub struct SynthArgs {
     #[arg(long, default_value = "m")]
     pub unit: String,
     /// Up axis of the file: Y or Z.
-    #[arg(long, default_value = "Y")]
-    pub up: String,
+    #[arg(long, value_enum, ignore_case = true, default_value = "Y")]
+    pub up: SynthUpArg,
     /// Seed of the small pose perturbations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -634,8 +747,8 @@ pub struct TwopacArgs {
     #[arg(long, requires = "lib")]
     pub character: Option<String>,
     /// Transition QP form: `eq13` (equality form, default) or `eq6` (H-representation).
-    #[arg(long, default_value = "eq13")]
-    pub form: String,
+    #[arg(long, value_enum, default_value = "eq13")]
+    pub form: QpFormArg,
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,

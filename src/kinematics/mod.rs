@@ -1,83 +1,22 @@
-//! Kinematic polytopes learned from the database (spec two-pac §3, eq 3–4): where the COM
-//! can be relative to an effector in contact.
+//! The contact frame of the kinematic samples (spec two-pac §3, eq 3): where the COM is
+//! relative to an effector in contact.
 //!
 //! # Model
 //! ```text
 //! point:    ʳc = R_eᵀ (c − p_e)        COM in the effector's contact frame (m);
 //!           R_e = Rz(yaw), p_e = contact-frame origin (com-from-bvh §7.5)
-//! outliers: per (character, effector): drop |ʳc − centroid| > P99.5 of those distances,
-//!           and |ʳc| > 1.3 · L_leg
-//! hull:     K_e ʳc ≤ k_e, unit outward rows, coplanar facets merged (≥ 4 non-coplanar points)
 //! ```
-//! `R_e` is yaw-only with `z` up, so one polytope serves any level surface and yaw; a
-//! contact at `(p, R)` uses `K_w = K_e Rᵀ`, `k_w = k_e + K_e Rᵀ p`
-//! ([`Polytope::to_world_yaw`]).
+//! The outlier rules and the hull that turn these points into kinematic polytopes are in
+//! [`crate::twopac::kinematic`].
 //!
 //! # References
 //! spec two-pac §3; com-from-bvh §7.5 (contact frames).
-
-use crate::math::stats::percentile;
-use crate::twopac::hull::{hull_hrep, HullOptions};
-use crate::twopac::polytope::Polytope;
-
-/// Distance percentile beyond which points are outliers.
-pub const OUTLIER_PERCENTILE: f64 = 99.5;
-/// Points farther than this many leg lengths from the contact are dropped.
-pub const MAX_LEG_LENGTHS: f64 = 1.3;
 
 /// The COM in a yaw-only contact frame: `Rz(yaw)ᵀ (c − origin)`, m.
 pub fn com_in_contact_frame(com: [f64; 3], origin: [f64; 3], yaw_rad: f64) -> [f64; 3] {
     let (s, c) = yaw_rad.sin_cos();
     let d = [com[0] - origin[0], com[1] - origin[1], com[2] - origin[2]];
     [c * d[0] + s * d[1], -s * d[0] + c * d[1], d[2]]
-}
-
-/// Which points survive the outlier rules, for one character and effector.
-///
-/// Non-finite points never survive; an empty set stays empty.
-pub fn inliers(points: &[[f64; 3]], leg_m: f64) -> Vec<bool> {
-    let finite: Vec<bool> = points
-        .iter()
-        .map(|p| p.iter().all(|v| v.is_finite()))
-        .collect();
-    let n = finite.iter().filter(|&&f| f).count();
-    if n == 0 {
-        return vec![false; points.len()];
-    }
-    let mut centroid = [0.0; 3];
-    for (p, _) in points.iter().zip(&finite).filter(|(_, &f)| f) {
-        for k in 0..3 {
-            centroid[k] += p[k] / n as f64;
-        }
-    }
-    let dist = |p: &[f64; 3]| {
-        ((p[0] - centroid[0]).powi(2) + (p[1] - centroid[1]).powi(2) + (p[2] - centroid[2]).powi(2))
-            .sqrt()
-    };
-    let d: Vec<f64> = points
-        .iter()
-        .zip(&finite)
-        .filter(|(_, &f)| f)
-        .map(|(p, _)| dist(p))
-        .collect();
-    let limit = percentile(&d, OUTLIER_PERCENTILE).unwrap_or(f64::INFINITY);
-    let reach = MAX_LEG_LENGTHS * leg_m;
-    points
-        .iter()
-        .zip(&finite)
-        .map(|(p, &f)| {
-            let norm = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-            f && dist(p) <= limit && norm <= reach
-        })
-        .collect()
-}
-
-/// The polytope of a point set (unit outward rows, coplanar facets merged).
-///
-/// # Errors
-/// Fewer than 4 non-coplanar points (the effector then has no polytope).
-pub fn polytope(points: &[[f64; 3]]) -> Result<Polytope, crate::twopac::TwopacError> {
-    hull_hrep(points, &HullOptions::default())
 }
 
 #[cfg(test)]
@@ -100,48 +39,5 @@ mod tests {
         for k in 0..3 {
             assert!((back[k] - local[k]).abs() < 1e-12, "{back:?}");
         }
-    }
-
-    #[test]
-    fn outliers_by_percentile_reach_and_non_finite() {
-        // 1000 points on a small cloud around (0, 0, 0.9), one far point, one NaN.
-        let mut pts: Vec<[f64; 3]> = (0..1000)
-            .map(|i| {
-                let t = i as f64 * 0.618;
-                [0.1 * t.sin(), 0.1 * t.cos(), 0.9 + 0.05 * (3.0 * t).sin()]
-            })
-            .collect();
-        pts.push([0.0, 0.0, 1.5]); // within P99.5? no: farthest of all
-        pts.push([f64::NAN, 0.0, 0.9]);
-        let keep = inliers(&pts, 0.9);
-        assert!(!keep[1000] && !keep[1001]);
-        let kept = keep.iter().filter(|&&k| k).count();
-        // P99.5 of 1001 distances drops about 5 points, the far one among them.
-        assert!((990..1000).contains(&kept), "{kept}");
-        // A short leg drops every point beyond 1.3 L_leg.
-        let short = inliers(&pts, 0.5);
-        assert!(short
-            .iter()
-            .zip(&pts)
-            .all(|(&k, p)| !k || (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() <= 0.65));
-        assert!(inliers(&[], 1.0).is_empty());
-    }
-
-    #[test]
-    fn polytope_holds_its_points() {
-        let pts: Vec<[f64; 3]> = (0..500)
-            .map(|i| {
-                let t = i as f64;
-                [
-                    0.2 * (0.37 * t).sin(),
-                    0.15 * (0.73 * t).cos(),
-                    0.8 + 0.1 * (1.3 * t).sin(),
-                ]
-            })
-            .collect();
-        let p = polytope(&pts).expect("a hull");
-        assert!(pts.iter().all(|&c| p.contains(c, 1e-9)));
-        assert!(!p.contains([0.0, 0.0, 2.0], 1e-9));
-        assert!(polytope(&pts[..3]).is_err());
     }
 }

@@ -20,9 +20,9 @@ use polars::prelude::*;
 
 use super::columns::col;
 use super::read::{read_stances, Table};
+use super::stances::PoolStance;
 use crate::error::{Error, Result};
 use crate::force_model::export::{sample_forces, StanceTimes};
-use crate::query::pool::PoolStance;
 use crate::skeleton::units::UpAxis;
 use crate::stances::params::{Heading, HeadingFrom};
 

@@ -1,6 +1,7 @@
-//! `kinematics.parquet` and `kinematics_points.parquet` (spec two-pac §3): the kinematic
-//! polytopes of each character's effectors, built from the library's own frames and
-//! contact runs, and read back as [`Polytope`]s.
+//! The kinematic tables (spec two-pac §3): `kinematics_samples.parquet` (a shard's
+//! samples), `kinematics.parquet` (the polytopes' facets) and `kinematics_points.parquet`
+//! (the points behind them), written and read back. The polytopes themselves are built
+//! from the samples in memory by [`crate::twopac::kinematic`].
 //!
 //! `kinematics.parquet`: one row per facet, `character_id`, `effector`, `nx`, `ny`, `nz`,
 //! `d` (`n·ʳc ≤ d`, unit outward `n`, metres, contact frame), sorted by (`character_id`,
@@ -18,20 +19,25 @@ use super::columns::col;
 use super::read::Table;
 use super::schema::KINEMATICS_FILE;
 use crate::error::{Error, Result};
-use crate::kinematics::{com_in_contact_frame, inliers, polytope};
-use crate::twopac::polytope::Polytope;
+use crate::kinematics::com_in_contact_frame;
 
 /// One kinematic sample: the COM in an effector's contact frame at one frame.
 #[derive(Debug, Clone, PartialEq)]
-struct Sample {
-    clip: Arc<str>,
-    frame: i64,
-    rc: [f64; 3],
+pub struct Sample {
+    /// The clip (one shared name per run of a clip's samples).
+    pub clip: Arc<str>,
+    /// The frame (file row).
+    pub frame: i64,
+    /// The COM in the contact frame, m.
+    pub rc: [f64; 3],
 }
 
-type Groups = BTreeMap<(String, String), Vec<Sample>>;
+/// Samples by (character, effector).
+pub type Groups = BTreeMap<(String, String), Vec<Sample>>;
 /// One facet row: character, effector, unit outward normal, offset (m).
-type Facet = (String, String, [f64; 3], f64);
+pub type Facet = (String, String, [f64; 3], f64);
+/// The facets of one polytope: unit outward normals and offsets (m), `n·ʳc ≤ d`.
+pub type FacetRows = (Vec<[f64; 3]>, Vec<f64>);
 
 fn strs(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<String>>> {
     Ok(df
@@ -270,79 +276,22 @@ impl SampleStore {
         points_table(&rows)
     }
 
-    /// The two kinematics tables (`(facets, points)`) with each character's leg length (m).
-    ///
-    /// # Errors
-    /// A column cannot be built.
-    pub fn kinematics(
-        mut self,
-        legs: &BTreeMap<String, f64>,
-    ) -> PolarsResult<(DataFrame, DataFrame)> {
+    /// The samples grouped by (character, effector), each group in (clip, frame) order.
+    pub fn into_groups(mut self) -> Groups {
         self.sort();
-        kinematics_from_groups(&self.groups, legs)
+        self.groups
     }
 }
 
-/// The two kinematics tables of a library from its `frames`, `contacts` and `clips`
-/// tables: `(facets, points)`. A (character, effector) with fewer than 4 non-coplanar
-/// points after the outlier rules has points but no facets (an error at query time).
+/// The two kinematics tables `(facets, points)`: the facets of every polytope (sorted by
+/// character, effector, normal, offset) and the samples kept behind them, in group order.
 ///
 /// # Errors
-/// A table lacks a needed column or has it with another type.
+/// A column cannot be built.
 pub fn kinematics_tables(
-    frames: &DataFrame,
-    contacts: &DataFrame,
-    clips: &DataFrame,
+    mut facets: Vec<Facet>,
+    kept: &[(&(String, String), Vec<&Sample>)],
 ) -> PolarsResult<(DataFrame, DataFrame)> {
-    let samples = samples_table(frames, contacts, clips)?;
-    let mut legs = BTreeMap::new();
-    add_character_legs(&mut legs, clips)?;
-    kinematics_from_samples(&samples, &legs)
-}
-
-/// The two kinematics tables (`(facets, points)`) from a samples table sorted by
-/// [`SAMPLES_SORT_KEYS`] and each character's leg length (m).
-///
-/// # Errors
-/// The samples table lacks a column or has it with another type.
-pub fn kinematics_from_samples(
-    samples: &DataFrame,
-    legs: &BTreeMap<String, f64>,
-) -> PolarsResult<(DataFrame, DataFrame)> {
-    let mut store = SampleStore::default();
-    store.add(samples)?;
-    store.kinematics(legs)
-}
-
-fn kinematics_from_groups(
-    groups: &Groups,
-    legs: &BTreeMap<String, f64>,
-) -> PolarsResult<(DataFrame, DataFrame)> {
-    let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
-    for (key, g) in groups {
-        let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
-        let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
-        let keep = inliers(&pts, leg);
-        kept.push((
-            key,
-            g.iter()
-                .zip(keep)
-                .filter(|(_, k)| *k)
-                .map(|(s, _)| s)
-                .collect(),
-        ));
-    }
-    let mut facets: Vec<Facet> = Vec::new();
-    for (key, g) in &kept {
-        let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
-        if let Ok(p) = polytope(&pts) {
-            facets.extend(
-                p.a.iter()
-                    .zip(&p.b)
-                    .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d)),
-            );
-        }
-    }
     facets.sort_by(|x, y| {
         (&x.0, &x.1)
             .cmp(&(&y.0, &y.1))
@@ -374,16 +323,16 @@ fn kinematics_from_groups(
     Ok((facet_df, points_df))
 }
 
-/// The kinematic polytopes of a library by (`character_id`, `effector`), in the contact
-/// frame (metres).
+/// The facets of a library's kinematic polytopes by (`character_id`, `effector`): unit
+/// outward normals and offsets (`n·ʳc ≤ d`, metres, contact frame), in file order.
 ///
 /// # Errors
 /// `kinematics.parquet` missing or malformed (the error names the file, column and row).
-pub fn read_polytopes(lib_dir: &Path) -> Result<BTreeMap<(String, String), Polytope>> {
+pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRows>> {
     let t = Table::open(&lib_dir.join(KINEMATICS_FILE))?;
     let (ch, eff) = (t.strings("character_id")?, t.strings("effector")?);
     let (nx, ny, nz, d) = (t.f64s("nx")?, t.f64s("ny")?, t.f64s("nz")?, t.f64s("d")?);
-    let mut rows: BTreeMap<(String, String), Polytope> = BTreeMap::new();
+    let mut rows: BTreeMap<(String, String), FacetRows> = BTreeMap::new();
     for i in 0..t.height() {
         let n = [nx[i], ny[i], nz[i]];
         let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
@@ -396,15 +345,16 @@ pub fn read_polytopes(lib_dir: &Path) -> Result<BTreeMap<(String, String), Polyt
             ));
         }
         let p = rows.entry((ch[i].clone(), eff[i].clone())).or_default();
-        p.a.push(n);
-        p.b.push(d[i]);
+        p.0.push(n);
+        p.1.push(d[i]);
     }
-    // Rows are renormalised to exactly unit length (stored values carry rounding).
-    Ok(rows
-        .into_iter()
-        .map(|(k, p)| (k, Polytope::new(p.a, p.b)))
-        .collect())
+    Ok(rows)
 }
+
+#[doc(hidden)]
+/// The kinematic polytopes of a library (moved to [`crate::pipeline::twopac::read_polytopes`];
+/// kept here only for callers that still name this path).
+pub use crate::pipeline::twopac::read_polytopes;
 
 /// The contact samples behind the polytopes, one row per sample: `character_id`,
 /// `effector`, `clip`, `frame`, `x`, `y`, `z` (m).
@@ -431,4 +381,27 @@ fn points_table(rows: &[(&(String, String), &Sample)]) -> PolarsResult<DataFrame
         col("y", p(1)),
         col("z", p(2)),
     ])
+}
+
+#[cfg(test)]
+mod schema_tests {
+    use super::*;
+    use crate::library::schema::{KINEMATICS_COLUMNS, KINEMATICS_POINTS_COLUMNS};
+
+    #[test]
+    fn the_kinematic_tables_have_the_schema_columns() {
+        let names = |df: &DataFrame| -> Vec<String> {
+            df.get_column_names()
+                .iter()
+                .map(|n| n.to_string())
+                .collect()
+        };
+        let (facets, points) = kinematics_tables(Vec::new(), &[]).unwrap();
+        assert_eq!(names(&facets), KINEMATICS_COLUMNS);
+        assert_eq!(names(&points), KINEMATICS_POINTS_COLUMNS);
+        assert_eq!(
+            names(&SampleStore::default().table().unwrap()),
+            KINEMATICS_POINTS_COLUMNS
+        );
+    }
 }

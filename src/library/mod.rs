@@ -5,20 +5,21 @@
 //! # References
 //! spec com-from-bvh §8 (column tables); STYLE.md §5.6 (deterministic files).
 
+pub mod atomic;
 pub mod clip_view;
-mod columns;
+pub(crate) mod columns;
 pub mod forces;
 pub mod info;
 pub mod kinematics;
 pub mod plates;
 pub mod provenance;
+#[doc(hidden)]
 pub mod queries;
 pub mod read;
 pub mod schema;
 pub mod scratch;
 pub mod stances;
 pub mod stream;
-pub mod twopac;
 pub mod write;
 
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};

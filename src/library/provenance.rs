@@ -14,19 +14,11 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use sha2::{Digest, Sha256};
 
+#[cfg(doc)]
+use super::schema::LIBRARY_MANIFEST_KEY;
 use super::schema::MANIFEST_FILE;
 use crate::error::{Error, Result};
 use crate::skeleton::com::Sex;
-
-/// Key-value metadata key of a query output: SHA-256 (hex) of its library's
-/// `manifest.json`.
-pub const LIBRARY_MANIFEST_KEY: &str = "stancelib.library_manifest_sha256";
-/// Key-value metadata key of a query output: the library folder as given.
-pub const LIBRARY_PATH_KEY: &str = "stancelib.library";
-/// Key-value metadata key of every output: the tool version (`CARGO_PKG_VERSION`).
-pub const TOOL_VERSION_KEY: &str = "stancelib.tool_version";
-/// The tool version recorded everywhere.
-pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// `secs` seconds after 1970-01-01T00:00:00Z as RFC 3339 in UTC (`YYYY-MM-DDThh:mm:ssZ`).
 ///

@@ -6,12 +6,10 @@ use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
 
-use crate::constraints::Coefficients;
 use crate::error::{Error, Result};
-use crate::force_model::{AxisModel, ForceModel};
-use crate::query::pool::PoolStance;
-use crate::stances::params::StanceParams;
-use crate::stances::segment::Boundary;
+
+use super::stances::PoolStance;
+pub use super::stances::{read_stance_timing, read_stances};
 
 use super::schema::{CLIPS_FILE, STANCES_FILE};
 
@@ -245,193 +243,6 @@ pub struct StanceLibrary {
     pub clips: BTreeMap<String, ClipInfo>,
 }
 
-fn boundary(t: &Table, name: &str, row: usize, v: &str) -> Result<Boundary> {
-    Boundary::parse(v).ok_or_else(|| {
-        Error::column(
-            &t.path,
-            name,
-            Some(row),
-            format!("unknown boundary kind '{v}'"),
-        )
-    })
-}
-
-fn fixed<const N: usize>(v: &[f64]) -> [f64; N] {
-    let mut out = [0.0; N];
-    out.copy_from_slice(&v[..N]);
-    out
-}
-
-/// One stance axis's model columns: `c0_*`, `harmonic_*`, `amp_*`, `phase_*`, `fit_rms_*`,
-/// `poly_*`.
-type AxisColumns = (
-    Vec<f64>,
-    Vec<Vec<i32>>,
-    Vec<Vec<f64>>,
-    Vec<Vec<f64>>,
-    Vec<f64>,
-    Vec<Vec<f64>>,
-);
-
-/// The force model of row `i` from one axis's columns.
-fn axis_model(t: &Table, name: &str, i: usize, cols: &AxisColumns) -> Result<AxisModel> {
-    let (c0, h, a, p, rms, poly) = cols;
-    if h[i].len() != a[i].len() || h[i].len() != p[i].len() {
-        return Err(Error::column(
-            &t.path,
-            &format!("harmonic_{name}"),
-            Some(i),
-            "harmonic, amp and phase lists differ in length",
-        ));
-    }
-    let harmonics = h[i]
-        .iter()
-        .map(|&j| u32::try_from(j).ok().filter(|&j| j >= 1))
-        .collect::<Option<Vec<u32>>>()
-        .ok_or_else(|| {
-            Error::column(
-                &t.path,
-                &format!("harmonic_{name}"),
-                Some(i),
-                "harmonics must be integers ≥ 1",
-            )
-        })?;
-    Ok(AxisModel {
-        c0: c0[i],
-        harmonics,
-        amps: a[i].clone(),
-        phases: p[i].clone(),
-        poly: poly[i].clone(),
-        fit_rms: rms[i],
-    })
-}
-
-/// Reads the stance rows of `stances.parquet` as query stances.
-///
-/// # Errors
-/// The file cannot be read, or a column is missing, mistyped or null (the error names the
-/// file, column and row).
-pub fn read_stances(path: &Path) -> Result<Vec<PoolStance>> {
-    let t = Table::open(path)?;
-    let s = |n: &str| t.strings(n);
-    let f = |n: &str| t.f64s(n);
-    let (ids, clips, chars, labels) =
-        (s("stance_id")?, s("clip")?, s("character_id")?, s("label")?);
-    let (b0, b1) = (s("boundary_start")?, s("boundary_end")?);
-    let first = t.i64s("first_frame")?;
-    let names = [
-        "z_c",
-        "zs",
-        "vs",
-        "ze",
-        "ve",
-        "vp",
-        "vps",
-        "x",
-        "z_td",
-        "z_lo",
-        "t_td_s",
-        "t_lo_s",
-        "t_e_s",
-        "dt_s",
-        "mass_kg",
-        "cp_h",
-        "cp_p",
-        "min_f_v",
-        "f_peak",
-        "mu_req",
-        "mu_req_robust",
-        "ext_min",
-        "ext_max",
-    ];
-    let cols: BTreeMap<&str, Vec<f64>> = names
-        .iter()
-        .map(|&n| Ok((n, f(n)?)))
-        .collect::<Result<_>>()?;
-    let v = |n: &str, i: usize| cols[n][i];
-    let axis_cols = ["h", "p", "v"]
-        .map(|a| {
-            Ok((
-                f(&format!("c0_{a}"))?,
-                t.i32_lists(&format!("harmonic_{a}"))?,
-                t.f64_lists(&format!("amp_{a}"), None)?,
-                t.f64_lists(&format!("phase_{a}"), None)?,
-                f(&format!("fit_rms_{a}"))?,
-                t.f64_lists(&format!("poly_{a}"), None)?,
-            ))
-        })
-        .into_iter()
-        .collect::<Result<Vec<AxisColumns>>>()?;
-    let l3 = |n: &str| t.f64_lists(n, Some(3));
-    let (a_f, a_mu) = (l3("a_f")?, t.f64_lists("a_mu", Some(2))?);
-    let (ang, h0) = (l3("ang_impulse")?, l3("ang_impulse_h0")?);
-    let (r0, r1, s0, s1) = (
-        l3("ell_r_min")?,
-        l3("ell_r_max")?,
-        l3("ell_s_min")?,
-        l3("ell_s_max")?,
-    );
-    let (support, unilateral) = (t.bools("support_ok")?, t.bools("unilateral_ok")?);
-    (0..t.height())
-        .map(|i| {
-            let mut axes: [AxisModel; 3] = Default::default();
-            for (a, name) in ["h", "p", "v"].iter().enumerate() {
-                let c = &axis_cols[a];
-                axes[a] = axis_model(&t, name, i, c)?;
-            }
-            let params = StanceParams {
-                zs: v("zs", i),
-                vs: v("vs", i),
-                ze: v("ze", i),
-                ve: v("ve", i),
-                vp: v("vp", i),
-                vps: v("vps", i),
-                x: v("x", i),
-                z_td: v("z_td", i),
-                z_lo: v("z_lo", i),
-                t_td: v("t_td_s", i),
-                t_lo: v("t_lo_s", i),
-                t_e: v("t_e_s", i),
-            };
-            Ok(PoolStance {
-                stance_id: ids[i].clone(),
-                clip: clips[i].clone(),
-                character_id: chars[i].clone(),
-                label: labels[i].clone(),
-                first_frame: first[i],
-                boundary_start: boundary(&t, "boundary_start", i, &b0[i])?,
-                boundary_end: boundary(&t, "boundary_end", i, &b1[i])?,
-                z_c: v("z_c", i),
-                params,
-                model: ForceModel {
-                    mass_kg: v("mass_kg", i),
-                    dt_s: v("dt_s", i),
-                    axes,
-                },
-                cp: [v("cp_h", i), v("cp_p", i)],
-                coef: Coefficients {
-                    a_f: fixed(&a_f[i]),
-                    a_mu: fixed(&a_mu[i]),
-                    min_f_v: v("min_f_v", i),
-                    unilateral_ok: unilateral[i],
-                    support_ok: support[i],
-                    f_peak: v("f_peak", i),
-                    mu_req: v("mu_req", i),
-                    mu_req_robust: v("mu_req_robust", i),
-                    ext_min: v("ext_min", i),
-                    ext_max: v("ext_max", i),
-                    ang_impulse: fixed(&ang[i]),
-                    ang_impulse_h0: fixed(&h0[i]),
-                    ell_r_min: fixed(&r0[i]),
-                    ell_r_max: fixed(&r1[i]),
-                    ell_s_min: fixed(&s0[i]),
-                    ell_s_max: fixed(&s1[i]),
-                },
-            })
-        })
-        .collect()
-}
-
 /// Reads the per-clip facts of `clips.parquet`.
 ///
 /// # Errors
@@ -468,24 +279,6 @@ pub fn open_library(dir: &Path) -> Result<StanceLibrary> {
         stances: read_stances(&dir.join(STANCES_FILE))?,
         clips: read_clip_info(&dir.join(CLIPS_FILE))?,
     })
-}
-
-/// Where each stance of `stances.parquet` sits in its clip, in file order (the order of
-/// [`read_stances`]): touchdown, liftoff and heading.
-///
-/// # Errors
-/// The file cannot be read, or a column is missing, mistyped or null.
-pub fn read_stance_timing(path: &Path) -> Result<Vec<crate::edit::plan::StanceTiming>> {
-    let t = Table::open(path)?;
-    let (td, lo) = (t.f64s("td_clip_s")?, t.f64s("lo_clip_s")?);
-    let (hx, hy) = (t.f64s("heading_x")?, t.f64s("heading_y")?);
-    Ok((0..t.height())
-        .map(|i| crate::edit::plan::StanceTiming {
-            td_clip_s: td[i],
-            lo_clip_s: lo[i],
-            heading: [hx[i], hy[i]],
-        })
-        .collect())
 }
 
 /// A clip's source file as `clips.parquet` records it.

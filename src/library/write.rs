@@ -436,14 +436,8 @@ pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()>
         ));
     }
     let kv = vec![
-        (
-            "stancelib.schema_version".to_string(),
-            SCHEMA_VERSION.to_string(),
-        ),
-        (
-            "stancelib.tool_version".to_string(),
-            env!("CARGO_PKG_VERSION").to_string(),
-        ),
+        (SCHEMA_VERSION_KEY.to_string(), SCHEMA_VERSION.to_string()),
+        (TOOL_VERSION_KEY.to_string(), TOOL_VERSION.to_string()),
     ];
     for (name, df) in tables.iter_mut() {
         write_atomic(dir, name, df, &kv)?;

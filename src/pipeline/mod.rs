@@ -1,6 +1,7 @@
 //! Batch orchestration at the I/O edge: input discovery, clip names, per-file ingest in
 //! parallel with a progress bar, the streaming library build, shards and their merge, the
-//! output-folder policy, and the declarative pipeline and body files.
+//! output-folder policy, the declarative pipeline and body files, and the `twopac` stage
+//! with its output tables.
 
 pub mod batch;
 pub mod build;
@@ -8,6 +9,9 @@ pub mod inputs;
 pub mod merge;
 pub mod names;
 pub mod output;
+pub mod queries;
 pub mod shard;
 pub(crate) mod sink;
 pub mod spec;
+pub mod twopac;
+pub mod twopac_tables;

@@ -23,7 +23,8 @@ use polars::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::library::kinematics::{
-    add_character_legs, samples_table, SampleStore, SAMPLES_SORT_KEYS,
+    add_character_legs, kinematics_tables, samples_table, Facet, Sample, SampleStore,
+    SAMPLES_SORT_KEYS,
 };
 use crate::library::read::parquet_rows;
 use crate::library::schema::{
@@ -31,12 +32,16 @@ use crate::library::schema::{
     KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX,
     SCHEMA_VERSION, STANCES_FILE,
 };
+use crate::library::schema::{
+    INPUTS_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION, TOOL_VERSION_KEY,
+};
 use crate::library::stances::{errors_table, stances_table};
 use crate::library::stream::{read_rows, TableWriter};
 use crate::library::write::{
     clips_table, contacts_table, frames_table, joints_table, write_atomic, ROW_GROUP_ROWS,
 };
 use crate::stances::limits::{limits, ClipFacts, StanceFacts};
+use crate::twopac::kinematic::kinematic_polytope;
 
 pub(crate) fn pe(name: &str, e: PolarsError) -> Error {
     Error::io(name, "cannot build table", e)
@@ -301,14 +306,11 @@ impl LibrarySink {
         let lim = limits(&self.stance_facts, &self.clip_facts);
         let json = |v: &dyn erased::Json| v.to_json();
         let kv: Vec<(String, String)> = vec![
-            ("stancelib.schema_version".into(), SCHEMA_VERSION.into()),
-            (
-                "stancelib.tool_version".into(),
-                env!("CARGO_PKG_VERSION").into(),
-            ),
-            ("stancelib.options".into(), fingerprint.to_string()),
-            ("stancelib.inputs".into(), json(&self.inputs)),
-            ("stancelib.limits".into(), json(&lim)),
+            (SCHEMA_VERSION_KEY.into(), SCHEMA_VERSION.into()),
+            (TOOL_VERSION_KEY.into(), TOOL_VERSION.into()),
+            (OPTIONS_KEY.into(), fingerprint.to_string()),
+            (INPUTS_KEY.into(), json(&self.inputs)),
+            (LIMITS_KEY.into(), json(&lim)),
         ];
         for (_, w) in std::mem::take(&mut self.writers) {
             w.finish(&kv)?;
@@ -321,9 +323,8 @@ impl LibrarySink {
                 .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
             write_atomic(&dir, KINEMATICS_SAMPLES_FILE, &mut table, &kv)?;
         }
-        let (mut facets, mut points) = samples
-            .kinematics(&self.legs)
-            .map_err(|e| pe(KINEMATICS_FILE, e))?;
+        let (mut facets, mut points) =
+            kinematics(samples, &self.legs).map_err(|e| pe(KINEMATICS_FILE, e))?;
         write_atomic(&dir, KINEMATICS_FILE, &mut facets, &kv)?;
         write_atomic(&dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
         drop((facets, points));
@@ -331,7 +332,7 @@ impl LibrarySink {
         let mut manifest = serde_json::json!({
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
             "schema_version": SCHEMA_VERSION,
-            "tool_version": env!("CARGO_PKG_VERSION"),
+            "tool_version": TOOL_VERSION,
             // Not in the Parquet metadata: these change from run to run (the tables do not).
             "created_utc": crate::library::provenance::now_utc(),
             "command_line": crate::library::provenance::command_line(),
@@ -349,9 +350,42 @@ impl LibrarySink {
             m.insert("shard".into(), s);
         }
         let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
-        std::fs::write(dir.join(MANIFEST_FILE), text)
-            .map_err(|err| Error::io(dir.join(MANIFEST_FILE), "cannot write", err))
+        crate::library::atomic::write_text_atomic(&dir.join(MANIFEST_FILE), &text)
     }
+}
+
+/// The two kinematics tables (`(facets, points)`) of `samples` with each character's leg
+/// length (m): per (character, effector) the outlier rules and the polytope
+/// ([`kinematic_polytope`]); a group with fewer than 4 non-coplanar points after the rules
+/// has points but no facets (an error at query time).
+fn kinematics(
+    samples: SampleStore,
+    legs: &BTreeMap<String, f64>,
+) -> PolarsResult<(DataFrame, DataFrame)> {
+    let groups = samples.into_groups();
+    let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
+    let mut facets: Vec<Facet> = Vec::new();
+    for (key, g) in &groups {
+        let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
+        let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
+        let (keep, poly) = kinematic_polytope(&pts, leg);
+        if let Some(p) = poly {
+            facets.extend(
+                p.a.iter()
+                    .zip(&p.b)
+                    .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d)),
+            );
+        }
+        kept.push((
+            key,
+            g.iter()
+                .zip(keep)
+                .filter(|(_, k)| *k)
+                .map(|(s, _)| s)
+                .collect(),
+        ));
+    }
+    kinematics_tables(facets, &kept)
 }
 
 /// `parts` stacked and sorted as table `name` (`empty` when there are none).

@@ -13,9 +13,11 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, register_font, PlotError};
+use super::{err, register_font, value_mesh, PlotError};
 use crate::force_model::GRAVITY as G;
 use crate::library::clip_view::{ClipView, EFFECTORS};
 
@@ -58,6 +60,10 @@ pub fn ballistic_fit(t: &[f64], z: &[f64]) -> Option<Vec<(f64, f64)>> {
     )
 }
 
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+type TimeChart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
 /// Writes the clip plot of `view` to `path`.
 ///
 /// # Errors
@@ -81,33 +87,57 @@ pub fn clip_png(path: &Path, view: &ClipView) -> Result<(), PlotError> {
     let parts = plots.split_by_breakpoints([] as [u32; 0], [330, 620]);
     let t0 = view.time_s.first().copied().unwrap_or(0.0);
     let t1 = view.time_s.last().copied().unwrap_or(1.0).max(t0 + 1e-3);
-    let fin = |v: &[f64]| {
-        v.iter()
-            .filter(|x| x.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                (a.min(x), b.max(x))
-            })
-    };
-    // (a) COM height and the flights.
-    let (z_lo, z_hi) = fin(&view.com_z);
-    let pad = ((z_hi - z_lo) * 0.1).max(0.02);
-    let mut a = ChartBuilder::on(&parts[0])
-        .caption(
-            "(a) COM height; flights: −g parabola fitted (dashed, red = not ballistic)",
-            ("sans-serif", 16),
-        )
+    height_panel(&parts[0], path, view, t0..t1)?;
+    speed_panel(&parts[1], path, view, t0..t1)?;
+    contact_panel(&parts[2], path, view, t0..t1)?;
+    warning_notes(&notes, path, &view.warnings)?;
+    root.present().map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+/// The smallest and largest finite value of `v` (±∞ when there is none).
+fn finite_range(v: &[f64]) -> (f64, f64) {
+    v.iter()
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        })
+}
+
+/// A panel over clip time `t` (s) with the given caption and value range.
+fn time_chart<'a, 'b>(
+    area: &'a Area<'b>,
+    path: &Path,
+    caption: &str,
+    t: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+) -> Result<TimeChart<'a, 'b>, PlotError> {
+    ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 16))
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(65)
-        .build_cartesian_2d(t0..t1, (z_lo - pad)..(z_hi + pad))
-        .map_err(|e| err(path, e))?;
-    a.configure_mesh()
-        .x_desc("clip time (s)")
-        .y_desc("COM z (m)")
-        .light_line_style(WHITE.mix(0.0))
-        .label_style(("sans-serif", 13))
-        .draw()
-        .map_err(|e| err(path, e))?;
+        .build_cartesian_2d(t, y)
+        .map_err(|e| err(path, e))
+}
+
+/// (a) COM height and the flights.
+fn height_panel(
+    area: &Area<'_>,
+    path: &Path,
+    view: &ClipView,
+    t: std::ops::Range<f64>,
+) -> Result<(), PlotError> {
+    let (z_lo, z_hi) = finite_range(&view.com_z);
+    let pad = ((z_hi - z_lo) * 0.1).max(0.02);
+    let mut a = time_chart(
+        area,
+        path,
+        "(a) COM height; flights: −g parabola fitted (dashed, red = not ballistic)",
+        t,
+        (z_lo - pad)..(z_hi + pad),
+    )?;
+    value_mesh(&mut a, path, "clip time (s)", "COM z (m)")?;
     let com: Vec<(f64, f64)> = view
         .time_s
         .iter()
@@ -137,22 +167,25 @@ pub fn clip_png(path: &Path, view: &ClipView) -> Result<(), PlotError> {
             .map_err(|e| err(path, e))?;
         }
     }
-    // (b) horizontal speed.
-    let (_, v_hi) = fin(&view.speed_xy);
-    let mut b = ChartBuilder::on(&parts[1])
-        .caption("(b) horizontal COM speed", ("sans-serif", 16))
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(65)
-        .build_cartesian_2d(t0..t1, 0.0..(v_hi.max(0.1) * 1.1))
-        .map_err(|e| err(path, e))?;
-    b.configure_mesh()
-        .x_desc("clip time (s)")
-        .y_desc("speed (m/s)")
-        .light_line_style(WHITE.mix(0.0))
-        .label_style(("sans-serif", 13))
-        .draw()
-        .map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+/// (b) horizontal speed.
+fn speed_panel(
+    area: &Area<'_>,
+    path: &Path,
+    view: &ClipView,
+    t: std::ops::Range<f64>,
+) -> Result<(), PlotError> {
+    let (_, v_hi) = finite_range(&view.speed_xy);
+    let mut b = time_chart(
+        area,
+        path,
+        "(b) horizontal COM speed",
+        t,
+        0.0..(v_hi.max(0.1) * 1.1),
+    )?;
+    value_mesh(&mut b, path, "clip time (s)", "speed (m/s)")?;
     let speed: Vec<(f64, f64)> = view
         .time_s
         .iter()
@@ -161,14 +194,23 @@ pub fn clip_png(path: &Path, view: &ClipView) -> Result<(), PlotError> {
         .collect();
     b.draw_series(LineSeries::new(speed, BLACK.stroke_width(2)))
         .map_err(|e| err(path, e))?;
-    // (c) contact bars.
-    let mut c = ChartBuilder::on(&parts[2])
-        .caption("(c) contacts (bars: frames in contact)", ("sans-serif", 16))
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(65)
-        .build_cartesian_2d(t0..t1, 0.0..4.0)
-        .map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+/// (c) contact bars.
+fn contact_panel(
+    area: &Area<'_>,
+    path: &Path,
+    view: &ClipView,
+    t: std::ops::Range<f64>,
+) -> Result<(), PlotError> {
+    let mut c = time_chart(
+        area,
+        path,
+        "(c) contacts (bars: frames in contact)",
+        t,
+        0.0..4.0,
+    )?;
     c.configure_mesh()
         .x_desc("clip time (s)")
         .y_labels(4)
@@ -214,9 +256,13 @@ pub fn clip_png(path: &Path, view: &ClipView) -> Result<(), PlotError> {
         }
         c.draw_series(bars).map_err(|e| err(path, e))?;
     }
-    // The warnings, one line each (at most six).
+    Ok(())
+}
+
+/// The warnings, one line each (at most six).
+fn warning_notes(notes: &Area<'_>, path: &Path, warnings: &[String]) -> Result<(), PlotError> {
     let mut y = 8;
-    for w in view.warnings.iter().take(6) {
+    for w in warnings.iter().take(6) {
         let text: String = w.chars().take(150).collect();
         notes
             .draw(&Text::new(
@@ -227,16 +273,15 @@ pub fn clip_png(path: &Path, view: &ClipView) -> Result<(), PlotError> {
             .map_err(|e| err(path, e))?;
         y += 16;
     }
-    if view.warnings.len() > 6 {
+    if warnings.len() > 6 {
         let more = format!(
             "… and {} more (clips.parquet, warnings)",
-            view.warnings.len() - 6
+            warnings.len() - 6
         );
         notes
             .draw(&Text::new(more, (20, y), ("sans-serif", 13)))
             .map_err(|e| err(path, e))?;
     }
-    root.present().map_err(|e| err(path, e))?;
     Ok(())
 }
 

@@ -42,6 +42,19 @@ pub struct PlotError {
     pub msg: String,
 }
 
+/// Draws a PNG with `draw` under a temporary name beside `path`, then renames it into
+/// place, so a failed draw leaves no file and an earlier one survives
+/// ([`crate::library::atomic::write_file_atomic`]).
+///
+/// # Errors
+/// The drawing fails or the rename does.
+pub fn write_png(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> Result<(), PlotError>,
+) -> anyhow::Result<()> {
+    crate::library::atomic::write_file_atomic(path, |tmp| draw(tmp).map_err(anyhow::Error::from))
+}
+
 fn err(path: &Path, e: impl std::fmt::Display) -> PlotError {
     PlotError {
         path: path.display().to_string(),
@@ -60,6 +73,23 @@ fn draw_legend<'a, 'b: 'a>(
         .border_style(BLACK)
         .label_font(("sans-serif", 13))
         .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(|e| err(path, e))
+}
+
+/// The mesh of a value panel: `x_desc` against `y_desc`, no light grid lines, 13 px labels.
+fn value_mesh(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    x_desc: &str,
+    y_desc: &str,
+) -> Result<(), PlotError> {
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .light_line_style(WHITE.mix(0.0))
+        .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| err(path, e))
 }
@@ -196,74 +226,11 @@ pub fn jump_map_png(
         "Fast filters (eq 10, 12) vs exact check (§7.4)",
         ranges,
     )?;
-    let rect = |b: &Binned, k: usize, row: usize| {
-        let x = b.d0 + k as f64 * b.width;
-        let y = h0 + row as f64 * dh;
-        [(x, y - dh / 2.0), (x + b.width, y + dh / 2.0)]
-    };
-    let colours = [
-        RGBColor(46, 139, 87),
-        RGBColor(255, 140, 0),
-        RGBColor(65, 105, 225),
-    ];
     if let Some(b) = &b {
-        let mut exact = Vec::new();
-        let mut agree = Vec::new();
-        for row in 0..map.heights.len() {
-            for k in 0..b.n_d {
-                let c = b.cells[row * b.n_d + k];
-                let n_exact = c[0] + c[2];
-                if n_exact > 0 {
-                    let mix = shade(n_exact, b.max_exact);
-                    exact.push(Rectangle::new(rect(b, k, row), BLUE.mix(mix).filled()));
-                }
-                let kind = (0..3).max_by_key(|&i| (c[i], 3 - i)).unwrap_or(0);
-                if c.iter().any(|&n| n > 0) {
-                    agree.push((kind, rect(b, k, row)));
-                }
-            }
-        }
-        l.draw_series(exact)
-            .map_err(|e| err(path, e))?
-            .label(format!(
-                "darker = more feasible (pair, cell)s, max {}",
-                b.max_exact
-            ))
-            .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], BLUE.filled()));
-        let names = ["both feasible", "approx only", "exact only"];
-        for (kind, name) in names.iter().enumerate() {
-            let rects = agree
-                .iter()
-                .filter(|(k, _)| *k == kind)
-                .map(|(_, c)| Rectangle::new(*c, colours[kind].filled()));
-            let colour = colours[kind];
-            r.draw_series(rects)
-                .map_err(|e| err(path, e))?
-                .label(*name)
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled())
-                });
-        }
+        draw_cells(&mut l, &mut r, path, b, map.heights.len(), (h0, dh))?;
     }
     if !recorded.is_empty() {
-        let (x, y) = (l.x_range(), l.y_range());
-        let inside: Vec<(f64, f64)> = recorded
-            .iter()
-            .copied()
-            .filter(|(d, h)| x.contains(d) && y.contains(h))
-            .collect();
-        l.draw_series(
-            inside
-                .iter()
-                .map(|&p| Cross::new(p, 7, BLACK.stroke_width(2))),
-        )
-        .map_err(|e| err(path, e))?
-        .label(format!(
-            "recorded jump ({} of {})",
-            inside.len(),
-            recorded.len()
-        ))
-        .legend(|(x, y)| Cross::new((x + 6, y), 5, BLACK.stroke_width(2)));
+        draw_recorded(&mut l, path, recorded)?;
     }
     colour_bar(&bar, path, b.as_ref().map_or(0, |b| b.max_exact))?;
     for chart in [&mut l, &mut r] {
@@ -277,6 +244,92 @@ pub fn jump_map_png(
             .map_err(|e| err(path, e))?;
     }
     root.present().map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+/// The binned cells: shaded by exact-feasible count on the left panel, by agreement of
+/// the fast filters and the exact check on the right; `(h0, dh)` is the first height row
+/// and the row spacing (m).
+fn draw_cells(
+    l: &mut Chart<'_, '_>,
+    r: &mut Chart<'_, '_>,
+    path: &Path,
+    b: &Binned,
+    n_heights: usize,
+    (h0, dh): (f64, f64),
+) -> Result<(), PlotError> {
+    let rect = |k: usize, row: usize| {
+        let x = b.d0 + k as f64 * b.width;
+        let y = h0 + row as f64 * dh;
+        [(x, y - dh / 2.0), (x + b.width, y + dh / 2.0)]
+    };
+    let colours = [
+        RGBColor(46, 139, 87),
+        RGBColor(255, 140, 0),
+        RGBColor(65, 105, 225),
+    ];
+    let mut exact = Vec::new();
+    let mut agree = Vec::new();
+    for row in 0..n_heights {
+        for k in 0..b.n_d {
+            let c = b.cells[row * b.n_d + k];
+            let n_exact = c[0] + c[2];
+            if n_exact > 0 {
+                let mix = shade(n_exact, b.max_exact);
+                exact.push(Rectangle::new(rect(k, row), BLUE.mix(mix).filled()));
+            }
+            let kind = (0..3).max_by_key(|&i| (c[i], 3 - i)).unwrap_or(0);
+            if c.iter().any(|&n| n > 0) {
+                agree.push((kind, rect(k, row)));
+            }
+        }
+    }
+    l.draw_series(exact)
+        .map_err(|e| err(path, e))?
+        .label(format!(
+            "darker = more feasible (pair, cell)s, max {}",
+            b.max_exact
+        ))
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], BLUE.filled()));
+    let names = ["both feasible", "approx only", "exact only"];
+    for (kind, name) in names.iter().enumerate() {
+        let rects = agree
+            .iter()
+            .filter(|(k, _)| *k == kind)
+            .map(|(_, c)| Rectangle::new(*c, colours[kind].filled()));
+        let colour = colours[kind];
+        r.draw_series(rects)
+            .map_err(|e| err(path, e))?
+            .label(*name)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled()));
+    }
+    Ok(())
+}
+
+/// The recorded jumps (distance, height; m) inside the panel, marked ×.
+fn draw_recorded(
+    l: &mut Chart<'_, '_>,
+    path: &Path,
+    recorded: &[(f64, f64)],
+) -> Result<(), PlotError> {
+    let (x, y) = (l.x_range(), l.y_range());
+    let inside: Vec<(f64, f64)> = recorded
+        .iter()
+        .copied()
+        .filter(|(d, h)| x.contains(d) && y.contains(h))
+        .collect();
+    l.draw_series(
+        inside
+            .iter()
+            .map(|&p| Cross::new(p, 7, BLACK.stroke_width(2))),
+    )
+    .map_err(|e| err(path, e))?
+    .label(format!(
+        "recorded jump ({} of {})",
+        inside.len(),
+        recorded.len()
+    ))
+    .legend(|(x, y)| Cross::new((x + 6, y), 5, BLACK.stroke_width(2)));
     Ok(())
 }
 

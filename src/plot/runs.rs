@@ -6,9 +6,10 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::{err, register_font, PlotError};
+use super::{err, register_font, value_mesh, PlotError};
 
 /// One cycle at one speed, as the figure needs it.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -55,6 +56,84 @@ fn span(v: impl Iterator<Item = f64>, pad_min: f64) -> std::ops::Range<f64> {
     (lo - pad)..(hi + pad)
 }
 
+type Chart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+/// The values of a point one panel shows.
+type Get = dyn Fn(&RunPoint) -> Vec<f64>;
+
+/// Cycle `c`'s lines on one panel: one per value slot (stance 1, stance 2; ext_min,
+/// ext_max) with its points, and its limits dashed.
+fn draw_cycle(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    points: &[RunPoint],
+    c: usize,
+    get: &Get,
+    lim: &Get,
+) -> Result<(), PlotError> {
+    let colour = PALETTE[c % PALETTE.len()];
+    let mine: Vec<&RunPoint> = points.iter().filter(|p| p.cycle == c).collect();
+    let slots = mine.iter().map(|p| get(p).len()).max().unwrap_or(0);
+    for k in 0..slots {
+        let line: Vec<(f64, f64)> = mine
+            .iter()
+            .filter_map(|p| get(p).get(k).map(|&y| (p.speed_mps, y)))
+            .filter(|(_, y)| y.is_finite())
+            .collect();
+        chart
+            .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
+            .map_err(|e| err(path, e))?;
+        chart
+            .draw_series(line.iter().map(|&pt| Circle::new(pt, 3, colour.filled())))
+            .map_err(|e| err(path, e))?;
+    }
+    for k in 0..mine.iter().map(|p| lim(p).len()).max().unwrap_or(0) {
+        let line: Vec<(f64, f64)> = mine
+            .iter()
+            .filter_map(|p| lim(p).get(k).map(|&y| (p.speed_mps, y)))
+            .collect();
+        chart
+            .draw_series(DashedLineSeries::new(line, 8, 5, colour.stroke_width(1)))
+            .map_err(|e| err(path, e))?;
+    }
+    Ok(())
+}
+
+/// Infeasible speeds: a red cross at the panel's value (or at `bottom`) and the violated
+/// constraint's name.
+fn mark_infeasible(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    points: &[RunPoint],
+    get: &Get,
+    bottom: f64,
+) -> Result<(), PlotError> {
+    for p in points.iter().filter(|p| !p.feasible) {
+        let y = get(p)
+            .first()
+            .copied()
+            .filter(|y| y.is_finite())
+            .unwrap_or(bottom);
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (p.speed_mps, y),
+                6,
+                RED.stroke_width(2),
+            )))
+            .map_err(|e| err(path, e))?;
+        let why = p.violated.as_deref().unwrap_or("infeasible");
+        let name = why.rsplit(": ").next().unwrap_or(why);
+        chart
+            .draw_series(std::iter::once(Text::new(
+                name.to_string(),
+                (p.speed_mps, y),
+                ("sans-serif", 11).into_font().color(&RED),
+            )))
+            .map_err(|e| err(path, e))?;
+    }
+    Ok(())
+}
+
 /// Writes the figure of `points` to `path` (PNG, 1100 × 1100 px).
 ///
 /// # Errors
@@ -70,7 +149,6 @@ pub fn runs_png(path: &Path, title: &str, points: &[RunPoint]) -> Result<(), Plo
     let speeds = span(points.iter().map(|p| p.speed_mps), 0.25);
     let n_cycles = points.iter().map(|p| p.cycle + 1).max().unwrap_or(0);
     // (a) β_h, (b) mu_min, (c) extension: (caption, y label, values per point, limits).
-    type Get = dyn Fn(&RunPoint) -> Vec<f64>;
     let beta: &Get = &|p| p.beta_h.clone();
     let mu: &Get = &|p| p.mu_min.into_iter().collect();
     let ext: &Get = &|p| p.ext_min_m.into_iter().chain(p.ext_max_m).collect();
@@ -109,68 +187,17 @@ pub fn runs_png(path: &Path, title: &str, points: &[RunPoint]) -> Result<(), Plo
             .y_label_area_size(65)
             .build_cartesian_2d(speeds.clone(), ys.clone())
             .map_err(|e| err(path, e))?;
-        chart
-            .configure_mesh()
-            .x_desc("target speed (m/s)")
-            .y_desc(ylabel)
-            .light_line_style(WHITE.mix(0.0))
-            .label_style(("sans-serif", 13))
-            .draw()
-            .map_err(|e| err(path, e))?;
+        value_mesh(&mut chart, path, "target speed (m/s)", ylabel)?;
         for c in 0..n_cycles {
-            let colour = PALETTE[c % PALETTE.len()];
-            let mine: Vec<&RunPoint> = points.iter().filter(|p| p.cycle == c).collect();
-            // One line per value slot (stance 1, stance 2; ext_min, ext_max).
-            let slots = mine.iter().map(|p| get(p).len()).max().unwrap_or(0);
-            for k in 0..slots {
-                let line: Vec<(f64, f64)> = mine
-                    .iter()
-                    .filter_map(|p| get(p).get(k).map(|&y| (p.speed_mps, y)))
-                    .filter(|(_, y)| y.is_finite())
-                    .collect();
-                chart
-                    .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
-                    .map_err(|e| err(path, e))?;
-                chart
-                    .draw_series(line.iter().map(|&pt| Circle::new(pt, 3, colour.filled())))
-                    .map_err(|e| err(path, e))?;
-            }
-            for k in 0..mine.iter().map(|p| lim(p).len()).max().unwrap_or(0) {
-                let line: Vec<(f64, f64)> = mine
-                    .iter()
-                    .filter_map(|p| lim(p).get(k).map(|&y| (p.speed_mps, y)))
-                    .collect();
-                chart
-                    .draw_series(DashedLineSeries::new(line, 8, 5, colour.stroke_width(1)))
-                    .map_err(|e| err(path, e))?;
-            }
+            draw_cycle(&mut chart, path, points, c, get, lim)?;
         }
-        // Infeasible speeds: a red cross at the panel's value (or its bottom) and the
-        // violated constraint's name.
-        let bottom = ys.start + (ys.end - ys.start) * 0.06;
-        for p in points.iter().filter(|p| !p.feasible) {
-            let y = get(p)
-                .first()
-                .copied()
-                .filter(|y| y.is_finite())
-                .unwrap_or(bottom);
-            chart
-                .draw_series(std::iter::once(Cross::new(
-                    (p.speed_mps, y),
-                    6,
-                    RED.stroke_width(2),
-                )))
-                .map_err(|e| err(path, e))?;
-            let why = p.violated.as_deref().unwrap_or("infeasible");
-            let name = why.rsplit(": ").next().unwrap_or(why);
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    name.to_string(),
-                    (p.speed_mps, y),
-                    ("sans-serif", 11).into_font().color(&RED),
-                )))
-                .map_err(|e| err(path, e))?;
-        }
+        mark_infeasible(
+            &mut chart,
+            path,
+            points,
+            get,
+            ys.start + (ys.end - ys.start) * 0.06,
+        )?;
     }
     root.present().map_err(|e| err(path, e))?;
     Ok(())

@@ -10,6 +10,7 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -150,6 +151,50 @@ fn view(
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(|e| err(path, e))?;
+    draw_contacts(&mut chart, path, d, k)?;
+    for (pts, colour, width, label) in [
+        (
+            &d.quasi_static,
+            RGBColor(255, 140, 0),
+            2,
+            "quasi-static polyline",
+        ),
+        (&d.curve, RGBColor(30, 90, 200), 3, "2PAC COM curve"),
+    ] {
+        chart
+            .draw_series(LineSeries::new(
+                pts.iter().map(pr),
+                colour.stroke_width(width),
+            ))
+            .map_err(|e| err(path, e))?
+            .label(label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(width))
+            });
+    }
+    draw_markers(&mut chart, path, d, k)?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(legend)
+        .draw()
+        .map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+type Chart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The contact polygons (crosses at the points, closed outline), projected on axes 0, `k`.
+fn draw_contacts(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    d: &TrajectoryPlot,
+    k: usize,
+) -> Result<(), PlotError> {
+    let pr = |p: &[f64; 3]| (p[0], p[k]);
     let grey = RGBColor(110, 110, 110);
     let mut first = true;
     for c in &d.contacts {
@@ -170,24 +215,18 @@ fn view(
             first = false;
         }
     }
-    let orange = RGBColor(255, 140, 0);
-    chart
-        .draw_series(LineSeries::new(
-            d.quasi_static.iter().map(pr),
-            orange.stroke_width(2),
-        ))
-        .map_err(|e| err(path, e))?
-        .label("quasi-static polyline")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
-    let blue = RGBColor(30, 90, 200);
-    chart
-        .draw_series(LineSeries::new(
-            d.curve.iter().map(pr),
-            blue.stroke_width(3),
-        ))
-        .map_err(|e| err(path, e))?
-        .label("2PAC COM curve")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue.stroke_width(3)));
+    Ok(())
+}
+
+/// The phase states, transition points, recorded COM and invalid samples, projected on
+/// axes 0, `k`.
+fn draw_markers(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    d: &TrajectoryPlot,
+    k: usize,
+) -> Result<(), PlotError> {
+    let pr = |p: &[f64; 3]| (p[0], p[k]);
     let green = RGBColor(46, 139, 87);
     chart
         .draw_series(
@@ -233,14 +272,6 @@ fn view(
             .label(format!("dynamically invalid samples ({})", d.invalid.len()))
             .legend(|(x, y)| Cross::new((x + 8, y), 4, RED.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(legend)
-        .draw()
-        .map_err(|e| err(path, e))?;
     Ok(())
 }
 

@@ -11,10 +11,13 @@
 
 pub mod feasibility;
 pub mod jump;
+pub mod limits;
 pub mod map;
+pub mod pairs;
 pub mod pool;
 pub mod run;
 pub mod solve;
+pub mod tables;
 
 #[cfg(test)]
 pub(crate) mod testkit;

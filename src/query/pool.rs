@@ -16,41 +16,12 @@
 
 use crate::constraints::coefficients::friction_demand;
 use crate::constraints::{Coefficients, SampledTables, StanceContext};
-use crate::force_model::ForceModel;
 use crate::stances::params::StanceParams;
-use crate::stances::segment::Boundary;
 
 use super::feasibility::ImpulseMoments;
 use super::solve::StanceShape;
 
-/// One stance of the library as the queries use it (a `stances.parquet` row).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PoolStance {
-    /// `<clip>:<label>:<first frame>`.
-    pub stance_id: String,
-    /// Clip name.
-    pub clip: String,
-    /// Character id (§11).
-    pub character_id: String,
-    /// `L`, `R`, `LR`, …
-    pub label: String,
-    /// First stance frame (file row).
-    pub first_frame: i64,
-    /// What precedes the stance.
-    pub boundary_start: Boundary,
-    /// What follows the stance.
-    pub boundary_end: Boundary,
-    /// Contact height `z_c`, m.
-    pub z_c: f64,
-    /// Model-consistent parameters (§3).
-    pub params: StanceParams,
-    /// The force model (stance axes).
-    pub model: ForceModel,
-    /// Data contact point `(cp_h, cp_p)`, m.
-    pub cp: [f64; 2],
-    /// Stored coefficients and original extremes (§7.2).
-    pub coef: Coefficients,
-}
+pub use crate::library::stances::PoolStance;
 
 impl PoolStance {
     /// The stance's own context `(vs, vps, t_TD, z_TD, cp)` (§7.3).

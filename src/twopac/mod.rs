@@ -51,6 +51,7 @@ pub mod clip;
 pub mod contact;
 pub mod equilibrium;
 pub mod hull;
+pub mod kinematic;
 pub mod phases;
 pub mod polytope;
 pub mod region;

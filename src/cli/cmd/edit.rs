@@ -26,6 +26,7 @@ use crate::pipeline::batch::file_sha256;
 use crate::plot::edit::{edit_png, EditPlot};
 use crate::query::feasibility::LimitForm;
 use crate::query::jump::{is_landing, is_liftoff, jump, recorded_jump};
+use crate::query::pairs::jump_rank;
 use crate::query::pool::Prepared;
 use crate::query::run::{check_scale, check_speed, run_cycles};
 use crate::skeleton::units::UpAxis;
@@ -430,6 +431,88 @@ fn recorded_pair(lib: &StanceLibrary) -> Option<(usize, usize)> {
     })
 }
 
+/// The (liftoff, landing) stance indices of `--pair LIFTOFF_ID:LANDING_ID`.
+fn given_pair(lib: &StanceLibrary, p: &str) -> anyhow::Result<(usize, usize)> {
+    let index = |id: &str| {
+        lib.stances
+            .iter()
+            .position(|s| s.stance_id == id)
+            .with_context(|| format!("--pair: unknown stance {id}"))
+    };
+    // Stance ids hold ':' themselves: split at the middle ':' of the 5 parts.
+    let parts: Vec<&str> = p.split(':').collect();
+    anyhow::ensure!(
+        parts.len() == 6,
+        "--pair: expected LIFTOFF_ID:LANDING_ID (each <clip>:<label>:<frame>), found {p}"
+    );
+    let (i, j) = (index(&parts[..3].join(":"))?, index(&parts[3..].join(":"))?);
+    anyhow::ensure!(
+        is_liftoff(&lib.stances[i]),
+        "--pair: {} is not a liftoff stance (rest or clip edge, then flight)",
+        lib.stances[i].stance_id
+    );
+    anyhow::ensure!(
+        is_landing(&lib.stances[j]),
+        "--pair: {} is not a landing stance (flight, then rest or clip edge)",
+        lib.stances[j].stance_id
+    );
+    Ok((i, j))
+}
+
+/// The (liftoff, landing) pairs an edit may use: the `--pair`; else, without both a
+/// height and a distance, the library's first recorded jump; else every liftoff and
+/// landing of one clip.
+fn jump_candidates(
+    lib: &StanceLibrary,
+    pair: Option<&str>,
+    height_and_distance: bool,
+) -> anyhow::Result<Vec<(usize, usize)>> {
+    let given = match pair {
+        Some(p) => Some(given_pair(lib, p)?),
+        None if !height_and_distance => Some(recorded_pair(lib).context(
+            "no recorded jump (liftoff then landing in one clip) in the library: give --pair",
+        )?),
+        None => None,
+    };
+    let n = lib.stances.len();
+    Ok(match given {
+        Some(p) => vec![p],
+        None => {
+            let ups = (0..n).filter(|&i| is_liftoff(&lib.stances[i]));
+            ups.flat_map(|i| {
+                (0..n)
+                    .filter(|&j| is_landing(&lib.stances[j]))
+                    .map(move |j| (i, j))
+            })
+            .filter(|&(i, j)| lib.stances[i].clip == lib.stances[j].clip)
+            .collect()
+        }
+    })
+}
+
+/// The two stances of a solved jump, as the editor places them.
+fn jump_stances(
+    lib: &StanceLibrary,
+    pool: &[Prepared],
+    times: &[StanceTiming],
+    pair: [usize; 2],
+    jmp: &crate::query::jump::Jump,
+) -> Vec<EditStance> {
+    pair.iter()
+        .enumerate()
+        .map(|(n, &s)| {
+            let (req, scaled) = jmp.sides[n];
+            EditStance {
+                source: lib.stances[s].clone(),
+                timing: times[s],
+                prepared: pool[s].clone(),
+                request: req,
+                scaled,
+            }
+        })
+        .collect()
+}
+
 /// Run `edit jump`.
 ///
 /// # Errors
@@ -452,51 +535,7 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
     let (lib, pool) = load_pool(&c.lib, active)?;
     let times = timing(&c.lib)?;
     let absolute = absolute_limits(&lib);
-    let index = |id: &str| {
-        lib.stances
-            .iter()
-            .position(|s| s.stance_id == id)
-            .with_context(|| format!("--pair: unknown stance {id}"))
-    };
-    let given = match &a.pair {
-        Some(p) => {
-            // Stance ids hold ':' themselves: split at the middle ':' of the 5 parts.
-            let parts: Vec<&str> = p.split(':').collect();
-            anyhow::ensure!(
-                parts.len() == 6,
-                "--pair: expected LIFTOFF_ID:LANDING_ID (each <clip>:<label>:<frame>), found {p}"
-            );
-            let (i, j) = (index(&parts[..3].join(":"))?, index(&parts[3..].join(":"))?);
-            anyhow::ensure!(
-                is_liftoff(&lib.stances[i]),
-                "--pair: {} is not a liftoff stance (rest or clip edge, then flight)",
-                lib.stances[i].stance_id
-            );
-            anyhow::ensure!(
-                is_landing(&lib.stances[j]),
-                "--pair: {} is not a landing stance (flight, then rest or clip edge)",
-                lib.stances[j].stance_id
-            );
-            Some((i, j))
-        }
-        None if a.height.is_none() || a.distance.is_none() => Some(recorded_pair(&lib).context(
-            "no recorded jump (liftoff then landing in one clip) in the library: give --pair",
-        )?),
-        None => None,
-    };
-    let candidates: Vec<(usize, usize)> = match given {
-        Some(p) => vec![p],
-        None => {
-            let ups = (0..pool.len()).filter(|&i| is_liftoff(&lib.stances[i]));
-            ups.flat_map(|i| {
-                (0..pool.len())
-                    .filter(|&j| is_landing(&lib.stances[j]))
-                    .map(move |j| (i, j))
-            })
-            .filter(|&(i, j)| lib.stances[i].clip == lib.stances[j].clip)
-            .collect()
-        }
-    };
+    let candidates = jump_candidates(&lib, a.pair.as_deref(), a.height.zip(a.distance).is_some())?;
     let request = |(i, j): (usize, usize)| {
         let (h0, d0) = recorded_jump(&lib.stances[i], &lib.stances[j]);
         let h = a.height.unwrap_or(h0 * a.height_scale.unwrap_or(1.0));
@@ -523,14 +562,10 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
         "{}: no liftoff and landing stance of one clip",
         c.lib.display()
     );
-    let key = |r: &Result<crate::query::jump::Jump, String>| match r {
-        Ok(j) => (!j.feasible(), j.force_change()),
-        Err(_) => (true, f64::INFINITY),
-    };
     let best = (0..solved.len())
         .min_by(|&x, &y| {
-            let (a1, b1) = key(&solved[x].3);
-            let (a2, b2) = key(&solved[y].3);
+            let (a1, b1) = jump_rank(&solved[x].3);
+            let (a2, b2) = jump_rank(&solved[y].3);
             a1.cmp(&a2).then(b1.total_cmp(&b2))
         })
         .unwrap_or(0);
@@ -543,20 +578,7 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
             lib.stances[*j].stance_id
         ),
     };
-    let stances: Vec<EditStance> = [*i, *j]
-        .iter()
-        .enumerate()
-        .map(|(n, &s)| {
-            let (req, scaled) = jmp.sides[n];
-            EditStance {
-                source: lib.stances[s].clone(),
-                timing: times[s],
-                prepared: pool[s].clone(),
-                request: req,
-                scaled,
-            }
-        })
-        .collect();
+    let stances = jump_stances(&lib, &pool, &times, [*i, *j], &jmp);
     let clip = lib.stances[*i].clip.clone();
     let ids = format!(
         "{} → {}",

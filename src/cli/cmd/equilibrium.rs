@@ -11,8 +11,8 @@ use super::super::args::EquilibriumArgs;
 use super::super::Outcome;
 use crate::error::Error;
 use crate::library::read::{parquet_rows, Table};
-use crate::library::twopac::equilibrium_table;
 use crate::library::write::write_atomic;
+use crate::pipeline::twopac_tables::equilibrium_table;
 use crate::twopac::contact::{contact_points, min_mu};
 use crate::twopac::equilibrium::{EqualityForm, Status, Verdict, MAX_COM_STATES};
 use crate::twopac::phases::parse_contacts;
@@ -82,13 +82,7 @@ pub fn run(a: EquilibriumArgs) -> anyhow::Result<Outcome> {
         "n_contact_points": points.len(),
         "min_mu": min_mu(&points),
     });
-    let kv = vec![
-        (
-            "stancelib.tool_version".to_string(),
-            env!("CARGO_PKG_VERSION").to_string(),
-        ),
-        ("stancelib.equilibrium".to_string(), options.to_string()),
-    ];
+    let kv = crate::library::schema::command_kv(crate::library::schema::EQUILIBRIUM_KEY, &options);
     let (dir, name) = split_out(&a.out)?;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     write_atomic(dir, &name, &mut equilibrium_table(&com, &verdicts)?, &kv)?;

@@ -5,8 +5,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::super::args::{LimitArgs, MapJumpsArgs, RunArgs, RunQueryArgs};
+use super::super::args::RunArgs;
 use super::super::Outcome;
+use crate::pipeline::queries::{map_jumps, query_stages, run_query};
 use crate::pipeline::spec::{
     expand_inputs, load_body, load_pipeline, relative_to, resolve, ConstraintsTable, QueriesTable,
 };
@@ -53,46 +54,15 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
     Ok(outcome)
 }
 
-/// The `[queries]` stages on the library just built, into `<lib>/queries/`.
+/// The `[queries]` stages on the library just built, into `<lib>/queries/` (every stage's
+/// options checked before the first runs).
 fn run_queries(q: &QueriesTable, c: Option<&ConstraintsTable>, lib: &Path) -> anyhow::Result<()> {
-    let dir = lib.join("queries");
-    // `[constraints] limits`: per_query (each query's default), absolute or relative.
-    let limits = c
-        .and_then(|c| c.limits.clone())
-        .filter(|l| l != "per_query");
-    let mu = c.and_then(|c| c.mu);
-    let active_set = c.and_then(|c| c.active_set);
-    if let Some(speeds) = &q.run_speeds {
-        super::query::run(RunQueryArgs {
-            lib: lib.to_path_buf(),
-            speed: None,
-            speeds: Some(speeds.clone()),
-            length_scale: q.length_scale.unwrap_or(1.0),
-            mass_scale: q.mass_scale.unwrap_or(1.0),
-            lim: LimitArgs {
-                limits: limits.clone(),
-                mu,
-                active_set,
-            },
-            out: dir.join("runs.parquet"),
-            png: None,
-        })?;
+    let (run, map) = query_stages(q, c, lib)?;
+    if let Some(r) = &run {
+        super::query::print_run(&run_query(r)?, &r.out);
     }
-    if q.jump_map == Some(true) {
-        super::map::run(MapJumpsArgs {
-            lib: lib.to_path_buf(),
-            heights: q
-                .map_heights
-                .clone()
-                .unwrap_or_else(|| "0.6:1.6:0.02".into()),
-            speeds: q.map_speeds.clone().unwrap_or_else(|| "0:5:0.05".into()),
-            lim: LimitArgs {
-                limits,
-                mu,
-                active_set,
-            },
-            out: dir.join("jump_map"),
-        })?;
+    if let Some(m) = &map {
+        super::map::print_map(&map_jumps(m)?, &m.out);
     }
     Ok(())
 }

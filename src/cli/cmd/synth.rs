@@ -16,18 +16,9 @@ use crate::synth::{
 /// contact_left_foot, contact_right_foot, force per kg x/y/z).
 ///
 /// # Errors
-/// Unknown motion, unit or axis; an unwritable output.
+/// An unknown unit; a rate, duration or unit out of range; an unwritable output.
 pub fn run(a: SynthArgs) -> anyhow::Result<Outcome> {
-    let motion = match a.motion.to_ascii_lowercase().as_str() {
-        "run" => SynthMotion::Run,
-        "jump" => SynthMotion::Jump,
-        m => anyhow::bail!("--motion: '{m}' is not run or jump"),
-    };
-    let up = match a.up.to_ascii_uppercase().trim_start_matches('+') {
-        "Y" => SynthUp::Y,
-        "Z" => SynthUp::Z,
-        u => anyhow::bail!("--up: '{u}' is not Y or Z"),
-    };
+    let (motion, up): (SynthMotion, SynthUp) = (a.motion.into(), a.up.into());
     let unit_m =
         parse_unit(&a.unit).ok_or_else(|| anyhow::anyhow!("--unit: '{}' is not a unit", a.unit))?;
     // The generator clamps these; the command refuses them instead of writing another clip.

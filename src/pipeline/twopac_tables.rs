@@ -5,7 +5,7 @@
 
 use polars::prelude::*;
 
-use super::columns::{col, list_col};
+use crate::library::columns::{col, list_col};
 use crate::twopac::bezier::ComState;
 use crate::twopac::equilibrium::Verdict;
 use crate::twopac::trajectory::{Phase, PhaseDiagnostic, Plan};

@@ -1,0 +1,554 @@
+//! The query stages at the I/O edge, from typed options: `query run` (a speed sweep of
+//! the run cycles) and `map jumps` (the jump feasibility map), each reading a library,
+//! answering, and writing its tables (and figures) atomically. The command line and the
+//! `[queries]` stages of a pipeline file both run them; what they print is the caller's.
+//!
+//! # References
+//! spec stance-model §6.8 (run), §6.10 (map), §7.5 (limits), §9 (new characters).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use polars::prelude::DataFrame;
+use rayon::prelude::*;
+
+use super::spec::{ConstraintsTable, QueriesTable};
+use crate::library::read::{open_library, StanceLibrary};
+use crate::library::write::write_atomic;
+use crate::plot::{jump_map_png, write_png};
+use crate::query::feasibility::{check_mu, LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
+use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
+use crate::query::map::{check_grid, jump_map, Axis, JumpMap, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};
+use crate::query::pool::Prepared;
+use crate::query::run::{
+    check_scale, check_speed, check_sweep, run_at_speed, run_cycles, scale_limits, RunCycle,
+    ScaledStance,
+};
+use crate::query::tables::{jump_map_table, jump_pairs_table, run_table, RunRow};
+use crate::stances::limits::S_EFF_RANGE;
+
+/// The limit options of a query (§7.5), as given: each `None` takes the query's default.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LimitOptions {
+    /// Limit form (`None`: the query's own default).
+    pub form: Option<LimitForm>,
+    /// Friction limit μ under either form.
+    pub mu: Option<f64>,
+    /// Active fraction of the friction check (`None`: [`DEFAULT_QUERY_ACTIVE_FRACTION`]).
+    pub active_set: Option<f64>,
+}
+
+impl LimitOptions {
+    /// The limit form (else `default`) and the given μ.
+    ///
+    /// # Errors
+    /// A μ that is not a positive finite number.
+    pub fn form(&self, default: LimitForm) -> anyhow::Result<(LimitForm, Option<f64>)> {
+        if let Some(m) = self.mu {
+            check_mu(m).map_err(|msg| crate::error::Error::invalid("--mu", msg))?;
+        }
+        Ok((self.form.unwrap_or(default), self.mu))
+    }
+
+    /// The friction check's active fraction `λ_act`.
+    ///
+    /// # Errors
+    /// A fraction outside `[0, 1)` or not finite.
+    pub fn active_fraction(&self) -> anyhow::Result<f64> {
+        let v = self.active_set.unwrap_or(DEFAULT_QUERY_ACTIVE_FRACTION);
+        anyhow::ensure!(
+            v.is_finite() && (0.0..1.0).contains(&v),
+            "--active-set must lie in [0, 1), found {v}"
+        );
+        Ok(v)
+    }
+}
+
+/// The speeds of a `start:stop:step` range given as `flag`, each checked.
+///
+/// # Errors
+/// A bad range, or a negative or non-finite speed.
+pub fn speed_range(flag: &str, range: &str) -> anyhow::Result<Vec<f64>> {
+    let v = Axis::parse(flag, range)?.values();
+    for s in &v {
+        check_speed(flag, *s)?;
+    }
+    Ok(v)
+}
+
+/// Opens a library and prepares every stance (tables built in parallel), the friction
+/// check on the active set `f_v ≥ active_fraction · max f_v`.
+///
+/// # Errors
+/// A missing or malformed library table.
+pub fn load_pool(
+    lib: &Path,
+    active_fraction: f64,
+) -> anyhow::Result<(StanceLibrary, Vec<Prepared>)> {
+    let library = open_library(lib).with_context(|| format!("library {}", lib.display()))?;
+    let pool = library
+        .stances
+        .par_iter()
+        .map(|s| Prepared::with_active_fraction(s.clone(), active_fraction))
+        .collect();
+    Ok((library, pool))
+}
+
+/// Writes `df` to the file `out` atomically (parent folder created).
+///
+/// # Errors
+/// An unwritable folder or file.
+pub fn write_table(out: &Path, df: &mut DataFrame, kv: &[(String, String)]) -> anyhow::Result<()> {
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let name = out
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("--out {}: not a file name", out.display()))?;
+    write_atomic(&dir, name, df, kv)?;
+    Ok(())
+}
+
+/// Key-value metadata of a query output: the tool version, the query's options and its
+/// library (the folder as given and the SHA-256 of its `manifest.json`).
+///
+/// # Errors
+/// The library's manifest cannot be read.
+pub fn query_kv(lib: &Path, options: serde_json::Value) -> anyhow::Result<Vec<(String, String)>> {
+    use crate::library::provenance::manifest_sha256;
+    use crate::library::schema::{command_kv, LIBRARY_MANIFEST_KEY, LIBRARY_PATH_KEY, QUERY_KEY};
+    let hash = manifest_sha256(lib).with_context(|| format!("library {}", lib.display()))?;
+    let mut kv = command_kv(QUERY_KEY, &options);
+    kv.push((LIBRARY_PATH_KEY.into(), lib.display().to_string()));
+    kv.push((LIBRARY_MANIFEST_KEY.into(), hash));
+    Ok(kv)
+}
+
+/// `query run`: every run cycle of a library at each speed, for a character `length_scale`
+/// times as long and `mass_scale` times as heavy.
+#[derive(Debug, Clone)]
+pub struct RunQuery {
+    /// Library folder.
+    pub lib: PathBuf,
+    /// Target speeds, m/s (checked: [`speed_range`]).
+    pub speeds: Vec<f64>,
+    /// Leg-length ratio target/recorded character.
+    pub length_scale: f64,
+    /// Body-mass ratio target/recorded character.
+    pub mass_scale: f64,
+    /// Limit options (default form: absolute).
+    pub limits: LimitOptions,
+    /// Output Parquet file.
+    pub out: PathBuf,
+    /// Table 1 as a figure (PNG), when given.
+    pub png: Option<PathBuf>,
+}
+
+/// One printed line of `query run`: a cycle at one speed (its first stance's values).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunLine {
+    /// Target speed, m/s.
+    pub speed_mps: f64,
+    /// The cycle's first stance.
+    pub stance_id: String,
+    /// `β_h`, `β_v` of the first stance.
+    pub beta: [Option<f64>; 2],
+    /// Friction the cycle needs (both stances solved).
+    pub mu_min: Option<f64>,
+    /// Peak force of the first stance, N.
+    pub f_peak_n: Option<f64>,
+    /// Longest COM–contact distance of the first stance, m.
+    pub ext_max_m: Option<f64>,
+    /// Contact point `cp_h` of the first stance, m.
+    pub cp_h_m: Option<f64>,
+    /// Feasible by the exact check.
+    pub feasible: bool,
+}
+
+/// What `query run` found: one line per (speed, cycle), speed-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunReport {
+    /// Cycles answered at each speed.
+    pub n_cycles: usize,
+    /// Speeds asked.
+    pub n_speeds: usize,
+    /// The lines, speed-major.
+    pub lines: Vec<RunLine>,
+}
+
+/// Runs `query run` and writes its table (and figure).
+///
+/// # Errors
+/// Bad scales or limit options, an unreadable library, too large a sweep, an unwritable
+/// output.
+pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
+    let (length, mass) = (q.length_scale, q.mass_scale);
+    check_scale("--length-scale", length)?;
+    check_scale("--mass-scale", mass)?;
+    let (form, mu) = q.limits.form(LimitForm::Absolute)?;
+    let active = q.limits.active_fraction()?;
+    let (lib, pool) = load_pool(&q.lib, active)?;
+    let all = run_cycles(&lib.stances);
+    let (cycles, skipped): (Vec<RunCycle>, Vec<RunCycle>) = all
+        .into_iter()
+        .partition(|c| !time_scaled(&lib, &lib.stances[c.stances[0]].clip));
+    if !skipped.is_empty() {
+        eprintln!(
+            "query run: {} cycle(s) left out: their clip's s_eff lies outside [{}, {}]",
+            skipped.len(),
+            S_EFF_RANGE.0,
+            S_EFF_RANGE.1
+        );
+    }
+    check_sweep("--speeds", cycles.len(), q.speeds.len())?;
+    // Absolute limits of the target character: the source character's, scaled by §9.
+    let limits: BTreeMap<String, Limits> = absolute_limits(&lib)
+        .into_iter()
+        .map(|(k, l)| (k, scale_limits(&l, length, mass)))
+        .collect();
+    // The target character: every stance scaled once (§9), then the speed sweep.
+    let scaled: Vec<(RunCycle, [Prepared; 2], [Limits; 2])> = cycles
+        .par_iter()
+        .map(|c| {
+            let prep = c.stances.map(|i| {
+                Prepared::with_active_fraction(pool[i].stance.scaled(length, mass), active)
+            });
+            let lim = [0, 1].map(|k| stance_limits(&prep[k], form, &limits, mu));
+            (*c, prep, lim)
+        })
+        .collect();
+    let mut rows = Vec::new();
+    for &v in &q.speeds {
+        for (c, prep, lim) in &scaled {
+            let cycle = [&prep[0], &prep[1]];
+            rows.push(RunRow {
+                length_scale: length,
+                mass_scale: mass,
+                stances: cycle,
+                candidate: run_at_speed(cycle, c.v_orig * length.sqrt(), v, [&lim[0], &lim[1]]),
+                limits: *lim,
+            });
+        }
+    }
+    let mut df = run_table(&rows)?;
+    let kv = query_kv(
+        &q.lib,
+        serde_json::json!({
+            "query": "run", "lib": q.lib, "speeds_mps": q.speeds,
+            "length_scale": length, "mass_scale": mass,
+            "limits": form.name(), "mu": mu, "active_set": active,
+        }),
+    )?;
+    write_table(&q.out, &mut df, &kv)?;
+    if let Some(png) = &q.png {
+        let points = run_points(&rows, scaled.len());
+        let title = format!(
+            "query run: {} cycle(s), limits {}{}",
+            scaled.len(),
+            form.name(),
+            if (length, mass) == (1.0, 1.0) {
+                String::new()
+            } else {
+                format!(", character L = {length}, M = {mass}")
+            }
+        );
+        write_png(png, |p| crate::plot::runs::runs_png(p, &title, &points))?;
+    }
+    Ok(RunReport {
+        n_cycles: scaled.len(),
+        n_speeds: q.speeds.len(),
+        lines: rows.iter().map(run_line).collect(),
+    })
+}
+
+fn run_line(r: &RunRow) -> RunLine {
+    let s = r.candidate.stances[0].as_ref().ok();
+    let mu = r
+        .candidate
+        .stances
+        .iter()
+        .map(|s| s.as_ref().ok().map(|s| s.verdict.mu_req));
+    let mu = mu
+        .collect::<Option<Vec<f64>>>()
+        .map(|v| v.into_iter().fold(0.0, f64::max));
+    RunLine {
+        speed_mps: r.candidate.speed,
+        stance_id: r.stances[0].stance.stance_id.clone(),
+        beta: [s.map(|s| s.solution.beta[0]), s.map(|s| s.solution.beta[2])],
+        mu_min: mu,
+        f_peak_n: s.map(|s| s.verdict.f_peak),
+        ext_max_m: s.map(|s| s.verdict.ext_max),
+        cp_h_m: s.map(|s| s.cp[0]),
+        feasible: r.candidate.feasible(),
+    }
+}
+
+/// The figure's points of `query run` rows (cycle-major within each speed, `n_cycles`
+/// cycles).
+fn run_points(rows: &[RunRow], n_cycles: usize) -> Vec<crate::plot::runs::RunPoint> {
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let solved: Vec<_> = r
+                .candidate
+                .stances
+                .iter()
+                .filter_map(|s| s.as_ref().ok())
+                .collect();
+            let both = solved.len() == 2;
+            let agg = |g: &dyn Fn(&ScaledStance) -> f64, max: bool| {
+                both.then(|| {
+                    let (a, b) = (g(solved[0]), g(solved[1]));
+                    if max {
+                        a.max(b)
+                    } else {
+                        a.min(b)
+                    }
+                })
+            };
+            crate::plot::runs::RunPoint {
+                cycle: i % n_cycles.max(1),
+                speed_mps: r.candidate.speed,
+                beta_h: solved.iter().map(|s| s.solution.beta[0]).collect(),
+                mu_min: agg(&|s| s.verdict.mu_req, true),
+                ext_min_m: agg(&|s| s.verdict.ext_min, false),
+                ext_max_m: agg(&|s| s.verdict.ext_max, true),
+                limits: (r.limits[0].mu, r.limits[0].chi_min, r.limits[0].chi_max),
+                feasible: r.candidate.feasible(),
+                violated: r.violated(),
+            }
+        })
+        .collect()
+}
+
+/// `map jumps`: the jump feasibility map of a library over apex heights × speeds.
+#[derive(Debug, Clone)]
+pub struct MapQuery {
+    /// Library folder.
+    pub lib: PathBuf,
+    /// Rows: apex heights, m.
+    pub heights: Vec<f64>,
+    /// Columns: horizontal apex speeds, m/s.
+    pub speeds: Vec<f64>,
+    /// Limit options (default form: relative).
+    pub limits: LimitOptions,
+    /// Output folder.
+    pub out: PathBuf,
+}
+
+/// What `map jumps` found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapReport {
+    /// Liftoff stances.
+    pub liftoffs: usize,
+    /// Landing stances.
+    pub landings: usize,
+    /// Liftoff × landing pairs of one character.
+    pub pairs: usize,
+    /// Grid rows × columns.
+    pub grid: (usize, usize),
+    /// Cells feasible by the fast filters, the exact check, both.
+    pub cells: (usize, usize, usize),
+    /// Intersection over union of the two feasible sets.
+    pub iou: f64,
+    /// Time spent computing the map, s.
+    pub elapsed_s: f64,
+}
+
+/// Runs `map jumps` and writes `jump_map.parquet`, `jump_map_pairs.parquet`,
+/// `jump_map.json` and the figures into its folder.
+///
+/// # Errors
+/// An empty or too large grid, bad limit options, an unreadable library, an unwritable
+/// output folder.
+pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
+    let (heights, speeds) = (&q.heights, &q.speeds);
+    anyhow::ensure!(
+        !heights.is_empty() && !speeds.is_empty(),
+        "the grid is empty: check --heights and --speeds"
+    );
+    check_grid("--heights × --speeds", heights.len(), speeds.len())?;
+    let (form, mu) = q.limits.form(LimitForm::Relative)?;
+    let active = q.limits.active_fraction()?;
+    let (lib, pool) = load_pool(&q.lib, active)?;
+    let absolute = absolute_limits(&lib);
+    let limits = |p: &Prepared| stance_limits(p, form, &absolute, mu);
+    let t0 = Instant::now();
+    let map = jump_map(&pool, heights, speeds, &limits)
+        .context("--heights × --speeds on this library")?;
+    let elapsed = t0.elapsed().as_secs_f64();
+    std::fs::create_dir_all(&q.out)
+        .with_context(|| format!("cannot create {}", q.out.display()))?;
+    let iou = map.agreement.iou();
+    let summary = serde_json::json!({
+        "heights_m": {"start": heights[0], "stop": heights[heights.len() - 1], "n": heights.len()},
+        "u_apex_mps": {"start": speeds[0], "stop": speeds[speeds.len() - 1], "n": speeds.len()},
+        "liftoffs": map.liftoffs.len(), "landings": map.landings.len(), "pairs": map.pairs.len(),
+        "cells_approx": map.agreement.approx, "cells_exact": map.agreement.exact,
+        "cells_both": map.agreement.both, "iou": iou,
+        "limits": form.name(), "mu": mu, "active_set": active,
+    });
+    let kv = query_kv(&q.lib, summary.clone())?;
+    write_atomic(
+        &q.out,
+        "jump_map.parquet",
+        &mut jump_map_table(&map, &pool)?,
+        &kv,
+    )?;
+    write_atomic(
+        &q.out,
+        "jump_map_pairs.parquet",
+        &mut jump_pairs_table(&map, &pool)?,
+        &kv,
+    )?;
+    crate::library::atomic::write_text_atomic(
+        &q.out.join("jump_map.json"),
+        &(serde_json::to_string_pretty(&summary)? + "\n"),
+    )?;
+    map_figures(&q.out, &map, &pool)?;
+    Ok(MapReport {
+        liftoffs: map.liftoffs.len(),
+        landings: map.landings.len(),
+        pairs: map.pairs.len(),
+        grid: (heights.len(), speeds.len()),
+        cells: (
+            map.agreement.approx,
+            map.agreement.exact,
+            map.agreement.both,
+        ),
+        iou,
+        elapsed_s: elapsed,
+    })
+}
+
+/// `jump_map.png`, and one `jump_map_<character>.png` each when the pool has several.
+fn map_figures(out: &Path, map: &JumpMap, pool: &[Prepared]) -> anyhow::Result<()> {
+    let recorded = recorded_jumps(map, pool);
+    let marks = |ids: Option<&str>| -> Vec<(f64, f64)> {
+        recorded
+            .iter()
+            .filter(|(c, _)| ids.is_none_or(|id| id == c.as_str()))
+            .map(|(_, p)| *p)
+            .collect()
+    };
+    write_png(&out.join("jump_map.png"), |p| {
+        jump_map_png(p, map, "all characters", &marks(None))
+    })?;
+    let characters: BTreeSet<&str> = map
+        .pairs
+        .iter()
+        .map(|p| pool[p.liftoff].stance.character_id.as_str())
+        .collect();
+    if characters.len() > 1 {
+        for id in &characters {
+            let mut one = map.clone();
+            one.pairs
+                .retain(|p| pool[p.liftoff].stance.character_id == *id);
+            one.agreement = one.pairs.iter().fold(Default::default(), |mut acc, p| {
+                acc.approx += p.agreement.approx;
+                acc.exact += p.agreement.exact;
+                acc.both += p.agreement.both;
+                acc.either += p.agreement.either;
+                acc
+            });
+            let file = out.join(format!("jump_map_{}.png", file_safe(id)));
+            write_png(&file, |p| jump_map_png(p, &one, id, &marks(Some(*id))))?;
+        }
+    }
+    Ok(())
+}
+
+/// The recorded jumps of the map's pairs, `(character_id, (distance, height))` in m: a
+/// liftoff and the landing right after it across one flight of the same clip, at the
+/// identity jump's height `(ze₁ + zs₂ + z_c,2 − z_c,1)/2` and distance `x₁ + x₂` (spec
+/// stance-model §6.9).
+pub fn recorded_jumps(map: &JumpMap, pool: &[Prepared]) -> Vec<(String, (f64, f64))> {
+    map.pairs
+        .iter()
+        .filter_map(|p| {
+            let (s1, s2) = (&pool[p.liftoff].stance, &pool[p.landing].stance);
+            let next = pool
+                .iter()
+                .map(|q| &q.stance)
+                .filter(|q| q.clip == s1.clip && q.first_frame > s1.first_frame)
+                .min_by_key(|q| q.first_frame)?;
+            (next.stance_id == s2.stance_id).then(|| {
+                let h = (s1.params.ze + s2.params.zs + s2.z_c - s1.z_c) / 2.0;
+                (s1.character_id.clone(), (s1.params.x + s2.params.x, h))
+            })
+        })
+        .collect()
+}
+
+/// `id` with every character but ASCII letters, digits, `-` and `_` replaced by `_`.
+fn file_safe(id: &str) -> String {
+    id.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The `[queries]` stages of a pipeline file on the library `lib` just built, as typed
+/// queries into `<lib>/queries/` (`runs.parquet`, `jump_map/`); `[constraints]` gives their
+/// limit options (`limits = "per_query"` keeps each query's default form). Every option is
+/// checked here, before any stage runs.
+///
+/// # Errors
+/// A bad speed, height or apex-speed range.
+pub fn query_stages(
+    q: &QueriesTable,
+    c: Option<&ConstraintsTable>,
+    lib: &Path,
+) -> anyhow::Result<(Option<RunQuery>, Option<MapQuery>)> {
+    let dir = lib.join("queries");
+    let limits = LimitOptions {
+        form: c
+            .and_then(|c| c.limits.as_deref())
+            .filter(|l| *l != "per_query")
+            .and_then(LimitForm::parse),
+        mu: c.and_then(|c| c.mu),
+        active_set: c.and_then(|c| c.active_set),
+    };
+    let run = match &q.run_speeds {
+        Some(speeds) => Some(RunQuery {
+            lib: lib.to_path_buf(),
+            speeds: speed_range("--speeds", speeds)?,
+            length_scale: q.length_scale.unwrap_or(1.0),
+            mass_scale: q.mass_scale.unwrap_or(1.0),
+            limits,
+            out: dir.join("runs.parquet"),
+            png: None,
+        }),
+        None => None,
+    };
+    let map = match q.jump_map {
+        Some(true) => Some(MapQuery {
+            lib: lib.to_path_buf(),
+            heights: axis_or("--heights", q.map_heights.as_deref(), DEFAULT_HEIGHTS)?,
+            speeds: axis_or("--speeds", q.map_speeds.as_deref(), DEFAULT_SPEEDS)?,
+            limits,
+            out: dir.join("jump_map"),
+        }),
+        _ => None,
+    };
+    Ok((run, map))
+}
+
+/// The values of the range `given` as `flag`, else of `default`.
+fn axis_or(flag: &str, given: Option<&str>, default: Axis) -> anyhow::Result<Vec<f64>> {
+    Ok(match given {
+        Some(r) => Axis::parse(flag, r)?,
+        None => default,
+    }
+    .values())
+}

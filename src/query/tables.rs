@@ -1,0 +1,366 @@
+//! The query outputs as tables: `query run`, `query jump` and `map jumps` (spec
+//! stance-model §6.8–§6.10). Column names carry their unit (`_m`, `_s`, `_mps`, `_n`).
+//!
+//! Per-stance values of a run cycle are lists in the order of `stance_ids`; a stance
+//! without an admissible solution has nulls there and its reason in `violated`.
+
+use polars::prelude::*;
+
+use super::feasibility::{Limits, Verdict, Violation};
+use super::jump::Jump;
+use super::map::{Agreement, JumpMap};
+use super::pool::Prepared;
+use super::run::{RunCandidate, ScaledStance};
+use crate::library::columns::{col, list_col};
+
+/// Name of a violated constraint in the `violated` columns.
+pub fn violation_name(v: Violation) -> &'static str {
+    match v {
+        Violation::Beta => "beta_negative",
+        Violation::Force => "force",
+        Violation::Friction => "friction",
+        Violation::Unilateral => "unilateral",
+        Violation::ExtensionMin => "extension_min",
+        Violation::ExtensionMax => "extension_max",
+    }
+}
+
+/// One `query run` row: a cycle at one speed for one character.
+pub struct RunRow<'a> {
+    /// Length scale `L` of the target character.
+    pub length_scale: f64,
+    /// Mass scale `M`.
+    pub mass_scale: f64,
+    /// The cycle's two stances (character-scaled).
+    pub stances: [&'a Prepared; 2],
+    /// The outcome.
+    pub candidate: RunCandidate,
+    /// The limits each stance was checked against.
+    pub limits: [Limits; 2],
+}
+
+impl RunRow<'_> {
+    fn solved(&self) -> [Option<&ScaledStance>; 2] {
+        self.candidate.stances.each_ref().map(|s| s.as_ref().ok())
+    }
+
+    /// First problem: `<stance_id>: <reason>`, or `None` when feasible.
+    pub fn violated(&self) -> Option<String> {
+        self.candidate
+            .stances
+            .iter()
+            .zip(self.stances)
+            .find_map(|(s, p)| {
+                let id = &p.stance.stance_id;
+                match s {
+                    Err(e) => Some(format!("{id}: {e}")),
+                    Ok(s) => s
+                        .verdict
+                        .violated
+                        .map(|v| format!("{id}: {}", violation_name(v))),
+                }
+            })
+    }
+
+    /// A cycle aggregate over its solved stances; `None` unless both solved.
+    fn agg(&self, get: impl Fn(&Verdict) -> f64, max: bool) -> Option<f64> {
+        let [a, b] = self.solved();
+        let (a, b) = (get(&a?.verdict), get(&b?.verdict));
+        Some(if max { a.max(b) } else { a.min(b) })
+    }
+}
+
+fn per_stance(rows: &[RunRow], get: impl Fn(&ScaledStance) -> f64) -> Vec<Vec<Option<f64>>> {
+    rows.iter()
+        .map(|r| r.solved().iter().map(|s| s.map(&get)).collect())
+        .collect()
+}
+
+/// The `query run` table (rows in the given order).
+///
+/// # Errors
+/// A column cannot be built.
+pub fn run_table(rows: &[RunRow]) -> PolarsResult<DataFrame> {
+    let f = |g: &dyn Fn(&RunRow) -> f64| -> Vec<f64> { rows.iter().map(g).collect() };
+    let o =
+        |g: &dyn Fn(&RunRow) -> Option<f64>| -> Vec<Option<f64>> { rows.iter().map(g).collect() };
+    let first = |r: &RunRow| r.stances[0].stance.clone();
+    let lists = |name: &str, g: &dyn Fn(&ScaledStance) -> f64| {
+        list_col(name, per_stance(rows, g), DataType::Float64)
+    };
+    let lim_list = |name: &str, g: &dyn Fn(&Limits) -> f64| {
+        let v: Vec<Vec<f64>> = rows
+            .iter()
+            .map(|r| r.limits.iter().map(g).collect())
+            .collect();
+        list_col(name, v, DataType::Float64)
+    };
+    DataFrame::new_infer_height(vec![
+        col("speed_mps", f(&|r| r.candidate.speed)),
+        col("length_scale", f(&|r| r.length_scale)),
+        col("mass_scale", f(&|r| r.mass_scale)),
+        col(
+            "character_id",
+            rows.iter()
+                .map(|r| first(r).character_id)
+                .collect::<Vec<_>>(),
+        ),
+        col(
+            "clip",
+            rows.iter().map(|r| first(r).clip).collect::<Vec<_>>(),
+        ),
+        list_col(
+            "stance_ids",
+            rows.iter()
+                .map(|r| {
+                    r.stances
+                        .iter()
+                        .map(|p| p.stance.stance_id.clone())
+                        .collect()
+                })
+                .collect(),
+            DataType::String,
+        )?,
+        col("v_orig_mps", f(&|r| r.candidate.v_orig)),
+        col("k", f(&|r| r.candidate.k)),
+        lists("beta_h", &|s| s.solution.beta[0])?,
+        lists("beta_v", &|s| s.solution.beta[2])?,
+        lists("beta_p", &|s| s.solution.beta[1])?,
+        lists("t_td_s", &|s| s.solution.t_td)?,
+        lists("t_lo_s", &|s| s.solution.t_lo)?,
+        lists("t_e_s", &|s| s.solution.t_e)?,
+        col("mu_min", o(&|r| r.agg(|v| v.mu_req, true))),
+        col("peak_force_n", o(&|r| r.agg(|v| v.f_peak, true))),
+        col("ext_min_m", o(&|r| r.agg(|v| v.ext_min, false))),
+        col("ext_max_m", o(&|r| r.agg(|v| v.ext_max, true))),
+        lists("cp_h_m", &|s| s.cp[0])?,
+        lists("cp_p_m", &|s| s.cp[1])?,
+        col(
+            "feasible_approx",
+            rows.iter()
+                .map(|r| r.candidate.feasible_approx())
+                .collect::<Vec<_>>(),
+        ),
+        col(
+            "feasible",
+            rows.iter()
+                .map(|r| r.candidate.feasible())
+                .collect::<Vec<_>>(),
+        ),
+        col(
+            "violated",
+            rows.iter().map(RunRow::violated).collect::<Vec<_>>(),
+        ),
+        lim_list("limit_mu", &|l| l.mu)?,
+        lim_list("limit_f_max_n", &|l| l.f_max)?,
+        lim_list("limit_chi_min_m", &|l| l.chi_min)?,
+        lim_list("limit_chi_max_m", &|l| l.chi_max)?,
+    ])
+}
+
+/// One `query jump` row: a liftoff/landing pair, solved or not.
+pub struct JumpRow<'a> {
+    /// Liftoff stance.
+    pub liftoff: &'a Prepared,
+    /// Landing stance.
+    pub landing: &'a Prepared,
+    /// Requested apex height above the liftoff contact, m.
+    pub height: f64,
+    /// Requested distance, m.
+    pub distance: f64,
+    /// The limits each side was checked against (liftoff, landing).
+    pub limits: [Limits; 2],
+    /// The jump, or why it has no admissible scaling.
+    pub jump: Result<Jump, String>,
+}
+
+impl JumpRow<'_> {
+    /// First problem, `liftoff: force`, or the solver's reason.
+    pub fn violated(&self) -> Option<String> {
+        match &self.jump {
+            Err(e) => Some(e.clone()),
+            Ok(j) => ["liftoff", "landing"]
+                .iter()
+                .zip(&j.sides)
+                .find_map(|(n, (_, s))| {
+                    s.verdict
+                        .violated
+                        .map(|v| format!("{n}: {}", violation_name(v)))
+                }),
+        }
+    }
+}
+
+/// The `query jump` table (rows in the given order: the caller ranks them).
+///
+/// # Errors
+/// A column cannot be built.
+pub fn jump_table(rows: &[JumpRow]) -> PolarsResult<DataFrame> {
+    let o = |g: &dyn Fn(&Jump) -> f64| -> Vec<Option<f64>> {
+        rows.iter().map(|r| r.jump.as_ref().ok().map(g)).collect()
+    };
+    let side = |k: usize, g: &dyn Fn(&ScaledStance) -> f64| -> Vec<Option<f64>> {
+        rows.iter()
+            .map(|r| r.jump.as_ref().ok().map(|j| g(&j.sides[k].1)))
+            .collect()
+    };
+    let ids = |g: &dyn Fn(&JumpRow) -> String| -> Vec<String> { rows.iter().map(g).collect() };
+    let mut cols = vec![
+        col("rank", (1..=rows.len() as i64).collect::<Vec<_>>()),
+        col(
+            "liftoff_stance_id",
+            ids(&|r| r.liftoff.stance.stance_id.clone()),
+        ),
+        col(
+            "landing_stance_id",
+            ids(&|r| r.landing.stance.stance_id.clone()),
+        ),
+        col(
+            "character_id",
+            ids(&|r| r.liftoff.stance.character_id.clone()),
+        ),
+        col(
+            "height_m",
+            rows.iter().map(|r| r.height).collect::<Vec<_>>(),
+        ),
+        col(
+            "distance_m",
+            rows.iter().map(|r| r.distance).collect::<Vec<_>>(),
+        ),
+        col("u_apex_mps", o(&|j| j.u_apex)),
+        col("flight_time_s", o(&|j| j.flight_time)),
+        col("d_flight_m", o(&|j| j.d_flight)),
+        col("force_change", o(&Jump::force_change)),
+    ];
+    // Slack to each limit the side was checked against (≥ 0 where met).
+    let margin = |k: usize, g: &dyn Fn(&ScaledStance, &Limits) -> f64| -> Vec<Option<f64>> {
+        rows.iter()
+            .map(|r| r.jump.as_ref().ok().map(|j| g(&j.sides[k].1, &r.limits[k])))
+            .collect()
+    };
+    for (k, n) in [(0, "1"), (1, "2")] {
+        let x = |j: &Jump| j.sides[k].0.x;
+        cols.extend([
+            col(&format!("beta_h{n}"), side(k, &|s| s.solution.beta[0])),
+            col(&format!("beta_v{n}"), side(k, &|s| s.solution.beta[2])),
+            col(&format!("beta_p{n}"), side(k, &|s| s.solution.beta[1])),
+            col(&format!("t_td{n}_s"), side(k, &|s| s.solution.t_td)),
+            col(&format!("t_lo{n}_s"), side(k, &|s| s.solution.t_lo)),
+            col(&format!("t_e{n}_s"), side(k, &|s| s.solution.t_e)),
+            col(&format!("x{n}_m"), o(&x)),
+            col(&format!("peak_force{n}_n"), side(k, &|s| s.verdict.f_peak)),
+            col(&format!("mu_req{n}"), side(k, &|s| s.verdict.mu_req)),
+            col(&format!("ext_min{n}_m"), side(k, &|s| s.verdict.ext_min)),
+            col(&format!("ext_max{n}_m"), side(k, &|s| s.verdict.ext_max)),
+            col(&format!("cp_h{n}_m"), side(k, &|s| s.cp[0])),
+            col(&format!("cp_p{n}_m"), side(k, &|s| s.cp[1])),
+            col(
+                &format!("margin_force{n}_n"),
+                margin(k, &|s, l| l.f_max - s.verdict.f_peak),
+            ),
+            col(
+                &format!("margin_mu{n}"),
+                margin(k, &|s, l| l.mu - s.verdict.mu_req),
+            ),
+            col(
+                &format!("margin_ext_min{n}_m"),
+                margin(k, &|s, l| s.verdict.ext_min - l.chi_min),
+            ),
+            col(
+                &format!("margin_ext_max{n}_m"),
+                margin(k, &|s, l| l.chi_max - s.verdict.ext_max),
+            ),
+        ]);
+    }
+    let flag = |g: &dyn Fn(&Jump) -> bool| -> Vec<bool> {
+        rows.iter().map(|r| r.jump.as_ref().is_ok_and(g)).collect()
+    };
+    cols.extend([
+        col("feasible_approx", flag(&Jump::feasible_approx)),
+        col("feasible", flag(&Jump::feasible)),
+        col(
+            "violated",
+            rows.iter().map(JumpRow::violated).collect::<Vec<_>>(),
+        ),
+    ]);
+    DataFrame::new_infer_height(cols)
+}
+
+/// `jump_map.parquet`: one row per pair and cell, pairs in (liftoff, landing) pool order,
+/// cells row-major (height, then `u_apex`).
+///
+/// # Errors
+/// A column cannot be built.
+pub fn jump_map_table(map: &JumpMap, pool: &[Prepared]) -> PolarsResult<DataFrame> {
+    let (n_h, n_u) = (map.heights.len(), map.speeds.len());
+    let n = map.pairs.len() * n_h * n_u;
+    let mut lift = Vec::with_capacity(n);
+    let mut land = Vec::with_capacity(n);
+    let (mut u, mut h) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut dist, mut flight) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut ap, mut ex) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for p in &map.pairs {
+        let (a, b) = (
+            pool[p.liftoff].stance.stance_id.as_str(),
+            pool[p.landing].stance.stance_id.as_str(),
+        );
+        for (r, &hr) in map.heights.iter().enumerate() {
+            let row = p.rows[r];
+            for (q, &uq) in map.speeds.iter().enumerate() {
+                lift.push(a);
+                land.push(b);
+                u.push(uq);
+                h.push(hr);
+                dist.push(row.map(|(d, c, _)| uq * d + c));
+                flight.push(row.map(|(_, _, t)| t));
+                ap.push(p.approx[r * n_u + q]);
+                ex.push(p.exact[r * n_u + q]);
+            }
+        }
+    }
+    DataFrame::new_infer_height(vec![
+        col("liftoff_stance_id", lift),
+        col("landing_stance_id", land),
+        col("u_apex_mps", u),
+        col("height_m", h),
+        col("distance_m", dist),
+        col("flight_time_s", flight),
+        col("feasible_approx", ap),
+        col("feasible_exact", ex),
+    ])
+}
+
+/// `jump_map_pairs.parquet`: one row per pair with its cell counts and IoU.
+///
+/// # Errors
+/// A column cannot be built.
+pub fn jump_pairs_table(map: &JumpMap, pool: &[Prepared]) -> PolarsResult<DataFrame> {
+    let p = &map.pairs;
+    let id = |i: usize| pool[i].stance.stance_id.clone();
+    let count = |g: &dyn Fn(&Agreement) -> usize| -> Vec<i64> {
+        p.iter().map(|x| g(&x.agreement) as i64).collect()
+    };
+    DataFrame::new_infer_height(vec![
+        col(
+            "liftoff_stance_id",
+            p.iter().map(|x| id(x.liftoff)).collect::<Vec<_>>(),
+        ),
+        col(
+            "landing_stance_id",
+            p.iter().map(|x| id(x.landing)).collect::<Vec<_>>(),
+        ),
+        col(
+            "character_id",
+            p.iter()
+                .map(|x| pool[x.liftoff].stance.character_id.clone())
+                .collect::<Vec<_>>(),
+        ),
+        col("n_approx", count(&|a| a.approx)),
+        col("n_exact", count(&|a| a.exact)),
+        col("n_both", count(&|a| a.both)),
+        col(
+            "iou",
+            p.iter().map(|x| x.agreement.iou()).collect::<Vec<_>>(),
+        ),
+    ])
+}
