@@ -26,8 +26,7 @@
 use crate::math::polyfit::{fit, fit_fixed_curvature, Poly};
 use crate::math::stats::median;
 
-/// Gravity magnitude, m/s².
-pub const G: f64 = 9.81;
+pub use crate::math::constants::GRAVITY as G;
 /// Longest flight, s.
 pub const T_FLIGHT_MAX_S: f64 = 1.0;
 /// Shortest airborne interval, s.

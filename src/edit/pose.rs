@@ -32,27 +32,7 @@ use crate::error::{Error, Result};
 use crate::ingest::body::BodyModel;
 use crate::skeleton::fk::local_translation;
 
-type V3 = [f64; 3];
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
+use crate::math::v3::{add, cross, dot, norm, sub, V3};
 
 /// What the pose stage needs of each planned stance's source stance.
 #[derive(Debug, Clone, PartialEq)]

@@ -58,7 +58,7 @@ mod simplex;
 pub mod trajectory;
 pub mod transition;
 mod unique_keys;
-mod v3;
+use crate::math::v3;
 pub mod validate;
 
 #[cfg(test)]

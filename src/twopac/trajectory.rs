@@ -38,6 +38,7 @@ use super::transition::{
 };
 use super::v3::{norm, scale, sub};
 use super::TwopacError;
+use crate::math::constants::STATIC_TOL;
 
 /// Most phases of one sequence (count). `twopac` plans it 31 times and solves each
 /// transition QP 2,000 times for `timings.json`, so its time grows with the phases.
@@ -461,7 +462,7 @@ pub fn phase_diagnostics(plan: &Plan, phases: &[Phase]) -> Vec<PhaseDiagnostic> 
         .iter()
         .zip(phases)
         .map(|(s, p)| PhaseDiagnostic {
-            static_feasible: s.is_static(1e-6),
+            static_feasible: s.is_static(STATIC_TOL),
             kinematic_margin_m: -p.polytope().max_violation(s.com),
         })
         .collect()
