@@ -177,7 +177,7 @@ impl SupportLp {
 /// # Errors
 ///
 /// [`TwopacError::Solver`] if an LP hits its pivot cap or turns out unbounded inside the
-/// clipping square, or more than [`MAX_LPS`] LPs are needed (numerical trouble or
+/// clipping square; [`TwopacError::NotConverged`] when more than [`MAX_LPS`] LPs are needed (numerical trouble or
 /// non-finite points; never seen on valid input).
 pub fn static_region(
     points: &[ContactPoint],
@@ -230,8 +230,9 @@ pub fn static_region(
             let (h, c) = lp.support(n).map_err(|e| fail("support", e))?;
             let chord = n[0] * a[0] + n[1] * a[1];
             if lp.n_lps > MAX_LPS {
-                return Err(TwopacError::Solver {
-                    what: format!("static region: more than {MAX_LPS} support LPs"),
+                return Err(TwopacError::NotConverged {
+                    what: format!("static region: support LPs (cap MAX_LPS = {MAX_LPS})"),
+                    iterations: lp.n_lps,
                 });
             }
             // A NaN gap also ends the refinement.
