@@ -34,6 +34,8 @@
 //! - `safety_limits`: issue 11 items 6, 10, 11, 12: every documented work limit refused
 //!   before work (exit 2, field and limit named), pipelines validated before the library
 //!   is touched, no option accepted and ignored, duplicate JSON/TOML keys refused.
+//! - `structure_stages`: issue 13 items 1, 4 — the contact stage's entry points give the
+//!   ingest's contacts; a per-clip ingest error keeps its kind (not "skeleton").
 //! - `twopac`: `equilibrium` and `twopac` on `fixtures/twopac/`: reference margins, boundary
 //!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
 mod analyst;
@@ -59,5 +61,6 @@ mod safety_outputs;
 mod scale;
 mod stances;
 mod stances_truth;
+mod structure_stages;
 mod twopac;
 mod util;

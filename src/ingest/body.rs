@@ -13,7 +13,7 @@
 //! FK in file units and axes; [`BodyModel::points`] and [`BodyModel::com`] in metres,
 //! internal Z-up frame.
 
-use super::kinematics::{choose_toe, facing, fk_frames, side_points, toe_tip};
+use super::points::{choose_toe, facing, fk_frames, side_points, toe_tip};
 use crate::bvh::Bvh;
 use crate::error::{Error, Result};
 use crate::skeleton::com::{com, BodyPoints, Sex};
@@ -22,7 +22,7 @@ use crate::skeleton::names::Side;
 use crate::skeleton::units::UpAxis;
 use crate::skeleton::{fk, leadin, Skeleton};
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// One clip's body, frozen for posing (see the module docs).
 #[derive(Debug, Clone)]
