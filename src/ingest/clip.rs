@@ -11,9 +11,8 @@
 //! # References
 //! spec com-from-bvh §2–§8.
 
-use super::points::{self, facing, first_non_finite, side_points, ClipPoints};
+use super::points::{self, facing, first_non_finite, side_points, ClipPoints, ClipSource};
 use super::{ClipFrames, ClipSummary, IngestOptions};
-use crate::bvh::Bvh;
 use crate::contacts::flight::clip_summary;
 use crate::contacts::{self, ClipMotion, ContactRun, EffectorPoints};
 use crate::error::{Error, Result};
@@ -24,19 +23,22 @@ use crate::skeleton::landmarks::{Landmarks, ToeTipRule};
 use crate::skeleton::names::Side;
 use crate::skeleton::Skeleton;
 
-/// Run the numerical stages on the kept frames (from row `skip`); fills the per-clip
+/// Run the numerical stages on the kept frames (from row `src.skip`); fills the per-clip
 /// fields of `summary`.
 pub(super) fn run(
-    skel: &Skeleton,
-    lm: &Landmarks,
-    rest_file: &[V3],
-    bvh: &Bvh,
-    skip: usize,
-    opts: &IngestOptions,
+    src: &ClipSource,
     summary: &mut ClipSummary,
 ) -> Result<(ClipFrames, Vec<ContactRun>)> {
+    let ClipSource {
+        skel,
+        lm,
+        bvh,
+        skip,
+        opts,
+        ..
+    } = *src;
     let dt = bvh.motion.frame_time_s;
-    let body = points::clip_points(skel, lm, rest_file, bvh, skip, opts, &mut summary.warnings)?;
+    let body = points::clip_points(src, &mut summary.warnings)?;
     record_body(summary, skel, &body, opts);
     let frames = body.frames();
     let fwd: Vec<V3> = frames

@@ -204,7 +204,15 @@ pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
         );
         return Ok(ClipOutcome::Skipped { summary, reason });
     }
-    let (frames, contacts) = clip::run(&skel, &lm, &rest, bvh, skip, opts, &mut summary)?;
+    let src = points::ClipSource {
+        skel: &skel,
+        lm: &lm,
+        rest_file: &rest,
+        bvh,
+        skip,
+        opts,
+    };
+    let (frames, contacts) = clip::run(&src, &mut summary)?;
     Ok(ClipOutcome::Body {
         summary,
         frames,

@@ -118,6 +118,17 @@ pub(super) fn side_points(limb: &Limb, fp: &[V3], ttip: V3) -> SidePoints {
     }
 }
 
+/// One parsed clip as the ingest stages see it: skeleton, landmarks, rest pose (file units
+/// and axes), the kept frames (from row `skip`) and the options.
+pub(super) struct ClipSource<'a> {
+    pub skel: &'a Skeleton,
+    pub lm: &'a Landmarks,
+    pub rest_file: &'a [V3],
+    pub bvh: &'a Bvh,
+    pub skip: usize,
+    pub opts: &'a IngestOptions,
+}
+
 /// A clip's kept frames in metres, internal Z-up frame, and what scaled them.
 pub(super) struct ClipPoints {
     /// Frames × points, m.
@@ -190,21 +201,21 @@ fn up_axis(
     a
 }
 
-/// FK over the kept frames (from row `skip`), in metres and the internal Z-up frame, with
+/// FK over the kept frames (from row `src.skip`), in metres and the internal Z-up frame, with
 /// the unit and up axis (overrides, or detected; detection warnings go to `warnings`).
 ///
 /// # Errors
 /// A non-finite rest-pose leg length, position or leg length in metres
 /// (`ErrorKind::NonFinite`, naming the first bad frame and joint).
-pub(super) fn clip_points(
-    skel: &Skeleton,
-    lm: &Landmarks,
-    rest_file: &[V3],
-    bvh: &Bvh,
-    skip: usize,
-    opts: &IngestOptions,
-    warnings: &mut Vec<String>,
-) -> Result<ClipPoints> {
+pub(super) fn clip_points(src: &ClipSource, warnings: &mut Vec<String>) -> Result<ClipPoints> {
+    let ClipSource {
+        skel,
+        lm,
+        rest_file,
+        bvh,
+        skip,
+        opts,
+    } = *src;
     let leg_file = rest_leg_length(skel, lm, rest_file)?;
     let (scale, unit) = match opts.unit_m {
         Some(u) => (u, "override".to_string()),

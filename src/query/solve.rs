@@ -511,6 +511,10 @@ pub fn candidates(
     };
     let inv_g = 1.0 / GRAVITY; // a constant: the divisions by g become products
     let mk = Maker {
+        shape,
+        req,
+        refs,
+        opts,
         sv: shape.derived.s_bar_v,
         dz_g: (req.ze - req.zs) * inv_g,
         beta_p,
@@ -518,13 +522,18 @@ pub fn candidates(
     };
     // (ii) no net horizontal impulse.
     if near_zero(0) {
-        return no_net_horizontal(shape, req, refs, opts, &mk);
+        return mk.no_net_horizontal();
     }
-    quadratic(shape, req, refs, opts, &mk)
+    mk.quadratic()
 }
 
-/// What every candidate of one request shares: `t_TD`, `u`, `w` and `β` for one `T > 0`.
-struct Maker {
+/// One request on one stance and what every candidate of it shares: `t_TD`, `u`, `w` and
+/// `β` for one `T > 0`.
+struct Maker<'a> {
+    shape: &'a StanceShape,
+    req: &'a Request,
+    refs: &'a Refs,
+    opts: &'a SolveOptions,
     /// `s̄_v`, s.
     sv: f64,
     /// `(z_e − z_s)/g`, s².
@@ -535,7 +544,7 @@ struct Maker {
     inv_jv: f64,
 }
 
-impl Maker {
+impl Maker<'_> {
     /// The candidate for `T` with `inv_t` = 1/T (passed in when a root gives it without a
     /// division).
     #[inline]
@@ -566,95 +575,85 @@ impl Maker {
     fn at(&self, t: f64, beta_h: f64) -> Candidate {
         self.at_inv(t, 1.0 / t, beta_h)
     }
-}
 
-/// §6.4 (ii), no net horizontal impulse: `T` from `β_v,ref`, `β_h` from A4.
-#[inline]
-fn no_net_horizontal(
-    shape: &StanceShape,
-    req: &Request,
-    refs: &Refs,
-    opts: &SolveOptions,
-    mk: &Maker,
-) -> Result<(Roots, Branch), Infeasible> {
-    if !matches(req.ve, req.vs, opts.match_tol) {
-        return Err(Infeasible::NoNetHorizontalImpulse);
-    }
-    let t = refs.beta_v * shape.j[2] / GRAVITY;
-    if t <= 0.0 {
-        return Ok((Roots::one(sign_fail(t, mk.beta_p)), Branch::NoNetHorizontal));
-    }
-    let mut c = mk.make_inv(t, 1.0 / t, 0.0);
-    let moment_scale = shape.dt * shape.j_scale[0];
-    let rest = req.ve * t - (req.ve - req.vs) * c.t_td;
-    let kh = shape.k[0];
-    c.beta[0] = if kh.abs() <= opts.eps_j * moment_scale {
-        if !matches(req.x, rest, opts.match_tol) {
-            return Err(Infeasible::NoNetHorizontalMoment);
-        }
-        refs.beta_h
-    } else {
-        (rest - req.x) / kh
-    };
-    Ok((Roots::one(c), Branch::NoNetHorizontal))
-}
-
-/// §6.2 `a T² + b T + c = 0` (and its degenerate forms of §6.4 (iv)), roots by the stable
-/// formula `q = −(b + sign(b)·√disc)/2`, `T1 = q/a`, `T2 = c/q`.
-#[inline]
-fn quadratic(
-    shape: &StanceShape,
-    req: &Request,
-    refs: &Refs,
-    opts: &SolveOptions,
-    mk: &Maker,
-) -> Result<(Roots, Branch), Infeasible> {
-    let d = req.ve - req.vs;
-    let dz = req.ze - req.zs;
-    let beta_h = d * shape.derived.inv_j[0];
-    let (sh, sv) = (shape.derived.s_bar_h, mk.sv);
-    let a = (req.vs + req.ve) / 2.0;
-    let b = -(req.x + d * (sh - sv));
-    let c = d * mk.dz_g;
-    if a == 0.0 {
-        // "Identically zero" (§6.4 (iv)) relative to the terms of b and the factors of c.
-        let b_tol = opts.match_tol * 1f64.max(req.x.abs()).max((d * (sh - sv)).abs());
-        let c_tol = opts.match_tol * 1f64.max(d.abs()).max(dz.abs());
-        if b.abs() > b_tol {
-            let t = -c / b;
-            return Ok((Roots::one(mk.at(t, beta_h)), Branch::Linear));
-        }
-        if c.abs() > c_tol {
-            return Err(Infeasible::NoRoot);
+    /// §6.4 (ii), no net horizontal impulse: `T` from `β_v,ref`, `β_h` from A4.
+    #[inline]
+    fn no_net_horizontal(&self) -> Result<(Roots, Branch), Infeasible> {
+        let (shape, req, refs, opts, mk) = (self.shape, self.req, self.refs, self.opts, self);
+        if !matches(req.ve, req.vs, opts.match_tol) {
+            return Err(Infeasible::NoNetHorizontalImpulse);
         }
         let t = refs.beta_v * shape.j[2] / GRAVITY;
-        return Ok((Roots::one(mk.at(t, beta_h)), Branch::FreePeriod));
-    }
-    let mut disc = b * b - 4.0 * a * c;
-    if disc < 0.0 {
-        if disc >= -opts.disc_rel_tol * (b * b + (4.0 * a * c).abs()) {
-            disc = 0.0;
-        } else {
-            return Err(Infeasible::NegativeDiscriminant);
+        if t <= 0.0 {
+            return Ok((Roots::one(sign_fail(t, mk.beta_p)), Branch::NoNetHorizontal));
         }
+        let mut c = mk.make_inv(t, 1.0 / t, 0.0);
+        let moment_scale = shape.dt * shape.j_scale[0];
+        let rest = req.ve * t - (req.ve - req.vs) * c.t_td;
+        let kh = shape.k[0];
+        c.beta[0] = if kh.abs() <= opts.eps_j * moment_scale {
+            if !matches(req.x, rest, opts.match_tol) {
+                return Err(Infeasible::NoNetHorizontalMoment);
+            }
+            refs.beta_h
+        } else {
+            (rest - req.x) / kh
+        };
+        Ok((Roots::one(c), Branch::NoNetHorizontal))
     }
-    if !disc.is_finite() {
-        return Err(Infeasible::NonFinite);
+
+    /// §6.2 `a T² + b T + c = 0` (and its degenerate forms of §6.4 (iv)), roots by the
+    /// stable formula `q = −(b + sign(b)·√disc)/2`, `T1 = q/a`, `T2 = c/q`.
+    #[inline]
+    fn quadratic(&self) -> Result<(Roots, Branch), Infeasible> {
+        let (shape, req, refs, opts, mk) = (self.shape, self.req, self.refs, self.opts, self);
+        let d = req.ve - req.vs;
+        let dz = req.ze - req.zs;
+        let beta_h = d * shape.derived.inv_j[0];
+        let (sh, sv) = (shape.derived.s_bar_h, mk.sv);
+        let a = (req.vs + req.ve) / 2.0;
+        let b = -(req.x + d * (sh - sv));
+        let c = d * mk.dz_g;
+        if a == 0.0 {
+            // "Identically zero" (§6.4 (iv)) relative to the terms of b and the factors of c.
+            let b_tol = opts.match_tol * 1f64.max(req.x.abs()).max((d * (sh - sv)).abs());
+            let c_tol = opts.match_tol * 1f64.max(d.abs()).max(dz.abs());
+            if b.abs() > b_tol {
+                let t = -c / b;
+                return Ok((Roots::one(mk.at(t, beta_h)), Branch::Linear));
+            }
+            if c.abs() > c_tol {
+                return Err(Infeasible::NoRoot);
+            }
+            let t = refs.beta_v * shape.j[2] / GRAVITY;
+            return Ok((Roots::one(mk.at(t, beta_h)), Branch::FreePeriod));
+        }
+        let mut disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            if disc >= -opts.disc_rel_tol * (b * b + (4.0 * a * c).abs()) {
+                disc = 0.0;
+            } else {
+                return Err(Infeasible::NegativeDiscriminant);
+            }
+        }
+        if !disc.is_finite() {
+            return Err(Infeasible::NonFinite);
+        }
+        let q = -0.5 * (b + b.signum() * disc.sqrt());
+        let roots = if q == 0.0 {
+            Roots::one(mk.at(0.0, beta_h)) // b = 0 and disc = 0 ⇒ c = 0: the double root T = 0
+        } else if disc == 0.0 {
+            Roots::one(mk.at(q / a, beta_h))
+        } else {
+            // T1 = q/a, T2 = c/q: with 1/q, 1/T1 = a/q and T2 need no division of their own.
+            let inv_q = 1.0 / q;
+            Roots::two(
+                mk.at_inv(q / a, a * inv_q, beta_h),
+                mk.at(c * inv_q, beta_h),
+            )
+        };
+        Ok((roots, Branch::Quadratic))
     }
-    let q = -0.5 * (b + b.signum() * disc.sqrt());
-    let roots = if q == 0.0 {
-        Roots::one(mk.at(0.0, beta_h)) // b = 0 and disc = 0 ⇒ c = 0: the double root T = 0
-    } else if disc == 0.0 {
-        Roots::one(mk.at(q / a, beta_h))
-    } else {
-        // T1 = q/a, T2 = c/q: with 1/q, 1/T1 = a/q and T2 need no division of their own.
-        let inv_q = 1.0 / q;
-        Roots::two(
-            mk.at_inv(q / a, a * inv_q, beta_h),
-            mk.at(c * inv_q, beta_h),
-        )
-    };
-    Ok((roots, Branch::Quadratic))
 }
 
 /// A placeholder candidate for `T ≤ 0` (no `t_TD` exists); it fails rule 1.
