@@ -18,7 +18,7 @@ use crate::math::savgol::{SavGol, DEFAULT_ORDER};
 use crate::math::spline::NaturalSpline;
 use crate::math::stats::median;
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// Options of the stance stage.
 #[derive(serde::Serialize, Debug, Clone, PartialEq, Default)]

@@ -21,7 +21,7 @@ use crate::math::constants::GRAVITY;
 /// Below this horizontal touchdown speed the heading comes from the hips, m/s.
 pub const V_MIN_HEADING: f64 = 0.2;
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// Where a stance's heading came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
