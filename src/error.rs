@@ -76,6 +76,16 @@ pub enum ErrorKind {
         /// The step and what failed.
         msg: String,
     },
+    /// An iterative numerical step stopped at its iteration cap before it converged.
+    #[error("{step}: not converged after {iterations} iterations (residual {residual:e})")]
+    NotConverged {
+        /// The step (`static region`, `COM placement`, …).
+        step: String,
+        /// Iterations done.
+        iterations: usize,
+        /// The residual left (in the step's own unit; NaN when it has none).
+        residual: f64,
+    },
     /// The Savitzky–Golay smoothing filter of a clip cannot be built (for example a frame
     /// time so short that the window exceeds `math::savgol::MAX_SAVGOL_WINDOW`).
     #[error("smoothing window of {window} frames{}: {msg}", frame_time_s.map(|dt| format!(" ({:.6} s at frame time {dt} s)", dt * *window as f64)).unwrap_or_default())]
@@ -140,6 +150,16 @@ impl Error {
         Error {
             kind: ErrorKind::Numeric { msg: msg.into() },
         }
+    }
+
+    /// An iterative step that did not converge (see [`ErrorKind::NotConverged`]).
+    pub fn not_converged(step: impl Into<String>, iterations: usize, residual: f64) -> Self {
+        ErrorKind::NotConverged {
+            step: step.into(),
+            iterations,
+            residual,
+        }
+        .into()
     }
 
     /// A BVH error at a line, without a path yet (see [`Error::with_path`]).

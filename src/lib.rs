@@ -3,9 +3,28 @@
 //! Turns motion-capture clips (BVH) into a physically grounded stance library.
 //!
 //! ## Stages
+//! The whole crate, data left to right; `math` (constants, 3-vectors, SG, fits) serves
+//! every stage, and only `bvh`, `library`, `pipeline` and `cli` touch files.
 //! ```text
-//! bvh (parse) → skeleton (model, FK, landmarks, units, COM) → contacts (floors, flags,
-//! flights) → ingest (one clip, pure) → library (Parquet tables) ← cli / pipeline (I/O)
+//!            ┌──────────────────────────── ingest (one clip, pure) ─────────────────────────┐
+//! BVH ─ bvh ─┤ skeleton (model, landmarks, units, FK, COM)                                  │
+//!   (parse)  │   → contacts::tracks → contacts::detect → contacts::runs_and_flights          │
+//!            └─ ClipFrames, ClipSummary (flights), ContactRun ──────────────────────────────┘
+//!                 │
+//!                 ├─ stances path:  stances (segment, build_clip)
+//!                 │                   → force_model (fit per stance) → constraints (coefficients)
+//!                 │                   → library (stances.parquet, frames, contacts, clips, errors)
+//!                 │                   → query (solve, feasibility, run, jump, map)
+//!                 │                   → edit (plan, COM path, pose) → bvh::write   (edited clip)
+//!                 │
+//!                 └─ twopac path:   kinematics (polytopes from contact samples) → library
+//!                                     (kinematics.parquet); twopac::clip (phases from a clip's
+//!                                     contact runs) or a phases JSON → twopac (contacts,
+//!                                     static region, transitions, trajectory, validation)
+//!
+//! pipeline (batch ingest in parallel, streaming build, shards, merge) and cli (commands)
+//! drive the stages and write the tables; plot draws PNGs of their results; synth makes
+//! clips with known truth for the tests.
 //! ```
 //!
 //! The method of each stage (equations, units, the papers' numbering and where the tool

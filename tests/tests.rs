@@ -69,6 +69,8 @@
 //! # Structure (issue 13)
 //! - `structure_edges`: enumerated options parsed (any case) and refused before work;
 //!   outputs of every kind leave no temporary behind.
+//! - `structure_stages`: items 1, 4 — the contact stage's entry points give the ingest's
+//!   contacts; batch ingest errors keep their kind.
 //!
 //! # Regressions and helpers
 //! - `regression`: one test per review finding, named after it.
@@ -114,6 +116,7 @@ mod safety_options;
 mod safety_outputs;
 // Structure (issue 13)
 mod structure_edges;
+mod structure_stages;
 // Regressions and helpers
 mod regression;
 mod util;

@@ -44,6 +44,7 @@
 use super::tables::dc_term;
 use super::StanceContext;
 use crate::force_model::{basis, ForceModel, GRAVITY};
+pub(crate) use crate::math::v3::cross;
 use std::f64::consts::TAU;
 
 /// One cosine term of an axis: `Ω`, amplitude (N), `cos φ`, `sin φ`.
@@ -214,13 +215,4 @@ pub fn angular_impulse(model: &ForceModel, ctx: &StanceContext) -> ([f64; 3], [f
 pub fn contact_point_matrix(impulse: [f64; 3]) -> [[f64; 2]; 3] {
     let [ih, ip, iv] = impulse;
     [[0.0, iv], [-iv, 0.0], [ip, -ih]]
-}
-
-/// `a × b` in the stance frame.
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }

@@ -23,11 +23,12 @@
 //! # References
 //! spec com-from-bvh §7.7.
 
+use super::contact_runs::ContactRun;
+use super::{runs, ClipMotion};
 use crate::math::polyfit::{fit, fit_fixed_curvature, Poly};
 use crate::math::stats::median;
 
-/// Gravity magnitude, m/s².
-pub const G: f64 = 9.81;
+pub use crate::math::constants::GRAVITY as G;
 /// Longest flight, s.
 pub const T_FLIGHT_MAX_S: f64 = 1.0;
 /// Shortest airborne interval, s.
@@ -202,6 +203,43 @@ pub fn curvature_inside(
     let tk: Vec<f64> = ks.iter().map(|&k| t[k]).collect();
     let zk: Vec<f64> = ks.iter().map(|&k| c[k][2]).collect();
     fit(&tk, &zk, 2).map(|p| p.curvature())
+}
+
+/// Flights (§7.7) of the clip's no-contact runs not at a clip edge (no effector in
+/// `contact` on any frame of the run), each with the curvature between the sub-frame
+/// liftoff and touchdown that bound it (from the contact runs `runs_out`, when both are
+/// known).
+pub fn flights(
+    contact: &[Vec<bool>; 4],
+    runs_out: &[ContactRun],
+    motion: &ClipMotion,
+) -> Vec<Flight> {
+    let (com, time_s, frame) = (motion.com, motion.time_s, motion.frame);
+    let n = frame.len();
+    let none: Vec<bool> = (0..n).map(|f| !contact.iter().any(|c| c[f])).collect();
+    runs(&none)
+        .into_iter()
+        .filter(|&(a, b)| a > 0 && b + 1 < n)
+        .map(|(a, b)| {
+            let mut f = fit_run(com, time_s, motion.com_vz, a, b, motion.dt, frame[0]);
+            let lo = runs_out
+                .iter()
+                .filter(|r| r.last_frame == frame[a - 1])
+                .filter_map(|r| r.lo_time_s)
+                .reduce(f64::max);
+            let td = runs_out
+                .iter()
+                .filter(|r| r.first_frame == frame[b + 1])
+                .filter_map(|r| r.td_time_s)
+                .reduce(f64::min);
+            if let (Some(lo), Some(td)) = (lo, td) {
+                f.a_z_all = curvature_inside(com, time_s, a, b, Some((lo, td))).or(f.a_z_all);
+                f.events_duration_s = Some(td - lo);
+                f.events_s = Some((lo, td));
+            }
+            f
+        })
+        .collect()
 }
 
 /// Clip summary: (median s_eff, median a_z) over airborne runs with a_z < 0.

@@ -1,17 +1,93 @@
 //! Contact detection: local floors, per-effector hysteresis with minimum durations, the
 //! optional static (elevated) contact mode, and the flight fits of the airborne runs.
 //!
+//! # Model
+//! ```text
+//! EffectorPoints ─ tracks ─▶ ContactTracks ─ detect ─▶ ContactTimeline
+//!     ─ runs_and_flights ─▶ contact runs (contact_runs::collect, sub-frame events: timing)
+//!                           physics cross-check (support::cross_check, speed-led rule)
+//!                           flights of the no-contact runs (flights, §7.7)
+//! ```
 //! Data flow: contact-point trajectories (metres, Z up) → [`floor`] heights →
-//! [`detect`] flags per effector → [`flight`] diagnostics of the no-contact runs.
+//! [`mod@detect`] flags per effector → [`flight`] diagnostics of the no-contact runs.
+//!
+//! # References
+//! spec com-from-bvh §7, §8.
 
+pub mod contact_runs;
 pub mod detect;
 pub mod flight;
 pub mod floor;
 pub mod options;
 pub mod support;
+pub mod timeline;
 pub mod timing;
 
+pub use contact_runs::ContactRun;
+pub use flight::{flights, Flight};
 pub use options::ContactOptions;
+pub use timeline::{detect, tracks, ContactTimeline, ContactTracks, EffectorPoints};
+
+use crate::math::v3::V3;
+
+/// The clip's clock and COM, by which contact runs are timed and flights fitted (one entry
+/// per kept frame).
+#[derive(Debug, Clone, Copy)]
+pub struct ClipMotion<'a> {
+    /// File row per kept frame (consecutive).
+    pub frame: &'a [i64],
+    /// `frame · dt`, s.
+    pub time_s: &'a [f64],
+    /// Frame time, s.
+    pub dt: f64,
+    /// Raw whole-body COM, m.
+    pub com: &'a [V3],
+    /// SG vertical COM velocity, m/s.
+    pub com_vz: &'a [f64],
+    /// Horizontal facing direction from the hips (unit, or zero).
+    pub facing: &'a [V3],
+}
+
+/// What the contact stage finds in a clip's timeline.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactEvents {
+    /// Contact runs (sorted by effector, then first frame).
+    pub runs: Vec<ContactRun>,
+    /// Flights of the no-contact runs not at a clip edge.
+    pub flights: Vec<Flight>,
+    /// Clip warnings of the physics cross-check.
+    pub warnings: Vec<String>,
+}
+
+/// Contact runs and flights of a detected timeline; with `opts.support_check`, the physics
+/// cross-check first ([`support::cross_check`]: it may add speed-led frames to `timeline`),
+/// and a warning for every missed support it could not resolve.
+pub fn runs_and_flights(
+    tracks: &ContactTracks,
+    timeline: &mut ContactTimeline,
+    motion: &ClipMotion,
+    opts: &ContactOptions,
+) -> ContactEvents {
+    let mut runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
+    let mut warnings = Vec::new();
+    if opts.support_check {
+        warnings = support::cross_check(tracks, timeline, motion, opts, &mut runs_out);
+    }
+    let flights = flight::flights(&timeline.contact, &runs_out, motion);
+    if opts.support_check {
+        for f in flights.iter().filter(|f| support::is_missed_support(f)) {
+            warnings.push(support::missed_support_warning(
+                f,
+                "no support found (no foot or hand slow enough)",
+            ));
+        }
+    }
+    ContactEvents {
+        runs: runs_out,
+        flights,
+        warnings,
+    }
+}
 
 /// Support effectors, in output order.
 pub const EFFECTORS: [&str; 4] = ["left_foot", "right_foot", "left_hand", "right_hand"];

@@ -36,8 +36,12 @@
 //! spec com-from-bvh §7.3, §7.4 (the static mode, off by default, is the whole-clip
 //! relative of this rule), §7.7.
 
+use super::contact_runs::{self, ContactRun};
 use super::detect::{clean, hysteresis_by, PointTrack};
-use super::flight::{Flight, AIRBORNE_MIN_S, AIRBORNE_TOL_S, G};
+use super::flight::{flights, Flight, AIRBORNE_MIN_S, AIRBORNE_TOL_S, G};
+use super::options::ContactOptions;
+use super::timeline::{ContactTimeline, ContactTracks};
+use super::{runs, ClipMotion, EFFECTORS};
 
 /// A no-contact interval whose fitted vertical COM curvature lies further than this from
 /// −g is not a flight but a missed support, m/s².
@@ -100,6 +104,81 @@ pub fn speed_led(
     let mut flags = hysteresis_by(&sub, |p, k| p.v[k] <= rule.v_on, |p, k| p.v[k] > rule.v_off);
     clean(&mut flags, rate_hz, min_gap_s, rule.min_on_s);
     flags
+}
+
+/// The physics cross-check of a clip's contacts (see the module docs): each missed-support
+/// flight of `timeline` gets the speed-led frames of every support effector inside it
+/// (OR-ed into `contact`, marked in `speed_led`); when any were found the flags are
+/// cleaned again and `runs_out` collected again. Returns one clip warning per missed
+/// support that the rule resolved.
+pub fn cross_check(
+    tracks: &ContactTracks,
+    timeline: &mut ContactTimeline,
+    motion: &ClipMotion,
+    opts: &ContactOptions,
+    runs_out: &mut Vec<ContactRun>,
+) -> Vec<String> {
+    let rule = SpeedLedRule::default();
+    let rate = 1.0 / tracks.dt;
+    let skip = motion.frame[0];
+    let mut warnings = Vec::new();
+    let mut changed = false;
+    for f in flights(&timeline.contact, runs_out, motion) {
+        if !is_missed_support(&f) {
+            continue;
+        }
+        let (a, b) = (
+            (f.first_frame - skip) as usize,
+            (f.last_frame - skip) as usize,
+        );
+        let mut found = Vec::new();
+        for (e, track) in tracks.tracks.iter().enumerate() {
+            if track.is_empty() {
+                continue;
+            }
+            let sl = speed_led(track, a, b, &rule, rate, opts.min_gap_s);
+            for (x, y) in runs(&sl) {
+                timeline.contact[e][a + x..=a + y]
+                    .iter_mut()
+                    .for_each(|v| *v = true);
+                timeline.speed_led[e][a + x..=a + y]
+                    .iter_mut()
+                    .for_each(|v| *v = true);
+                found.push(format!(
+                    "{} {}-{}",
+                    EFFECTORS[e],
+                    skip + (a + x) as i64,
+                    skip + (a + y) as i64
+                ));
+                changed = true;
+            }
+        }
+        if !found.is_empty() {
+            warnings.push(missed_support_warning(
+                &f,
+                &format!("speed-led contacts: {}", found.join(", ")),
+            ));
+        }
+    }
+    if changed {
+        for flags in timeline.contact.iter_mut() {
+            clean(flags, rate, opts.min_gap_s, opts.min_on_s);
+        }
+        *runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
+    }
+    warnings
+}
+
+/// The clip warning for a no-contact interval whose COM is not ballistic; `outcome` says
+/// what the speed-led rule found.
+pub fn missed_support_warning(f: &Flight, outcome: &str) -> String {
+    format!(
+        "missed support: no contact over frames {}-{} ({:.3} s) but the COM curves at {:+.2} m/s², not -g; {outcome}",
+        f.first_frame,
+        f.last_frame,
+        f.events_duration_s.unwrap_or(f.duration_s),
+        f.a_z_all.unwrap_or(f64::NAN),
+    )
 }
 
 #[cfg(test)]

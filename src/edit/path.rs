@@ -21,7 +21,7 @@
 
 use crate::force_model::{ForceModel, GRAVITY};
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// One stance of the plan, solved and placed in the world.
 #[derive(Debug, Clone, PartialEq)]

@@ -24,7 +24,7 @@ use crate::query::pool::{PoolStance, Prepared};
 use crate::query::run::{scale_and_check, ScaledStance};
 use crate::query::solve::Request;
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// Where a source stance sits in its clip (from `stances.parquet`).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -32,27 +32,7 @@ use crate::error::{Error, Result};
 use crate::ingest::body::BodyModel;
 use crate::skeleton::fk::local_translation;
 
-type V3 = [f64; 3];
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
+use crate::math::v3::{add, cross, dot, norm, sub, V3};
 
 /// What the pose stage needs of each planned stance's source stance.
 #[derive(Debug, Clone, PartialEq)]
@@ -491,6 +471,116 @@ fn foot_goal(
     }
 }
 
+/// Step 1 of [`pose_frame`]: the reference pose of output time `t` into `ws.pose` (the
+/// source stance's pose at the same fraction of its contact, or in a flight the source
+/// flight edges' poses, blended across a flight between two stances) and the yaw that
+/// turns it onto the planned heading. Returns the yaw and the stance `t` lies in.
+fn reference_pose(
+    r: &Reference,
+    path: &ComPath,
+    src: &[StanceSource],
+    t: f64,
+    ws: &mut PoseWorkspace,
+) -> (f64, Option<usize>) {
+    let st = &path.stances;
+    let src_of = |k: usize| &src[st[k].source];
+    let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src_of(k).heading_rad);
+    let (before, after) = match path.phase(t) {
+        Phase::Stance(k) => {
+            let (td, lo) = st[k].contact_window();
+            let s = src_of(k);
+            let u = if lo > td { (t - td) / (lo - td) } else { 0.0 };
+            r.sample(s.td_clip_s + u * (s.lo_clip_s - s.td_clip_s), &mut ws.pose);
+            return (yaw_of(k), Some(k));
+        }
+        Phase::Flight { before, after } => (before, after),
+    };
+    let side_a = before.map(|b| {
+        let (_, lo) = st[b].contact_window();
+        let e_new = st[b].end() - lo;
+        let s = src_of(b);
+        let rate = if e_new > 0.0 { s.after_s / e_new } else { 1.0 };
+        (lo, s.lo_clip_s + (t - lo) * rate)
+    });
+    let side_b = after.map(|a| {
+        let (td, _) = st[a].contact_window();
+        let b_new = td - st[a].t0;
+        let s = src_of(a);
+        let rate = if b_new > 0.0 { s.before_s / b_new } else { 1.0 };
+        (td, s.td_clip_s - (td - t) * rate)
+    });
+    match (side_a, side_b, before, after) {
+        (Some((lo, ta)), Some((td, tb)), Some(b), Some(a)) => {
+            let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
+            let (ya, yb) = (yaw_of(b), yaw_of(a));
+            r.sample(tb, &mut ws.pose);
+            std::mem::swap(&mut ws.pose, &mut ws.other);
+            r.sample(ta, &mut ws.pose);
+            for (qa, qb) in ws.pose.q.iter_mut().zip(&ws.other.q) {
+                *qa = rot::slerp(*qa, *qb, w);
+            }
+            for (va, vb) in ws.pose.row.iter_mut().zip(&ws.other.row) {
+                *va += w * (vb - *va);
+            }
+            (ya + w * wrap_pi(yb - ya), None)
+        }
+        (Some((_, ta)), _, Some(b), _) => {
+            r.sample(ta, &mut ws.pose);
+            (yaw_of(b), None)
+        }
+        (_, Some((_, tb)), _, Some(a)) => {
+            r.sample(tb, &mut ws.pose);
+            (yaw_of(a), None)
+        }
+        _ => {
+            r.sample(0.0, &mut ws.pose);
+            (0.0, None)
+        }
+    }
+}
+
+/// One IK pass of the feet (step 2 of [`pose_frame`]): each pulled ankle goes part way
+/// (`w`) from where FK puts it towards its goal, by two-bone IK and the goal orientation;
+/// `ws` is left with FK of the result. Returns the largest distance of a planted (support)
+/// foot from its goal, m.
+fn place_feet(
+    r: &Reference,
+    ws: &mut PoseWorkspace,
+    pulls: &[Option<(V3, Quat, f64)>; 2],
+    planted: [bool; 2],
+    max_reach: f64,
+) -> f64 {
+    let body = &r.body;
+    let goal: [Option<(V3, Quat)>; 2] = std::array::from_fn(|side| {
+        pulls[side].map(|(p, q, w)| {
+            let ankle = r.legs[side][2];
+            let (fp, fq) = (ws.file[ankle], ws.world_q[ankle]);
+            let pos = std::array::from_fn(|i| fp[i] + w * (p[i] - fp[i]));
+            (pos, rot::slerp(fq, q, w))
+        })
+    });
+    for (side, g) in goal.iter().enumerate() {
+        if let Some((p, _)) = *g {
+            two_bone(r, ws, side, p, max_reach);
+            forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+        }
+    }
+    for (side, g) in goal.iter().enumerate() {
+        if let Some((_, o)) = *g {
+            let ankle = r.legs[side][2];
+            let parent = body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
+            ws.pose.q[ankle] = rot::normalize(rot::mul(rot::conj(parent), o));
+        }
+    }
+    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+    // Support feet only: a swing foot may be out of reach and is not planted.
+    (0..2)
+        .filter(|&side| planted[side])
+        .filter_map(|side| goal[side].map(|(p, _)| norm(sub(ws.file[r.legs[side][2]], p))))
+        .fold(0.0, f64::max)
+        * body.unit_m
+}
+
 /// Poses one output time into `ws.pose`; returns the frame's outcome.
 pub fn pose_frame(
     r: &Reference,
@@ -503,61 +593,8 @@ pub fn pose_frame(
     let phase = path.phase(t);
     let st = &path.stances;
     let src_of = |k: usize| &src[st[k].source];
-    let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src_of(k).heading_rad);
     // 1. Reference pose, foot anchors and yaw.
-    let (yaw, stance) = match phase {
-        Phase::Stance(k) => {
-            let (td, lo) = st[k].contact_window();
-            let s = src_of(k);
-            let u = if lo > td { (t - td) / (lo - td) } else { 0.0 };
-            r.sample(s.td_clip_s + u * (s.lo_clip_s - s.td_clip_s), &mut ws.pose);
-            (yaw_of(k), Some(k))
-        }
-        Phase::Flight { before, after } => {
-            let side_a = before.map(|b| {
-                let (_, lo) = st[b].contact_window();
-                let e_new = st[b].end() - lo;
-                let s = src_of(b);
-                let rate = if e_new > 0.0 { s.after_s / e_new } else { 1.0 };
-                (lo, s.lo_clip_s + (t - lo) * rate)
-            });
-            let side_b = after.map(|a| {
-                let (td, _) = st[a].contact_window();
-                let b_new = td - st[a].t0;
-                let s = src_of(a);
-                let rate = if b_new > 0.0 { s.before_s / b_new } else { 1.0 };
-                (td, s.td_clip_s - (td - t) * rate)
-            });
-            match (side_a, side_b, before, after) {
-                (Some((lo, ta)), Some((td, tb)), Some(b), Some(a)) => {
-                    let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
-                    let (ya, yb) = (yaw_of(b), yaw_of(a));
-                    r.sample(tb, &mut ws.pose);
-                    std::mem::swap(&mut ws.pose, &mut ws.other);
-                    r.sample(ta, &mut ws.pose);
-                    for (qa, qb) in ws.pose.q.iter_mut().zip(&ws.other.q) {
-                        *qa = rot::slerp(*qa, *qb, w);
-                    }
-                    for (va, vb) in ws.pose.row.iter_mut().zip(&ws.other.row) {
-                        *va += w * (vb - *va);
-                    }
-                    (ya + w * wrap_pi(yb - ya), None)
-                }
-                (Some((_, ta)), _, Some(b), _) => {
-                    r.sample(ta, &mut ws.pose);
-                    (yaw_of(b), None)
-                }
-                (_, Some((_, tb)), _, Some(a)) => {
-                    r.sample(tb, &mut ws.pose);
-                    (yaw_of(a), None)
-                }
-                _ => {
-                    r.sample(0.0, &mut ws.pose);
-                    (0.0, None)
-                }
-            }
-        }
-    };
+    let (yaw, stance) = reference_pose(r, path, src, t, ws);
     let body = &r.body;
     let q_yaw = rot::axis_angle(up_file(body), yaw);
     let (com_plan, _) = path.com(t);
@@ -570,42 +607,13 @@ pub fn pose_frame(
     let (mut err_m, mut foot_err) = (f64::INFINITY, 0.0);
     let mut com_pose = [0.0; 3];
     let pulls: [Option<(V3, Quat, f64)>; 2] = [0, 1].map(|side| foot_goal(r, path, src, t, side));
-    let mut goal: [Option<(V3, Quat)>; 2] = [None; 2];
+    let planted = [0, 1].map(|side| stance.is_some_and(|k| src_of(k).feet[side]));
     while iterations < opts.max_iterations {
         iterations += 1;
         ws.pose.q.copy_from_slice(&ws.free_q);
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
         if pulls.iter().any(Option::is_some) {
-            for (side, g) in goal.iter_mut().enumerate() {
-                *g = pulls[side].map(|(p, q, w)| {
-                    let ankle = r.legs[side][2];
-                    let (fp, fq) = (ws.file[ankle], ws.world_q[ankle]);
-                    let pos = std::array::from_fn(|i| fp[i] + w * (p[i] - fp[i]));
-                    (pos, rot::slerp(fq, q, w))
-                });
-            }
-            for (side, g) in goal.iter().enumerate() {
-                if let Some((p, _)) = *g {
-                    two_bone(r, ws, side, p, opts.max_reach);
-                    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-                }
-            }
-            for (side, g) in goal.iter().enumerate() {
-                if let Some((_, o)) = *g {
-                    let ankle = r.legs[side][2];
-                    let parent =
-                        body.skeleton.parents[ankle].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
-                    ws.pose.q[ankle] = rot::normalize(rot::mul(rot::conj(parent), o));
-                }
-            }
-            forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-            // Support feet only: a swing foot may be out of reach and is not planted.
-            let planted = |side: usize| stance.is_some_and(|k| src_of(k).feet[side]);
-            foot_err = (0..2)
-                .filter(|&side| planted(side))
-                .filter_map(|side| goal[side].map(|(p, _)| norm(sub(ws.file[r.legs[side][2]], p))))
-                .fold(0.0, f64::max)
-                * body.unit_m;
+            foot_err = place_feet(r, ws, &pulls, planted, opts.max_reach);
         }
         com_pose = body.com(&ws.pts);
         let e = sub(com_plan, com_pose);

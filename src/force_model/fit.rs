@@ -110,20 +110,15 @@ pub fn k_max(samples: usize, n_st: usize) -> u32 {
 
 fn check_options(opts: &FitOptions) -> Result<()> {
     if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&opts.samples) {
-        return Err(Error::config(
-            None,
-            None,
-            format!(
-                "fit.samples = {} is not in [{MIN_SAMPLES}, {MAX_SAMPLES}]",
-                opts.samples
-            ),
+        return Err(Error::invalid(
+            "fit.samples",
+            format!("{} is not in [{MIN_SAMPLES}, {MAX_SAMPLES}]", opts.samples),
         ));
     }
     if !(0.0..=1.0).contains(&opts.energy) {
-        return Err(Error::config(
-            None,
-            None,
-            format!("fit.energy = {} is not in [0, 1]", opts.energy),
+        return Err(Error::invalid(
+            "fit.energy",
+            format!("{} is not in [0, 1]", opts.energy),
         ));
     }
     Ok(())
@@ -237,9 +232,10 @@ impl StanceForce<'_> {
     /// Checks `Δt > 0`, `m > 0` and finite `t_TD`, `R_s`; `step` prefixes the message.
     ///
     /// # Errors
-    /// A config error saying which value is bad.
+    /// [`crate::ErrorKind::Numeric`] saying which value is bad (they are computed upstream:
+    /// the stance times, the heading, the body mass carried through).
     pub fn check(&self, step: &str) -> Result<()> {
-        let bad = |what: String| Err(Error::config(None, None, format!("{step}: {what}")));
+        let bad = |what: String| Err(Error::numeric(format!("{step}: {what}")));
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return bad(format!("stance duration {} s is not positive", self.dt));
         }
@@ -286,9 +282,9 @@ impl StanceForce<'_> {
 /// * `n_st`: number of stance frames (sets `j_cap`; below 5 frames `j_cap = 1`).
 ///
 /// # Errors
-/// [`crate::ErrorKind::Config`] when `dt` or `mass_kg` is not finite and positive, `t_td`
-/// or an entry of `r_s` is not finite, `opts.samples ∉ [2, 2²⁰]`, `opts.energy ∉ [0, 1]`, or a
-/// sampled force is not finite. Nothing else fails; `max_harmonics = 0` keeps only `c0`.
+/// [`crate::ErrorKind::Numeric`] when `dt` or `mass_kg` is not finite and positive, `t_td`
+/// or an entry of `r_s` is not finite, or a sampled force is not finite;
+/// [`crate::ErrorKind::Invalid`] when `opts.samples ∉ [2, 2²⁰]` or `opts.energy ∉ [0, 1]`. Nothing else fails; `max_harmonics = 0` keeps only `c0`.
 #[allow(clippy::too_many_arguments)]
 pub fn fit_stage_a(
     ws: &mut FitWorkspace,
@@ -300,7 +296,7 @@ pub fn fit_stage_a(
     n_st: usize,
     opts: &FitOptions,
 ) -> Result<ForceModel> {
-    let bad = |what: String| Err(Error::config(None, None, format!("stage a: {what}")));
+    let bad = |what: String| Err(Error::numeric(format!("stage a: {what}")));
     check_options(opts)?;
     let stance = StanceForce {
         acc,

@@ -51,8 +51,7 @@ pub use fit::{fit_axis, fit_stage_a, j_cap, k_max, FitWorkspace, StanceForce};
 pub use model::{AxisModel, ForceModel};
 pub use ratio::{fit_ratio, EdgeTargets, RatioFit, RatioOptions};
 
-/// Gravity magnitude `g` (m/s²); the gravity vector is `g⃗ = (0, 0, −g)` (spec preamble).
-pub const GRAVITY: f64 = 9.81;
+pub use crate::math::constants::GRAVITY;
 /// Default number of samples `N` per stance (spec §4.1 step 3).
 pub const DEFAULT_SAMPLES: usize = 64;
 /// Default cap `K_max` on the harmonics kept per axis (spec §4.1 step 5).

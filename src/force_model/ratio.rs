@@ -342,7 +342,9 @@ fn ratio_fit(
             return r;
         }
     }
-    let svd = x.svd(true, true);
+    let Some(svd) = crate::math::svd::svd(x, true, true) else {
+        return vec![0.0; deg + 1];
+    };
     let cut = RATIO_SVD_EPS * svd.singular_values.max();
     match svd.solve(&DVector::from_column_slice(s), cut) {
         Ok(r) if r.iter().all(|v| v.is_finite()) => r.iter().copied().collect(),

@@ -15,7 +15,7 @@
 
 use std::collections::BTreeMap;
 
-use super::kinematics::{choose_toe, facing, fk_frames, side_points, toe_tip};
+use super::points::{choose_toe, facing, fk_frames, side_points, toe_tip};
 use crate::bvh::Bvh;
 use crate::error::{Error, Result};
 use crate::skeleton::com::{com, BodyPoints, Sex};
@@ -24,7 +24,7 @@ use crate::skeleton::names::Side;
 use crate::skeleton::units::UpAxis;
 use crate::skeleton::{fk, leadin, Skeleton};
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// One clip's body, frozen for posing (see the module docs).
 #[derive(Debug, Clone)]

@@ -2,18 +2,22 @@
 //!
 //! # Model
 //! ```text
-//! Bvh → Skeleton → landmarks → lead-in → FK (file frame) → unit, up axis → points (m, Z up)
-//!     → toe tips → COM (de Leva) → SG velocity/acceleration → local floor → contacts
-//!     → flights (§7.7) → contact runs (§8)
+//! Bvh → Skeleton → landmarks → lead-in                                  (ingest)
+//!     → points::clip_points: FK (file frame) → unit, up axis → points (m, Z up)
+//!     → points::toe_tips → COM (de Leva) → SG velocity/acceleration      (clip::run)
+//!     → contacts::tracks (local floor) → contacts::detect (timeline)
+//!     → contacts::runs_and_flights: contact runs (§8), cross-check, flights (§7.7)
 //! ```
-//! Pure: no I/O. The batch layer (`library`, `cli`) reads files and writes tables.
+//! `clip` is that sequence of stage calls; `points` holds the FK, unit, up-axis and toe-tip
+//! steps that [`body::BodyModel`] shares. Pure: no I/O. The batch layer (`library`, `cli`)
+//! reads files and writes tables.
 //!
 //! # References
 //! spec com-from-bvh §1–§8.
 
 pub mod body;
-mod contact_runs;
-mod kinematics;
+mod clip;
+mod points;
 
 use std::collections::BTreeMap;
 
@@ -26,7 +30,7 @@ use crate::skeleton::landmarks::{self, Mapping};
 use crate::skeleton::units::UpAxis;
 use crate::skeleton::{fk, leadin, Skeleton};
 
-pub use contact_runs::ContactRun;
+pub use crate::contacts::ContactRun;
 
 /// Default body mass, kg (spec com-from-bvh §5).
 pub const DEFAULT_MASS_KG: f64 = 70.0;
@@ -200,7 +204,15 @@ pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
         );
         return Ok(ClipOutcome::Skipped { summary, reason });
     }
-    let (frames, contacts) = kinematics::run(&skel, &lm, &rest, bvh, skip, opts, &mut summary)?;
+    let src = points::ClipSource {
+        skel: &skel,
+        lm: &lm,
+        rest_file: &rest,
+        bvh,
+        skip,
+        opts,
+    };
+    let (frames, contacts) = clip::run(&src, &mut summary)?;
     Ok(ClipOutcome::Body {
         summary,
         frames,

@@ -51,7 +51,7 @@ pub fn fit(t: &[f64], y: &[f64], deg: usize) -> Option<Poly> {
     let t_mean = t.iter().sum::<f64>() / t.len() as f64;
     let a = DMatrix::from_fn(t.len(), deg + 1, |r, k| (t[r] - t_mean).powi(k as i32));
     let b = DVector::from_column_slice(y);
-    let sol = a.svd(true, true).solve(&b, 1e-12).ok()?;
+    let sol = super::svd::svd(a, true, true)?.solve(&b, 1e-12).ok()?;
     Some(Poly {
         coef: sol.iter().copied().collect(),
         t_mean,

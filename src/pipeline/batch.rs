@@ -67,20 +67,16 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
         return input_error(rec, path, &InputProblem::TooLarge { bytes: rdr.bytes });
     }
     rec.content_sha256 = hex(&rdr.hasher.finalize());
+    // The ingest error keeps its kind; the record's message names the file before it.
     let outcome = match parsed {
-        Err(e) => Err(("parse", e)),
-        Ok(b) => ingest(&b, opts).map_err(|e| {
-            let stage = if matches!(e.kind, ErrorKind::Skeleton { .. }) {
-                "mapping"
-            } else {
-                "frames"
-            };
-            (stage, Error::skeleton(format!("{}: {e}", path.display())))
-        }),
+        Err(e) => Err(("parse", e.to_string())),
+        Ok(b) => {
+            ingest(&b, opts).map_err(|e| (ingest_stage(&e), format!("{}: {e}", path.display())))
+        }
     };
     match outcome {
-        Err((stage, e)) => {
-            rec.message = Some(e.to_string());
+        Err((stage, message)) => {
+            rec.message = Some(message);
             rec.error_stage = Some(stage);
         }
         Ok(ClipOutcome::Skipped { summary, reason }) => {
@@ -100,6 +96,16 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
         }
     }
     rec
+}
+
+/// The `errors.parquet` stage of an ingest error: `mapping` for a skeleton that maps onto
+/// no body, `frames` for a failure in the per-frame stages.
+fn ingest_stage(e: &Error) -> &'static str {
+    if matches!(e.kind, ErrorKind::Skeleton { .. }) {
+        "mapping"
+    } else {
+        "frames"
+    }
 }
 
 /// `rec` as an error of the `input` stage: the path could not be read as a BVH file.

@@ -494,18 +494,12 @@ pub fn candidates(
     if !(shape.derived.valid && inputs.iter().sum::<f64>().is_finite()) {
         return Err(Infeasible::InvalidInput);
     }
-    let g = GRAVITY;
     let jv = shape.j[2];
-    let kh = shape.k[0];
-    let [inv_jh, inv_jp, inv_jv] = shape.derived.inv_j;
     let near_zero = |a: usize| shape.j[a].abs() <= opts.eps_j * shape.j_scale[a];
     // (i) support.
     if jv <= 0.0 || near_zero(2) {
         return Err(Infeasible::NoSupport);
     }
-    let sv = shape.derived.s_bar_v;
-    let d = req.ve - req.vs;
-    let dz = req.ze - req.zs;
     // (iii) perpendicular.
     let beta_p = if near_zero(1) {
         if !matches(req.vp, req.vps, opts.match_tol) {
@@ -513,36 +507,90 @@ pub fn candidates(
         }
         refs.beta_p
     } else {
-        (req.vp - req.vps) * inv_jp
+        (req.vp - req.vps) * shape.derived.inv_j[1]
     };
-    // t_TD, u, w and the candidate for one T > 0.
-    // `inv_t` = 1/T, passed in when a root gives it without a division.
     let inv_g = 1.0 / GRAVITY; // a constant: the divisions by g become products
-    let dz_g = dz * inv_g;
-    let make_inv = |t: f64, inv_t: f64, beta_h: f64| {
-        let t_td = t / 2.0 - sv - dz_g * inv_t;
-        let u = t_td + sv;
+    let mk = Maker {
+        shape,
+        req,
+        refs,
+        opts,
+        sv: shape.derived.s_bar_v,
+        dz_g: (req.ze - req.zs) * inv_g,
+        beta_p,
+        inv_jv: shape.derived.inv_j[2],
+    };
+    // (ii) no net horizontal impulse.
+    if near_zero(0) {
+        return mk.no_net_horizontal();
+    }
+    mk.quadratic()
+}
+
+/// One request on one stance and what every candidate of it shares: `t_TD`, `u`, `w` and
+/// `β` for one `T > 0`.
+struct Maker<'a> {
+    shape: &'a StanceShape,
+    req: &'a Request,
+    refs: &'a Refs,
+    opts: &'a SolveOptions,
+    /// `s̄_v`, s.
+    sv: f64,
+    /// `(z_e − z_s)/g`, s².
+    dz_g: f64,
+    /// `β_p` (§6.4 (iii)).
+    beta_p: f64,
+    /// `1/J_v`.
+    inv_jv: f64,
+}
+
+impl Maker<'_> {
+    /// The candidate for `T` with `inv_t` = 1/T (passed in when a root gives it without a
+    /// division).
+    #[inline]
+    fn make_inv(&self, t: f64, inv_t: f64, beta_h: f64) -> Candidate {
+        let t_td = t / 2.0 - self.sv - self.dz_g * inv_t;
+        let u = t_td + self.sv;
         Candidate {
-            beta: [beta_h, beta_p, g * t * inv_jv],
+            beta: [beta_h, self.beta_p, GRAVITY * t * self.inv_jv],
             t_td,
             t_e: t,
             u,
             w: t - u,
         }
-    };
-    let make = |t: f64, beta_h: f64| make_inv(t, 1.0 / t, beta_h);
-    // (ii) no net horizontal impulse: T from β_v,ref, β_h from A4.
-    if near_zero(0) {
+    }
+
+    /// The candidate for a root `T`: [`Maker::make_inv`] for `T > 0` finite, else the
+    /// placeholder that fails rule 1.
+    #[inline]
+    fn at_inv(&self, t: f64, inv_t: f64, beta_h: f64) -> Candidate {
+        if t > 0.0 && t.is_finite() {
+            self.make_inv(t, inv_t, beta_h)
+        } else {
+            sign_fail(t, self.beta_p)
+        }
+    }
+
+    #[inline]
+    fn at(&self, t: f64, beta_h: f64) -> Candidate {
+        self.at_inv(t, 1.0 / t, beta_h)
+    }
+
+    /// §6.4 (ii), no net horizontal impulse: `T` from `β_v,ref`, `β_h` from A4.
+    #[inline]
+    fn no_net_horizontal(&self) -> Result<(Roots, Branch), Infeasible> {
+        let (shape, req, refs, opts, mk) = (self.shape, self.req, self.refs, self.opts, self);
         if !matches(req.ve, req.vs, opts.match_tol) {
             return Err(Infeasible::NoNetHorizontalImpulse);
         }
-        let t = refs.beta_v * jv / g;
+        let t = refs.beta_v * shape.j[2] / GRAVITY;
         if t <= 0.0 {
-            return Ok((Roots::one(sign_fail(t, beta_p)), Branch::NoNetHorizontal));
+            return Ok((Roots::one(sign_fail(t, mk.beta_p)), Branch::NoNetHorizontal));
         }
-        let mut c = make(t, 0.0);
+        let mut c = mk.make_inv(t, 1.0 / t, 0.0);
         let moment_scale = shape.dt * shape.j_scale[0];
-        let rest = req.ve * t - d * c.t_td;
+        let rest = req.ve * t - (req.ve - req.vs) * c.t_td;
+        let kh = shape.k[0];
         c.beta[0] = if kh.abs() <= opts.eps_j * moment_scale {
             if !matches(req.x, rest, opts.match_tol) {
                 return Err(Infeasible::NoNetHorizontalMoment);
@@ -551,56 +599,61 @@ pub fn candidates(
         } else {
             (rest - req.x) / kh
         };
-        return Ok((Roots::one(c), Branch::NoNetHorizontal));
+        Ok((Roots::one(c), Branch::NoNetHorizontal))
     }
-    let beta_h = d * inv_jh;
-    let sh = shape.derived.s_bar_h;
-    let a = (req.vs + req.ve) / 2.0;
-    let b = -(req.x + d * (sh - sv));
-    let c = d * dz_g;
-    let at_inv = |t: f64, inv_t: f64| {
-        if t > 0.0 && t.is_finite() {
-            make_inv(t, inv_t, beta_h)
+
+    /// §6.2 `a T² + b T + c = 0` (and its degenerate forms of §6.4 (iv)), roots by the
+    /// stable formula `q = −(b + sign(b)·√disc)/2`, `T1 = q/a`, `T2 = c/q`.
+    #[inline]
+    fn quadratic(&self) -> Result<(Roots, Branch), Infeasible> {
+        let (shape, req, refs, opts, mk) = (self.shape, self.req, self.refs, self.opts, self);
+        let d = req.ve - req.vs;
+        let dz = req.ze - req.zs;
+        let beta_h = d * shape.derived.inv_j[0];
+        let (sh, sv) = (shape.derived.s_bar_h, mk.sv);
+        let a = (req.vs + req.ve) / 2.0;
+        let b = -(req.x + d * (sh - sv));
+        let c = d * mk.dz_g;
+        if a == 0.0 {
+            // "Identically zero" (§6.4 (iv)) relative to the terms of b and the factors of c.
+            let b_tol = opts.match_tol * 1f64.max(req.x.abs()).max((d * (sh - sv)).abs());
+            let c_tol = opts.match_tol * 1f64.max(d.abs()).max(dz.abs());
+            if b.abs() > b_tol {
+                let t = -c / b;
+                return Ok((Roots::one(mk.at(t, beta_h)), Branch::Linear));
+            }
+            if c.abs() > c_tol {
+                return Err(Infeasible::NoRoot);
+            }
+            let t = refs.beta_v * shape.j[2] / GRAVITY;
+            return Ok((Roots::one(mk.at(t, beta_h)), Branch::FreePeriod));
+        }
+        let mut disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            if disc >= -opts.disc_rel_tol * (b * b + (4.0 * a * c).abs()) {
+                disc = 0.0;
+            } else {
+                return Err(Infeasible::NegativeDiscriminant);
+            }
+        }
+        if !disc.is_finite() {
+            return Err(Infeasible::NonFinite);
+        }
+        let q = -0.5 * (b + b.signum() * disc.sqrt());
+        let roots = if q == 0.0 {
+            Roots::one(mk.at(0.0, beta_h)) // b = 0 and disc = 0 ⇒ c = 0: the double root T = 0
+        } else if disc == 0.0 {
+            Roots::one(mk.at(q / a, beta_h))
         } else {
-            sign_fail(t, beta_p)
-        }
-    };
-    let at = |t: f64| at_inv(t, 1.0 / t);
-    if a == 0.0 {
-        // "Identically zero" (§6.4 (iv)) relative to the terms of b and the factors of c.
-        let b_tol = opts.match_tol * 1f64.max(req.x.abs()).max((d * (sh - sv)).abs());
-        let c_tol = opts.match_tol * 1f64.max(d.abs()).max(dz.abs());
-        if b.abs() > b_tol {
-            let t = -c / b;
-            return Ok((Roots::one(at(t)), Branch::Linear));
-        }
-        if c.abs() > c_tol {
-            return Err(Infeasible::NoRoot);
-        }
-        return Ok((Roots::one(at(refs.beta_v * jv / g)), Branch::FreePeriod));
+            // T1 = q/a, T2 = c/q: with 1/q, 1/T1 = a/q and T2 need no division of their own.
+            let inv_q = 1.0 / q;
+            Roots::two(
+                mk.at_inv(q / a, a * inv_q, beta_h),
+                mk.at(c * inv_q, beta_h),
+            )
+        };
+        Ok((roots, Branch::Quadratic))
     }
-    let mut disc = b * b - 4.0 * a * c;
-    if disc < 0.0 {
-        if disc >= -opts.disc_rel_tol * (b * b + (4.0 * a * c).abs()) {
-            disc = 0.0;
-        } else {
-            return Err(Infeasible::NegativeDiscriminant);
-        }
-    }
-    if !disc.is_finite() {
-        return Err(Infeasible::NonFinite);
-    }
-    let q = -0.5 * (b + b.signum() * disc.sqrt());
-    let roots = if q == 0.0 {
-        Roots::one(at(0.0)) // b = 0 and disc = 0 ⇒ c = 0: the double root T = 0
-    } else if disc == 0.0 {
-        Roots::one(at(q / a))
-    } else {
-        // T1 = q/a, T2 = c/q: with 1/q, 1/T1 = a/q and T2 need no division of their own.
-        let inv_q = 1.0 / q;
-        Roots::two(at_inv(q / a, a * inv_q), at(c * inv_q))
-    };
-    Ok((roots, Branch::Quadratic))
 }
 
 /// A placeholder candidate for `T ≤ 0` (no `t_TD` exists); it fails rule 1.

@@ -18,7 +18,7 @@ use crate::math::savgol::{SavGol, DEFAULT_ORDER};
 use crate::math::spline::NaturalSpline;
 use crate::math::stats::median;
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// Options of the stance stage.
 #[derive(serde::Serialize, Debug, Clone, PartialEq, Default)]
@@ -286,158 +286,289 @@ pub fn build_clip(
     mass_kg: f64,
     opts: &StanceOptions,
 ) -> (Vec<Stance>, Vec<StanceNote>) {
-    let n = fr.frame.len();
-    let dt = summary.frame_time_s;
-    let mut warnings = Vec::new();
-    let failed = |message: String| StanceNote {
-        message,
-        failed: true,
+    let data = match ClipData::new(clip, fr, summary, contacts, mass_kg) {
+        Ok(data) => data,
+        Err(note) => return (Vec::new(), vec![note]),
     };
-    let sg = match SavGol::for_frame_time(dt, DEFAULT_ORDER) {
-        Ok(sg) => sg,
-        Err(e) => {
-            warnings.push(failed(format!("cannot build the smoothing filter: {e}")));
-            return (Vec::new(), warnings);
-        }
-    };
-    let smooth: Vec<V3> = {
-        let cols: [Vec<f64>; 3] = std::array::from_fn(|i| {
-            sg.apply(&fr.com.iter().map(|c| c[i]).collect::<Vec<_>>(), 0, dt)
-        });
-        if cols[0].len() != n {
-            warnings.push(failed(format!(
-                "{n} frames, fewer than the smoothing window of {} frames",
-                sg.window()
-            )));
-            return (Vec::new(), warnings);
-        }
-        (0..n)
-            .map(|k| [cols[0][k], cols[1][k], cols[2][k]])
-            .collect()
-    };
-    let (Some(pos), Some(vel), Some(acc)) = (
-        Splines::new(&fr.time_s, &smooth),
-        Splines::new(&fr.time_s, &fr.com_v),
-        Splines::new(&fr.time_s, &fr.com_a),
-    ) else {
-        warnings.push(StanceNote::from(
-            "cannot build splines of the COM (too few frames)".to_string(),
-        ));
-        return (Vec::new(), warnings);
-    };
-    let speed: Vec<f64> = fr
-        .com_v
-        .iter()
-        .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
-        .collect();
-    let frame0 = fr.frame[0];
-    let flight_at = |a: usize| {
-        summary
-            .flights
-            .iter()
-            .find(|f| f.first_frame == frame0 + a as i64)
-    };
-    let ballistic = |a: usize, _b: usize| flight_at(a).is_some_and(|f| f.ballistic);
+    let ballistic = |a: usize, _b: usize| data.flight_at(a).is_some_and(|f| f.ballistic);
     let (segments, w) = segment(&SegmentInput {
         contact: &fr.contact,
-        speed: &speed,
+        speed: &data.speed,
         ballistic: &ballistic,
-        dt,
+        dt: data.dt,
     });
-    warnings.extend(w.into_iter().map(StanceNote::from));
+    let mut notes: Vec<StanceNote> = w.into_iter().map(StanceNote::from).collect();
     let mut ws = FitWorkspace::new(opts.fit.samples);
     let mut previous: Option<V3> = None;
     let mut out = Vec::with_capacity(segments.len());
     for seg in segments {
+        match data.stance(&seg, &mut previous, &mut ws, opts) {
+            Ok(stance) => out.push(stance),
+            Err(note) => notes.push(note),
+        }
+    }
+    (out, notes)
+}
+
+/// One clip's inputs to the stance stage, with its smoothed COM splines.
+struct ClipData<'a> {
+    clip: &'a str,
+    fr: &'a ClipFrames,
+    summary: &'a ClipSummary,
+    contacts: &'a [ContactRun],
+    mass_kg: f64,
+    /// Frame time, s.
+    dt: f64,
+    /// `|v_COM|` per frame, m/s.
+    speed: Vec<f64>,
+    /// SG-smoothed COM position, m.
+    pos: Splines,
+    /// SG COM velocity, m/s.
+    vel: Splines,
+    /// SG COM acceleration, m/s².
+    acc: Splines,
+}
+
+/// The state `(position m, velocity m/s)` at each edge of a stance, from the ballistic fit
+/// of the adjacent flight when there is one, else from the COM splines.
+struct EdgeStates {
+    td: (V3, V3),
+    lo: (V3, V3),
+    fit_before: bool,
+    fit_after: bool,
+}
+
+/// The SG-smoothed COM of a clip; a failed note when the filter cannot be built or the
+/// clip is shorter than its window.
+fn smoothed_com(fr: &ClipFrames, dt: f64) -> Result<Vec<V3>, StanceNote> {
+    let n = fr.frame.len();
+    let failed = |message: String| StanceNote {
+        message,
+        failed: true,
+    };
+    let sg = SavGol::for_frame_time(dt, DEFAULT_ORDER)
+        .map_err(|e| failed(format!("cannot build the smoothing filter: {e}")))?;
+    let cols: [Vec<f64>; 3] =
+        std::array::from_fn(|i| sg.apply(&fr.com.iter().map(|c| c[i]).collect::<Vec<_>>(), 0, dt));
+    if cols[0].len() != n {
+        return Err(failed(format!(
+            "{n} frames, fewer than the smoothing window of {} frames",
+            sg.window()
+        )));
+    }
+    Ok((0..n)
+        .map(|k| [cols[0][k], cols[1][k], cols[2][k]])
+        .collect())
+}
+
+impl<'a> ClipData<'a> {
+    fn new(
+        clip: &'a str,
+        fr: &'a ClipFrames,
+        summary: &'a ClipSummary,
+        contacts: &'a [ContactRun],
+        mass_kg: f64,
+    ) -> Result<ClipData<'a>, StanceNote> {
+        let dt = summary.frame_time_s;
+        let smooth = smoothed_com(fr, dt)?;
+        let (Some(pos), Some(vel), Some(acc)) = (
+            Splines::new(&fr.time_s, &smooth),
+            Splines::new(&fr.time_s, &fr.com_v),
+            Splines::new(&fr.time_s, &fr.com_a),
+        ) else {
+            return Err(StanceNote::from(
+                "cannot build splines of the COM (too few frames)".to_string(),
+            ));
+        };
+        let speed: Vec<f64> = fr
+            .com_v
+            .iter()
+            .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
+            .collect();
+        Ok(ClipData {
+            clip,
+            fr,
+            summary,
+            contacts,
+            mass_kg,
+            dt,
+            speed,
+            pos,
+            vel,
+            acc,
+        })
+    }
+
+    /// The flight that starts at kept frame `a`.
+    fn flight_at(&self, a: usize) -> Option<&'a Flight> {
+        let frame0 = self.fr.frame[0];
+        self.summary
+            .flights
+            .iter()
+            .find(|f| f.first_frame == frame0 + a as i64)
+    }
+
+    /// The flight before a stance that starts at a flight boundary.
+    fn flight_before(&self, seg: &Segment) -> Option<&'a Flight> {
+        (seg.start == Boundary::Flight)
+            .then(|| flight_ending_at(self.summary, self.fr.frame[0] + seg.i0 as i64 - 1))
+            .flatten()
+    }
+
+    /// The flight after a stance that ends at a flight boundary.
+    fn flight_after(&self, seg: &Segment) -> Option<&'a Flight> {
+        (seg.end == Boundary::Flight)
+            .then(|| self.flight_at(seg.i1 + 1))
+            .flatten()
+    }
+
+    /// Touchdown and liftoff time of a stance, s: the clip's first (last) frame at a clip
+    /// edge, else the sub-frame event, else half a frame outside the stance's frames.
+    fn stance_times(&self, seg: &Segment) -> (f64, f64) {
+        let (fr, dt, n) = (self.fr, self.dt, self.fr.frame.len());
         let t_td = if seg.i0 == 0 {
             fr.time_s[0]
         } else {
-            event_time(contacts, &seg, fr, Edge::Touchdown).unwrap_or(fr.time_s[seg.i0] - dt / 2.0)
+            event_time(self.contacts, seg, fr, Edge::Touchdown)
+                .unwrap_or(fr.time_s[seg.i0] - dt / 2.0)
         };
         let t_lo = if seg.i1 + 1 == n {
             fr.time_s[n - 1]
         } else {
-            event_time(contacts, &seg, fr, Edge::Liftoff).unwrap_or(fr.time_s[seg.i1] + dt / 2.0)
+            event_time(self.contacts, seg, fr, Edge::Liftoff)
+                .unwrap_or(fr.time_s[seg.i1] + dt / 2.0)
         };
-        let dt_s = t_lo - t_td;
-        let fit_before = (seg.start == Boundary::Flight)
-            .then(|| flight_ending_at(summary, frame0 + seg.i0 as i64 - 1))
-            .flatten()
-            .and_then(|f| ballistic_fit(fr, f));
-        let fit_after = (seg.end == Boundary::Flight)
-            .then(|| flight_at(seg.i1 + 1))
-            .flatten()
-            .and_then(|f| ballistic_fit(fr, f));
-        let (p_td, v_td) = fit_before
+        (t_td, t_lo)
+    }
+
+    /// The edge states of a stance (adjacent flights' ballistic fits, else the splines).
+    fn edge_states(&self, seg: &Segment, t_td: f64, t_lo: f64) -> EdgeStates {
+        let fit_before = self
+            .flight_before(seg)
+            .and_then(|f| ballistic_fit(self.fr, f));
+        let fit_after = self
+            .flight_after(seg)
+            .and_then(|f| ballistic_fit(self.fr, f));
+        let td = fit_before
             .as_ref()
-            .map_or((pos.at(t_td), vel.at(t_td)), |f| {
+            .map_or((self.pos.at(t_td), self.vel.at(t_td)), |f| {
                 (f.position(t_td), f.velocity(t_td))
             });
-        let (p_lo, v_lo) = fit_after
+        let lo = fit_after
             .as_ref()
-            .map_or((pos.at(t_lo), vel.at(t_lo)), |f| {
+            .map_or((self.pos.at(t_lo), self.vel.at(t_lo)), |f| {
                 (f.position(t_lo), f.velocity(t_lo))
             });
+        EdgeStates {
+            td,
+            lo,
+            fit_before: fit_before.is_some(),
+            fit_after: fit_after.is_some(),
+        }
+    }
+
+    /// The stance heading (§2): from the touchdown velocity, or the liftoff velocity of a
+    /// standing liftoff (no flight before, a flight after: it heads where it leaves to).
+    fn heading(&self, seg: &Segment, edges: &EdgeStates, previous: Option<V3>) -> Heading {
+        let fr = self.fr;
         let facing_td: V3 = match seg.i0 {
             0 => fr.facing[0],
             i => std::array::from_fn(|a| 0.5 * (fr.facing[i - 1][a] + fr.facing[i][a])),
         };
-        // A standing liftoff (no flight before, a flight after) heads where it leaves to.
-        let v_heading = if fit_before.is_none() && fit_after.is_some() {
-            v_lo
+        let v_heading = if !edges.fit_before && edges.fit_after {
+            edges.lo.1
         } else {
-            v_td
+            edges.td.1
         };
-        let h: Heading = heading(v_heading, facing_td, previous);
-        let targets = (fit_before.is_some() || fit_after.is_some())
-            .then(|| edge_targets(&h, (p_td, v_td), (p_lo, v_lo), dt_s, mass_kg));
-        let z_c = median(&fr.ground_z[seg.i0..=seg.i1]).unwrap_or(0.0);
-        let (label, effectors) = label(&seg, &fr.contact);
+        heading(v_heading, facing_td, previous)
+    }
+
+    /// The force fit of a stance (§4), with the adjacent flights' edge targets when it has
+    /// a ballistic neighbour; a failed note when the fit fails.
+    fn fit_force(
+        &self,
+        ws: &mut FitWorkspace,
+        seg: &Segment,
+        times: (f64, f64),
+        h: &Heading,
+        edges: &EdgeStates,
+        opts: &StanceOptions,
+    ) -> Result<(StanceFit, Option<EdgeTargets>), StanceNote> {
+        let (t_td, t_lo) = times;
+        let dt_s = t_lo - t_td;
+        let targets = (edges.fit_before || edges.fit_after)
+            .then(|| edge_targets(h, edges.td, edges.lo, dt_s, self.mass_kg));
         let force = StanceForce {
-            acc: &acc.0,
+            acc: &self.acc.0,
             t_td,
             dt: dt_s,
             r_s: h.rotation(),
-            mass_kg,
+            mass_kg: self.mass_kg,
         };
+        match fit_stance(ws, &force, seg.i1 - seg.i0 + 1, targets.as_ref(), &opts.fit) {
+            Ok(fit) => Ok((fit, targets)),
+            Err(e) => Err(StanceNote {
+                message: format!(
+                    "stance at frame {}: force fit failed: {e}",
+                    self.fr.frame[seg.i0]
+                ),
+                failed: true,
+            }),
+        }
+    }
+
+    /// One stance of the clip: times, edge states, heading, force fit, then its row.
+    /// `previous` is the heading of the last stance built (updated on success).
+    fn stance(
+        &self,
+        seg: &Segment,
+        previous: &mut Option<V3>,
+        ws: &mut FitWorkspace,
+        opts: &StanceOptions,
+    ) -> Result<Stance, StanceNote> {
+        let times = self.stance_times(seg);
+        let edges = self.edge_states(seg, times.0, times.1);
+        let h = self.heading(seg, &edges, *previous);
+        let (fit, targets) = self.fit_force(ws, seg, times, &h, &edges, opts)?;
+        *previous = Some(h.e_h);
+        Ok(self.stance_row(seg, times, &edges, h, fit, targets.is_some()))
+    }
+
+    /// The stance's row: parameters, contact point, constraint coefficients, adjacent
+    /// flights and warnings.
+    fn stance_row(
+        &self,
+        seg: &Segment,
+        (t_td, t_lo): (f64, f64),
+        edges: &EdgeStates,
+        h: Heading,
+        fit: StanceFit,
+        targeted: bool,
+    ) -> Stance {
+        let (fr, clip, mass_kg) = (self.fr, self.clip, self.mass_kg);
+        let ((p_td, v_td), (p_lo, v_lo)) = (edges.td, edges.lo);
+        let dt_s = t_lo - t_td;
         let StanceFit {
             model,
             kind: force_model,
             ratio,
             targets_met,
-        } = match fit_stance(
-            &mut ws,
-            &force,
-            seg.i1 - seg.i0 + 1,
-            targets.as_ref(),
-            &opts.fit,
-        ) {
-            Ok(m) => m,
-            Err(e) => {
-                warnings.push(StanceNote {
-                    message: format!(
-                        "stance at frame {}: force fit failed: {e}",
-                        fr.frame[seg.i0]
-                    ),
-                    failed: true,
-                });
-                continue;
-            }
-        };
+        } = fit;
         let mut sw = Vec::new();
-        if targets.is_some() && force_model == ForceModelKind::Ratio && targets_met < 2 {
+        if targeted && force_model == ForceModelKind::Ratio && targets_met < 2 {
             sw.push(format!(
                 "the force model meets {targets_met} of 2 vertical edge targets of the adjacent flight(s)"
             ));
         }
-        previous = Some(h.e_h);
+        let z_c = median(&fr.ground_z[seg.i0..=seg.i1]).unwrap_or(0.0);
+        let (label, effectors) = label(seg, &fr.contact);
         let (j, p) = (model.j(), model.p());
         let v_td_s = h.to_stance(v_td);
         let z_td = p_td[2] - z_c;
         let prm = model_consistent(v_td_s, z_td, j, p, dt_s);
         let dp = h.to_stance(std::array::from_fn(|i| p_lo[i] - p_td[i]));
         let measured = params::from_states(v_td_s, z_td, dp, h.to_stance(v_lo), dt_s);
-        let cp = contact_point(&seg, fr).map_or([0.0, 0.0], |c| {
+        let cp = contact_point(seg, fr).map_or([0.0, 0.0], |c| {
             let d = h.to_stance(std::array::from_fn(|i| c[i] - p_td[i]));
             [d[0], d[1]]
         });
@@ -457,21 +588,13 @@ pub fn build_clip(
                 "J_v ≤ 0: the stance cannot support the body; excluded from scaling".to_string(),
             );
         }
-        let edge_rest = |k: usize| speed[k] < V_QUIET;
+        let edge_rest = |k: usize| self.speed[k] < V_QUIET;
         let rest_at_edge = (seg.start == Boundary::ClipEdge && edge_rest(seg.i0))
             || (seg.end == Boundary::ClipEdge && edge_rest(seg.i1));
-        let before = (seg.start == Boundary::Flight)
-            .then(|| flight_ending_at(summary, frame0 + seg.i0 as i64 - 1))
-            .flatten()
-            .map(|f| flight_ref(f, t_td));
-        let after = (seg.end == Boundary::Flight)
-            .then(|| flight_at(seg.i1 + 1))
-            .flatten()
-            .map(|f| flight_ref(f, t_lo));
-        out.push(Stance {
+        Stance {
             stance_id: format!("{clip}:{label}:{}", fr.frame[seg.i0]),
             clip: clip.to_string(),
-            character_id: summary.character_id.clone().unwrap_or_default(),
+            character_id: self.summary.character_id.clone().unwrap_or_default(),
             label,
             effectors,
             first_frame: fr.frame[seg.i0],
@@ -482,8 +605,8 @@ pub fn build_clip(
             boundary_start: seg.start,
             boundary_end: seg.end,
             rest_at_edge,
-            flight_before: before,
-            flight_after: after,
+            flight_before: self.flight_before(seg).map(|f| flight_ref(f, t_td)),
+            flight_after: self.flight_after(seg).map(|f| flight_ref(f, t_lo)),
             heading: h,
             z_c,
             params: prm,
@@ -495,7 +618,6 @@ pub fn build_clip(
             force_model,
             ratio,
             warnings: sw,
-        });
+        }
     }
-    (out, warnings)
 }

@@ -50,8 +50,8 @@ impl From<&Stance> for StanceFacts {
     }
 }
 
-/// Absolute friction limit.
-pub const DEFAULT_MU: f64 = 0.7;
+/// Absolute friction limit (the crate-wide default μ).
+pub use crate::math::constants::DEFAULT_MU;
 /// Margin on the extremes of the example stances.
 pub const MARGIN: f64 = 1.05;
 /// Below this many eligible stances a character uses the library-wide values.

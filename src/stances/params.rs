@@ -17,12 +17,11 @@
 //! # References
 //! spec stance-model §2, §3 (normative: model-consistent parameters).
 
-/// Gravity magnitude, m/s².
-pub const G: f64 = 9.81;
+use crate::math::constants::GRAVITY;
 /// Below this horizontal touchdown speed the heading comes from the hips, m/s.
 pub const V_MIN_HEADING: f64 = 0.2;
 
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// Where a stance's heading came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -137,11 +136,11 @@ pub struct StanceParams {
 /// Parameters from a touchdown state and a liftoff displacement and velocity, all in stance
 /// axes (`dp` = p_LO − p_TD, `v_lo`), with `z_td` above the contact height.
 pub fn from_states(v_td: V3, z_td: f64, dp: V3, v_lo: V3, dt: f64) -> StanceParams {
-    let t_td = -v_td[2] / G;
-    let zs = z_td + v_td[2] * v_td[2] / (2.0 * G);
+    let t_td = -v_td[2] / GRAVITY;
+    let zs = z_td + v_td[2] * v_td[2] / (2.0 * GRAVITY);
     let z_lo = z_td + dp[2];
-    let e = v_lo[2] / G;
-    let ze = z_lo + v_lo[2] * v_lo[2] / (2.0 * G);
+    let e = v_lo[2] / GRAVITY;
+    let ze = z_lo + v_lo[2] * v_lo[2] / (2.0 * GRAVITY);
     let x = v_td[0] * t_td + dp[0] + v_lo[0] * e;
     StanceParams {
         zs,
@@ -162,11 +161,15 @@ pub fn from_states(v_td: V3, z_td: f64, dp: V3, v_lo: V3, dt: f64) -> StancePara
 /// Model-consistent parameters (β = 1): the liftoff state from `J` and `P` of the force
 /// model (§3, §5). `v_td` in stance axes.
 pub fn model_consistent(v_td: V3, z_td: f64, j: V3, p: V3, dt: f64) -> StanceParams {
-    let v_lo = [v_td[0] + j[0], v_td[1] + j[1], v_td[2] + j[2] - G * dt];
+    let v_lo = [
+        v_td[0] + j[0],
+        v_td[1] + j[1],
+        v_td[2] + j[2] - GRAVITY * dt,
+    ];
     let dp = [
         v_td[0] * dt + p[0],
         v_td[1] * dt + p[1],
-        v_td[2] * dt - 0.5 * G * dt * dt + p[2],
+        v_td[2] * dt - 0.5 * GRAVITY * dt * dt + p[2],
     ];
     from_states(v_td, z_td, dp, v_lo, dt)
 }
@@ -180,16 +183,16 @@ mod tests {
         // Touchdown descending at 1 m/s, heading speed 3 m/s; a force that exactly reverses
         // the vertical velocity with zero net displacement offset (J_v = 2 + gΔt).
         let dt = 0.2;
-        let j = [0.0, 0.0, 2.0 + G * dt];
+        let j = [0.0, 0.0, 2.0 + GRAVITY * dt];
         // P_v for a constant force: J_v·Δt/2.
         let p = [0.0, 0.0, j[2] * dt / 2.0];
         let s = model_consistent([3.0, 0.0, -1.0], 0.9, j, p, dt);
-        assert!((s.t_td - 1.0 / G).abs() < 1e-12);
-        assert!((s.zs - (0.9 + 1.0 / (2.0 * G))).abs() < 1e-12);
+        assert!((s.t_td - 1.0 / GRAVITY).abs() < 1e-12);
+        assert!((s.zs - (0.9 + 1.0 / (2.0 * GRAVITY))).abs() < 1e-12);
         // Symmetric stance: liftoff at the touchdown height, rising at 1 m/s.
         assert!((s.z_lo - s.z_td).abs() < 1e-12 && (s.ze - s.zs).abs() < 1e-12);
-        assert!((s.x - 3.0 * (2.0 / G + dt)).abs() < 1e-12);
-        assert!((s.t_e - (2.0 / G + dt)).abs() < 1e-12);
+        assert!((s.x - 3.0 * (2.0 / GRAVITY + dt)).abs() < 1e-12);
+        assert!((s.t_e - (2.0 / GRAVITY + dt)).abs() < 1e-12);
     }
 
     #[test]

@@ -36,7 +36,7 @@ pub const TANGENT_SWITCH: f64 = 1e-5;
 /// "of `+Y` if `normal ∥ X`").
 pub const PARALLEL_X_TOL: f64 = 1e-9;
 /// Default friction coefficient `μ` of §1 (two-pac §1.1 `friction`).
-pub const DEFAULT_MU: f64 = 0.7;
+pub use crate::math::constants::DEFAULT_MU;
 
 /// The shape of a contact: where its contact points are.
 #[derive(Debug, Clone, PartialEq)]

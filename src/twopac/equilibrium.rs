@@ -37,8 +37,7 @@ use clarabel::solver::{
 use nalgebra::{DMatrix, DVector};
 use std::sync::OnceLock;
 
-/// Gravity `g⃗ = (0, 0, −G)`, m/s² (§9: `g = 9.81`).
-pub const GRAVITY: f64 = 9.81;
+pub use crate::math::constants::GRAVITY;
 /// Singular values of `G V` below this fraction of the largest are treated as zero.
 pub const RANK_TOL_REL: f64 = 1e-9;
 /// A wrench with `‖w − UUᵀw‖ > RANGE_TOL_REL · max(‖w‖, m g · 1 m)` is outside `range(G V)`.
@@ -327,7 +326,9 @@ fn range_basis(generators: &[[f64; 6]]) -> DMatrix<f64> {
         return DMatrix::zeros(6, 0);
     }
     let gv = DMatrix::from_fn(6, generators.len(), |i, j| generators[j][i]);
-    let svd = gv.svd(true, false);
+    let Some(svd) = crate::math::svd::svd(gv, true, false) else {
+        return DMatrix::zeros(6, 0);
+    };
     let u = svd.u.expect("svd computed with u");
     let smax = svd.singular_values.max();
     let keep: Vec<usize> = (0..svd.singular_values.len())

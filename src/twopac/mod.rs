@@ -59,7 +59,7 @@ mod simplex;
 pub mod trajectory;
 pub mod transition;
 mod unique_keys;
-mod v3;
+use crate::math::v3;
 pub mod validate;
 
 #[cfg(test)]
@@ -109,6 +109,14 @@ pub enum TwopacError {
     Solver {
         /// What was being solved, and how it failed.
         what: String,
+    },
+    /// An iterative solver stopped at its cap before it converged.
+    #[error("solver: {what}: not converged after {iterations} iterations")]
+    NotConverged {
+        /// What was being solved.
+        what: String,
+        /// Iterations (LPs, pivots) done.
+        iterations: usize,
     },
     /// A convex hull cannot be built (§3: at least 4 non-coplanar points).
     #[error("hull of {n_points} points: {msg}")]

@@ -177,7 +177,7 @@ impl SupportLp {
 /// # Errors
 ///
 /// [`TwopacError::Solver`] if an LP hits its pivot cap or turns out unbounded inside the
-/// clipping square, or more than [`MAX_LPS`] LPs are needed (numerical trouble or
+/// clipping square; [`TwopacError::NotConverged`] when more than [`MAX_LPS`] LPs are needed (numerical trouble or
 /// non-finite points; never seen on valid input).
 pub fn static_region(
     points: &[ContactPoint],
@@ -213,7 +213,43 @@ pub fn static_region(
         let (h, c) = lp.support(d).map_err(|e| fail("support", e))?;
         init.push((d, h, c));
     }
-    let mut facets: Vec<([f64; 2], f64)> = Vec::new();
+    let (mut facets, found) = refine(&mut lp, &init, opts)?;
+    let vertices = convex_hull_2d(&found, opts.tol_m);
+    if !full_dimensional(&vertices, 100.0 * opts.tol_m) {
+        facets.extend(init.iter().map(|&(d, h, _)| (d, h)));
+    }
+    let (facets, status) = drop_square_rows(facets, centre, opts.box_half_m);
+    let facets = dedupe(facets);
+    let polytope = Polytope {
+        a: facets.iter().map(|&(n, _)| [n[0], n[1], 0.0]).collect(),
+        b: facets.iter().map(|&(_, h)| h).collect(),
+    };
+    Ok(StaticRegion {
+        polytope,
+        vertices,
+        status,
+        n_lps: lp.n_lps,
+    })
+}
+
+/// One initial support direction: `(d, h_Q(d), argmax)`.
+type Support = ([f64; 2], f64, [f64; 2]);
+/// A facet `n·c ≤ h` of the region (unit outward `n`, offset `h` in m).
+type Facet = ([f64; 2], f64);
+
+/// Refine every chord between consecutive initial support points (counter-clockwise) by
+/// the support in its outward normal, until the gap is within `tol_m` or [`MAX_DEPTH`]:
+/// returns the facets `(n, h)` and every support point found.
+fn refine(
+    lp: &mut SupportLp,
+    init: &[Support],
+    opts: &RegionOptions,
+) -> Result<(Vec<Facet>, Vec<[f64; 2]>), TwopacError> {
+    let fail = |what: &str, e: LpFailure| TwopacError::Solver {
+        what: format!("static region: {what}: {e:?}"),
+    };
+    let nd = init.len();
+    let mut facets: Vec<Facet> = Vec::new();
     let mut found: Vec<[f64; 2]> = init.iter().map(|x| x.2).collect();
     for k in 0..nd {
         let (_, _, c0) = init[k];
@@ -230,8 +266,9 @@ pub fn static_region(
             let (h, c) = lp.support(n).map_err(|e| fail("support", e))?;
             let chord = n[0] * a[0] + n[1] * a[1];
             if lp.n_lps > MAX_LPS {
-                return Err(TwopacError::Solver {
-                    what: format!("static region: more than {MAX_LPS} support LPs"),
+                return Err(TwopacError::NotConverged {
+                    what: format!("static region: support LPs (cap MAX_LPS = {MAX_LPS})"),
+                    iterations: lp.n_lps,
                 });
             }
             // A NaN gap also ends the refinement.
@@ -245,21 +282,26 @@ pub fn static_region(
             }
         }
     }
-    let vertices = convex_hull_2d(&found, opts.tol_m);
-    if !full_dimensional(&vertices, 100.0 * opts.tol_m) {
-        facets.extend(init.iter().map(|&(d, h, _)| (d, h)));
-    }
-    // Drop rows on the clipping square.
+    Ok((facets, found))
+}
+
+/// Drop the facets that lie on the clipping square (half-width `box_half_m` about
+/// `centre`); the region is unbounded when there were any.
+fn drop_square_rows(
+    mut facets: Vec<Facet>,
+    centre: [f64; 2],
+    box_half_m: f64,
+) -> (Vec<Facet>, RegionStatus) {
     let lim = [
-        centre[0] + opts.box_half_m,
-        opts.box_half_m - centre[0],
-        centre[1] + opts.box_half_m,
-        opts.box_half_m - centre[1],
+        centre[0] + box_half_m,
+        box_half_m - centre[0],
+        centre[1] + box_half_m,
+        box_half_m - centre[1],
     ];
     let axes = [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]];
     let on_square = |n: [f64; 2], h: f64| {
         axes.iter().zip(lim).any(|(ax, l)| {
-            (n[0] - ax[0]).abs() + (n[1] - ax[1]).abs() < 1e-9 && h >= l - 1e-6 * opts.box_half_m
+            (n[0] - ax[0]).abs() + (n[1] - ax[1]).abs() < 1e-9 && h >= l - 1e-6 * box_half_m
         })
     };
     let before = facets.len();
@@ -269,17 +311,7 @@ pub fn static_region(
     } else {
         RegionStatus::Bounded
     };
-    let facets = dedupe(facets);
-    let polytope = Polytope {
-        a: facets.iter().map(|&(n, _)| [n[0], n[1], 0.0]).collect(),
-        b: facets.iter().map(|&(_, h)| h).collect(),
-    };
-    Ok(StaticRegion {
-        polytope,
-        vertices,
-        status,
-        n_lps: lp.n_lps,
-    })
+    (facets, status)
 }
 
 /// Sort facets by angle and merge equal normals (keeping the larger offset).

@@ -32,12 +32,13 @@ use super::bezier::{check_control_points, Bezier, ComState, ControlViolation};
 use super::contact::Contact;
 use super::equilibrium::EqualityForm;
 use super::polytope::Polytope;
-use super::region::{static_region, RegionOptions};
+use super::region::{static_region, RegionOptions, RegionStatus, StaticRegion};
 use super::transition::{
     transition_eq13, transition_eq6, QpForm, TransitionOptions, TransitionPoint,
 };
 use super::v3::{norm, scale, sub};
 use super::TwopacError;
+use crate::math::constants::STATIC_TOL;
 
 /// Most phases of one sequence (count). `twopac` plans it 31 times and solves each
 /// transition QP 2,000 times for `timings.json`, so its time grows with the phases.
@@ -235,6 +236,33 @@ pub fn plan(
     start: &ComState,
     opts: &PlanOptions,
 ) -> Result<Plan, TwopacError> {
+    let c_data0 = check_phases(phases)?;
+    let changes = contact_changes(phases)?;
+    let solver = PointSolver::new(phases, mass_kg, opts)?;
+    let phase_states = phase_states(phases, &solver, c_data0)?;
+    let transitions = transitions(phases, &changes, &solver, &phase_states)?;
+    let starts = phase_starts(phases);
+    let (windows, switch_times_s) = windows(
+        phases,
+        &solver.polys,
+        &phase_states,
+        &transitions,
+        starts.as_ref(),
+        start,
+    )?;
+    Ok(Plan {
+        mass_kg,
+        phase_states,
+        transitions,
+        windows,
+        switch_times_s,
+        phase_starts_s: starts,
+        forms: solver.forms,
+    })
+}
+
+/// The checks of §1 that need no solve; returns the data COM of phase 0 (the start).
+fn check_phases(phases: &[Phase]) -> Result<[f64; 3], TwopacError> {
     let n = phases.len();
     let bad = |phase: usize, msg: &str| TwopacError::InvalidPhases {
         phase,
@@ -259,64 +287,116 @@ pub fn plan(
             return Err(bad(j, "duration must be finite and non-negative"));
         }
     }
-    let Some(c_data0) = phases[0].com else {
-        return Err(bad(
-            0,
-            "the first phase needs a data COM (the start position)",
-        ));
-    };
-    let mut changes = Vec::with_capacity(n.saturating_sub(1));
-    for j in 0..n - 1 {
-        changes.push(change(&phases[j], &phases[j + 1], j)?);
-    }
-    let forms = phases
-        .iter()
-        .map(|p| EqualityForm::new(&p.contacts, mass_kg))
-        .collect::<Result<Vec<_>, _>>()?;
-    let polys: Vec<Polytope> = phases.iter().map(Phase::polytope).collect();
-    let regions = if opts.form == QpForm::Eq6 {
-        forms
+    phases[0]
+        .com
+        .ok_or_else(|| bad(0, "the first phase needs a data COM (the start position)"))
+}
+
+/// The contact change `(adds, effector)` of every boundary `j → j+1` (§1).
+fn contact_changes(phases: &[Phase]) -> Result<Vec<(bool, String)>, TwopacError> {
+    (0..phases.len().saturating_sub(1))
+        .map(|j| change(&phases[j], &phases[j + 1], j))
+        .collect()
+}
+
+/// The QP of §4 for every phase's statics and kinematics: equality forms, phase polytopes
+/// and (eq 6 form) static regions.
+struct PointSolver<'a> {
+    forms: Vec<EqualityForm>,
+    polys: Vec<Polytope>,
+    regions: Vec<Option<StaticRegion>>,
+    opts: &'a PlanOptions,
+}
+
+impl<'a> PointSolver<'a> {
+    fn new(phases: &[Phase], mass_kg: f64, opts: &'a PlanOptions) -> Result<Self, TwopacError> {
+        let forms = phases
             .iter()
-            .map(|f| static_region(&f.points, &opts.region).map(Some))
-            .collect::<Result<Vec<_>, _>>()?
-    } else {
-        vec![None; n]
-    };
-    let solve = |statics: usize, kin: &Polytope, c_prev: [f64; 3]| match &regions[statics] {
-        Some(r) if r.status != super::region::RegionStatus::Empty => {
-            transition_eq6(r, forms[statics].degenerate, kin, c_prev, &opts.transition)
+            .map(|p| EqualityForm::new(&p.contacts, mass_kg))
+            .collect::<Result<Vec<_>, _>>()?;
+        let polys: Vec<Polytope> = phases.iter().map(Phase::polytope).collect();
+        let regions = if opts.form == QpForm::Eq6 {
+            forms
+                .iter()
+                .map(|f| static_region(&f.points, &opts.region).map(Some))
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            vec![None; phases.len()]
+        };
+        Ok(PointSolver {
+            forms,
+            polys,
+            regions,
+            opts,
+        })
+    }
+
+    /// The point of §4 with the statics of phase `statics` inside `kin`, nearest `c_prev`.
+    fn solve(
+        &self,
+        statics: usize,
+        kin: &Polytope,
+        c_prev: [f64; 3],
+    ) -> Result<TransitionPoint, TwopacError> {
+        let t = &self.opts.transition;
+        match &self.regions[statics] {
+            Some(r) if r.status != RegionStatus::Empty => {
+                transition_eq6(r, self.forms[statics].degenerate, kin, c_prev, t)
+            }
+            _ => transition_eq13(&self.forms[statics], kin, c_prev, t),
         }
-        _ => transition_eq13(&forms[statics], kin, c_prev, &opts.transition),
-    };
-    let with_where = |e: TwopacError, t: Option<usize>, who: Vec<String>| match e {
+    }
+}
+
+/// A kinematics failure, told where: the transition (`None`: a phase state) and effectors.
+fn with_where(e: TwopacError, t: Option<usize>, who: Vec<String>) -> TwopacError {
+    match e {
         TwopacError::KinematicsInfeasible { .. } => TwopacError::KinematicsInfeasible {
             transition: t,
             effectors: who,
         },
         other => other,
-    };
-
-    // Phase states (§1).
-    let mut phase_states: Vec<TransitionPoint> = Vec::with_capacity(n);
-    for j in 0..n {
-        let c_prev = phases[j]
-            .com
-            .or_else(|| phase_states.last().map(|s| s.com))
-            .unwrap_or(c_data0);
-        let s =
-            solve(j, &polys[j], c_prev).map_err(|e| with_where(e, None, phases[j].effectors()))?;
-        phase_states.push(s);
     }
+}
 
-    // Transitions (§4).
-    let mut transitions: Vec<Transition> = Vec::with_capacity(n.saturating_sub(1));
+/// Phase states `c^(j)` (§1): statics and kinematics of phase `j`, nearest its data COM
+/// (or the previous state).
+fn phase_states(
+    phases: &[Phase],
+    solver: &PointSolver,
+    c_data0: [f64; 3],
+) -> Result<Vec<TransitionPoint>, TwopacError> {
+    let mut states: Vec<TransitionPoint> = Vec::with_capacity(phases.len());
+    for (j, phase) in phases.iter().enumerate() {
+        let c_prev = phase
+            .com
+            .or_else(|| states.last().map(|s| s.com))
+            .unwrap_or(c_data0);
+        let s = solver
+            .solve(j, &solver.polys[j], c_prev)
+            .map_err(|e| with_where(e, None, phase.effectors()))?;
+        states.push(s);
+    }
+    Ok(states)
+}
+
+/// Transition points `c^(j,j+1)` (§4): statics of the phase with fewer contacts inside the
+/// kinematics of the one with more, each nearest the previous point.
+fn transitions(
+    phases: &[Phase],
+    changes: &[(bool, String)],
+    solver: &PointSolver,
+    phase_states: &[TransitionPoint],
+) -> Result<Vec<Transition>, TwopacError> {
+    let mut out: Vec<Transition> = Vec::with_capacity(changes.len());
     let mut c_prev = phase_states[0].com;
     for (j, (adds, effector)) in changes.iter().enumerate() {
         let (fewer, more) = if *adds { (j, j + 1) } else { (j + 1, j) };
-        let point = solve(fewer, &polys[more], c_prev)
+        let point = solver
+            .solve(fewer, &solver.polys[more], c_prev)
             .map_err(|e| with_where(e, Some(j), phases[more].effectors()))?;
         c_prev = point.com;
-        transitions.push(Transition {
+        out.push(Transition {
             index: j,
             statics_phase: fewer,
             kinematics_phase: more,
@@ -325,9 +405,12 @@ pub fn plan(
             point,
         });
     }
+    Ok(out)
+}
 
-    // Data clock (§6).
-    let starts: Option<Vec<f64>> = phases
+/// Phase start times on the data clock (§6), `None` unless every phase has a duration.
+fn phase_starts(phases: &[Phase]) -> Option<Vec<f64>> {
+    phases
         .iter()
         .map(|p| p.duration_s)
         .collect::<Option<Vec<f64>>>()
@@ -340,15 +423,72 @@ pub fn plan(
                     s
                 })
                 .collect()
-        });
-    let mid = |j: usize| -> Option<f64> {
-        starts
-            .as_ref()
-            .map(|s| s[j] + 0.5 * phases[j].duration_s.unwrap_or(0.0))
-    };
+        })
+}
 
+/// The parameter `u ∈ {0, 0.01, …, 1}` where the curve comes closest to `target` (§6).
+fn closest_approach(curve: &Bezier, target: [f64; 3]) -> f64 {
+    (0..=100)
+        .map(|k| k as f64 * U_STEP)
+        .min_by(|a, b| {
+            norm(sub(curve.eval(*a), target)).total_cmp(&norm(sub(curve.eval(*b), target)))
+        })
+        .unwrap_or(0.0)
+}
+
+/// The switch parameter (§6 step 4): the first `u = u_min + 0.01 k < 1` with `c(u)` in
+/// `next` and `|c'(u)| > SWITCH_MIN_SPEED`; 1 when there is none.
+fn switch_parameter(curve: &Bezier, next: &Polytope, u_min: f64) -> f64 {
+    let mut k = 0;
+    loop {
+        let cand = u_min + k as f64 * U_STEP;
+        if cand >= 1.0 {
+            return 1.0;
+        }
+        if next.contains(curve.eval(cand), 1e-9) && norm(curve.d1(cand)) > SWITCH_MIN_SPEED {
+            return cand;
+        }
+        k += 1;
+    }
+}
+
+/// The window duration `T_w` (§6 step 2): to the middle of phase `J` on the data clock
+/// (at least [`MIN_WINDOW_S`]), else the polyline rule through the attractors.
+fn window_duration(
+    mid_j: Option<f64>,
+    t_cur: f64,
+    from: [f64; 3],
+    attractors: &[[f64; 3]],
+    end: [f64; 3],
+) -> f64 {
+    let mut poly_len = 0.0;
+    let mut last = from;
+    for p in attractors.iter().chain(std::iter::once(&end)) {
+        poly_len += norm(sub(*p, last));
+        last = *p;
+    }
+    match mid_j {
+        Some(m) => (m - t_cur).max(MIN_WINDOW_S),
+        None => POLYLINE_MIN_S.max(poly_len / POLYLINE_SPEED_MPS),
+    }
+}
+
+/// The sliding windows of §6 and the switch times (data boundaries, or the closest
+/// approach to each transition point without durations).
+fn windows(
+    phases: &[Phase],
+    polys: &[Polytope],
+    phase_states: &[TransitionPoint],
+    transitions: &[Transition],
+    starts: Option<&Vec<f64>>,
+    start: &ComState,
+) -> Result<(Vec<Window>, Vec<f64>), TwopacError> {
+    let n = phases.len();
+    let mid = |j: usize| -> Option<f64> {
+        starts.map(|s| s[j] + 0.5 * phases[j].duration_s.unwrap_or(0.0))
+    };
     let mut windows = Vec::new();
-    let mut switch_times_s: Vec<f64> = match &starts {
+    let mut switch_times_s: Vec<f64> = match starts {
         Some(s) => s[1..].to_vec(),
         None => vec![f64::NAN; n - 1],
     };
@@ -364,53 +504,21 @@ pub fn plan(
         let big_j = if two { j + 2 } else { j + 1 };
         let attractors: Vec<[f64; 3]> = transitions[j..big_j].iter().map(|t| t.point.com).collect();
         let end = ComState::at_rest(phase_states[big_j].com);
-        let mut poly_len = 0.0;
-        let mut last = x_cur.pos;
-        for p in attractors.iter().chain(std::iter::once(&end.pos)) {
-            poly_len += norm(sub(*p, last));
-            last = *p;
-        }
-        let t_w = match mid(big_j) {
-            Some(m) => (m - t_cur).max(MIN_WINDOW_S),
-            None => POLYLINE_MIN_S.max(poly_len / POLYLINE_SPEED_MPS),
-        };
+        let t_w = window_duration(mid(big_j), t_cur, x_cur.pos, &attractors, end.pos);
         let curve = Bezier::with_attractors(&x_cur, &end, t_w, &attractors)?;
-        let closest = |target: [f64; 3]| -> f64 {
-            (0..=100)
-                .map(|k| k as f64 * U_STEP)
-                .min_by(|a, b| {
-                    norm(sub(curve.eval(*a), target)).total_cmp(&norm(sub(curve.eval(*b), target)))
-                })
-                .unwrap_or(0.0)
-        };
         if starts.is_none() {
             for (i, t) in transitions[j..big_j].iter().enumerate() {
-                switch_times_s[j + i] = t_cur + closest(t.point.com) * t_w;
+                switch_times_s[j + i] = t_cur + closest_approach(&curve, t.point.com) * t_w;
             }
         }
         let u_end = if big_j + 1 == n {
             1.0
         } else {
-            let u_min = match &starts {
+            let u_min = match starts {
                 Some(s) => ((s[big_j] - t_cur) / t_w).clamp(0.0, 1.0),
-                None => closest(transitions[big_j - 1].point.com),
+                None => closest_approach(&curve, transitions[big_j - 1].point.com),
             };
-            let mut u = 1.0;
-            let mut k = 0;
-            loop {
-                let cand = u_min + k as f64 * U_STEP;
-                if cand >= 1.0 {
-                    break;
-                }
-                if polys[big_j].contains(curve.eval(cand), 1e-9)
-                    && norm(curve.d1(cand)) > SWITCH_MIN_SPEED
-                {
-                    u = cand;
-                    break;
-                }
-                k += 1;
-            }
-            u
+            switch_parameter(&curve, &polys[big_j], u_min)
         };
         let guarantee_phase = if two {
             j + 1
@@ -434,15 +542,7 @@ pub fn plan(
         t_cur += u_end * t_w;
         j = big_j;
     }
-    Ok(Plan {
-        mass_kg,
-        phase_states,
-        transitions,
-        windows,
-        switch_times_s,
-        phase_starts_s: starts,
-        forms,
-    })
+    Ok((windows, switch_times_s))
 }
 
 /// Per-phase diagnostics of §8: statics at the phase state and the kinematic margin.
@@ -461,7 +561,7 @@ pub fn phase_diagnostics(plan: &Plan, phases: &[Phase]) -> Vec<PhaseDiagnostic> 
         .iter()
         .zip(phases)
         .map(|(s, p)| PhaseDiagnostic {
-            static_feasible: s.is_static(1e-6),
+            static_feasible: s.is_static(STATIC_TOL),
             kinematic_margin_m: -p.polytope().max_violation(s.com),
         })
         .collect()

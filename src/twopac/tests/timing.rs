@@ -62,6 +62,13 @@ fn ten_phases() -> Vec<Phase> {
 #[test]
 #[ignore = "timing report, run by hand in release mode"]
 fn report_measured_figures() {
+    report_margins();
+    report_region_and_transitions();
+    report_plans();
+}
+
+/// Equilibrium margins of the reference scenes R1 and R2 (§8.1).
+fn report_margins() {
     let r1 = EqualityForm::new(&[point_set(&R1_POINTS, [0.0, 0.0, 1.0], 0.5)], 55.8836).unwrap();
     println!("R1 margin: {:?}", r1.verdict(R1_COM, [0.0; 3]).margin_n);
     let r2_pts = [
@@ -79,7 +86,10 @@ fn report_measured_figures() {
         "R2 margin, acc 1000: {:?}",
         r2.verdict([0.0, 0.0, 1.0], [1000.0, 0.0, 0.0]).margin_n
     );
+}
 
+/// The static region of the ring scene and the two transition QP forms, timed.
+fn report_region_and_transitions() {
     let ring = contact_points(&ring_scene());
     let opts = RegionOptions::default();
     let region = static_region(&ring, &opts).unwrap();
@@ -124,7 +134,10 @@ fn report_measured_figures() {
         med * 1e6,
         p95 * 1e6
     );
+}
 
+/// The 10-phase trajectory under both QP forms, timed, and its validation.
+fn report_plans() {
     let phases = ten_phases();
     for (name, form) in [("eq 13", QpForm::Eq13), ("eq 6", QpForm::Eq6)] {
         let po = PlanOptions {

@@ -14,11 +14,10 @@
 //!             else median ground_z
 //! ```
 
-use crate::contacts::detect::PointTrack;
-use crate::contacts::{runs, timing, EFFECTORS};
+use super::timeline::{ContactTimeline, ContactTracks};
+use super::{runs, timing, ClipMotion, EFFECTORS};
 use crate::math::stats::median;
-
-type V3 = [f64; 3];
+use crate::math::v3::V3;
 
 /// One maximal run of `contact_<e>`.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,27 +51,20 @@ pub struct ContactRun {
     pub normal: V3,
 }
 
-/// What the detector saw, per effector: its point tracks and the speed-led frames.
-pub(super) struct Detector<'a> {
-    pub tracks: &'a [Vec<PointTrack>; 4],
-    pub speed_led: &'a [Vec<bool>; 4],
-}
-
 /// Collect the runs of every effector (sorted by effector, then first frame).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn collect(
-    det: &Detector,
-    contact: &[Vec<bool>; 4],
-    stat: &[Vec<bool>; 4],
-    surf: &[Vec<Option<f64>>; 4],
-    points: &[Vec<Vec<V3>>; 4],
-    ground_z: &[f64],
-    facing: &[V3],
-    frame: &[i64],
-    time_s: &[f64],
-    dt: f64,
+pub fn collect(
+    tracks: &ContactTracks,
+    timeline: &ContactTimeline,
+    motion: &ClipMotion,
     static_mode: bool,
 ) -> Vec<ContactRun> {
+    let (contact, stat, surf) = (
+        &timeline.contact,
+        &timeline.static_contact,
+        &timeline.surface_z,
+    );
+    let (points, ground_z, dt) = (&tracks.points, &tracks.ground_z, tracks.dt);
+    let (facing, frame, time_s) = (motion.facing, motion.frame, motion.time_s);
     let n = frame.len();
     let mut out = Vec::new();
     for e in 0..4 {
@@ -97,10 +89,10 @@ pub(super) fn collect(
                 dy = (a..=b).map(|f| facing[f][1]).sum();
             }
             let first_static = static_mode.then(|| (a..=b).find(|&f| stat[e][f])).flatten();
-            let speed_led = det.speed_led[e][a..=b].iter().any(|&f| f);
+            let speed_led = timeline.speed_led[e][a..=b].iter().any(|&f| f);
             let floor = median(&ground_z[a..=b]).unwrap_or(0.0);
             let raised = || {
-                det.tracks[e]
+                tracks.tracks[e]
                     .iter()
                     .filter_map(|p| median(&p.h[a..=b]))
                     .reduce(f64::min)
@@ -110,7 +102,7 @@ pub(super) fn collect(
                 (None, true) => floor + raised().unwrap_or(0.0),
                 (None, false) => floor,
             };
-            let tracks = &det.tracks[e];
+            let own = &tracks.tracks[e];
             let prev_end = out
                 .iter()
                 .rev()
@@ -126,12 +118,12 @@ pub(super) fn collect(
                 last_frame: frame[b],
                 t_td_s: (a > 0).then(|| time_s[a] - dt / 2.0),
                 t_lo_s: (b + 1 < n).then(|| time_s[b] + dt / 2.0),
-                td_time_s: (a > 0).then(|| match e < 2 && !tracks.is_empty() {
-                    true => timing::touchdown(tracks, time_s, a, b, prev_end),
+                td_time_s: (a > 0).then(|| match e < 2 && !own.is_empty() {
+                    true => timing::touchdown(own, time_s, a, b, prev_end),
                     false => time_s[a] - dt / 2.0,
                 }),
-                lo_time_s: (b + 1 < n).then(|| match e < 2 && !tracks.is_empty() {
-                    true => timing::liftoff(tracks, time_s, a, b, next_start),
+                lo_time_s: (b + 1 < n).then(|| match e < 2 && !own.is_empty() {
+                    true => timing::liftoff(own, time_s, a, b, next_start),
                     false => time_s[b] + dt / 2.0,
                 }),
                 speed_led,
