@@ -84,8 +84,8 @@ pub const MAX_DURATION_S: f64 = 60.0;
 pub const MIN_UNIT_M: f64 = 1e-6;
 /// Largest file unit, metres per file unit; larger units are clamped.
 pub const MAX_UNIT_M: f64 = 1e6;
-/// Gravity of the force model, m/s².
-pub const GRAVITY_MPS2: f64 = 9.81;
+/// Gravity of the force model, m/s² (the crate's one [`GRAVITY`](crate::math::constants::GRAVITY)).
+pub const GRAVITY_MPS2: f64 = crate::math::constants::GRAVITY;
 /// Highest platform under the right foot's first running stance, m.
 pub const MAX_PLATFORM_M: f64 = 0.3;
 

@@ -3,10 +3,10 @@
 
 use std::collections::BTreeMap;
 
-use stancelib::library::kinematics::read_polytopes;
 use stancelib::library::read::Table;
 use stancelib::pipeline::batch::discover;
 use stancelib::pipeline::build::{build_and_write, BuildOptions};
+use stancelib::pipeline::twopac::read_polytopes;
 
 use crate::util::shared_or_skip;
 

@@ -458,8 +458,9 @@ fn running_stances_are_feasible_as_recorded() {
     // sides, asked for its own speed (the run policy at k = 1: the identity), passes the
     // exact check at μ = 0.7 with its character's absolute limits and the queries' default
     // active set; target ≥ 85 % (54 % with the Fourier model).
-    use stancelib::cli::cmd::query::{absolute_limits, load_pool, stance_limits};
+    use stancelib::pipeline::queries::load_pool;
     use stancelib::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
+    use stancelib::query::limits::{absolute_limits, stance_limits};
     use stancelib::query::run::{policy_request, scale_and_check};
     use stancelib::stances::segment::Boundary;
     let Some(lib) = nightly_library() else { return };

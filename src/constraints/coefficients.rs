@@ -58,6 +58,16 @@ pub struct ForceCoefficients {
     pub mu_req_robust: f64,
 }
 
+/// `max(a, b)`, NaN when either is NaN (`f64::max` drops a NaN, which would turn a model
+/// that evaluates to NaN into `A^F = 0`, `F_peak = 0`: a stance that looks harmless).
+fn max_nan(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
 /// Eq 9 and eq 11 coefficients, `F_peak`, `μ_req` and the unilateral test from the tables.
 ///
 /// An empty grid gives zeros, `unilateral_ok = true` and `μ_req = A^μ = +∞`.
@@ -69,12 +79,12 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
     let mut max_f_v = f64::NEG_INFINITY;
     for ((&h, &p), &v) in fh.iter().zip(fp).zip(fv) {
         let (h2, p2, v2) = (h * h, p * p, v * v);
-        a_f[0] = a_f[0].max(h2);
-        a_f[1] = a_f[1].max(p2);
-        a_f[2] = a_f[2].max(v2);
-        f_peak = f_peak.max(h2 + p2 + v2);
-        min_f_v = min_f_v.min(v);
-        max_f_v = max_f_v.max(v);
+        a_f[0] = max_nan(a_f[0], h2);
+        a_f[1] = max_nan(a_f[1], p2);
+        a_f[2] = max_nan(a_f[2], v2);
+        f_peak = max_nan(f_peak, h2 + p2 + v2);
+        min_f_v = -max_nan(-min_f_v, -v);
+        max_f_v = max_nan(max_f_v, v);
     }
     if fv.is_empty() {
         (min_f_v, max_f_v) = (0.0, 0.0);

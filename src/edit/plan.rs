@@ -18,24 +18,15 @@
 
 use super::path::{ComPath, PlannedStance};
 use super::pose::{Reference, StanceSource};
-use crate::library::queries::violation_name;
 use crate::query::feasibility::Limits;
 use crate::query::pool::{PoolStance, Prepared};
 use crate::query::run::{scale_and_check, ScaledStance};
 use crate::query::solve::Request;
+use crate::query::tables::violation_name;
 
 use crate::math::v3::V3;
 
-/// Where a source stance sits in its clip (from `stances.parquet`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StanceTiming {
-    /// Touchdown, clip time (s).
-    pub td_clip_s: f64,
-    /// Liftoff, clip time (s).
-    pub lo_clip_s: f64,
-    /// Unit heading `e_h` (world x, y).
-    pub heading: [f64; 2],
-}
+pub use crate::library::stances::StanceTiming;
 
 /// One solved stance of an edit.
 #[derive(Debug, Clone)]

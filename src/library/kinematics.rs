@@ -351,11 +351,6 @@ pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRow
     Ok(rows)
 }
 
-#[doc(hidden)]
-/// The kinematic polytopes of a library (moved to [`crate::pipeline::twopac::read_polytopes`];
-/// kept here only for callers that still name this path).
-pub use crate::pipeline::twopac::read_polytopes;
-
 /// The contact samples behind the polytopes, one row per sample: `character_id`,
 /// `effector`, `clip`, `frame`, `x`, `y`, `z` (m).
 fn points_table(rows: &[(&(String, String), &Sample)]) -> PolarsResult<DataFrame> {

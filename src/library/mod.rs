@@ -14,7 +14,6 @@ pub mod kinematics;
 pub mod plates;
 pub mod provenance;
 #[doc(hidden)]
-pub mod queries;
 pub mod read;
 pub mod schema;
 pub mod scratch;

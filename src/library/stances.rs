@@ -544,17 +544,28 @@ pub fn read_stances(path: &Path) -> Result<Vec<PoolStance>> {
     (0..t.height()).map(|i| cols.row(&t, i)).collect()
 }
 
+/// Where a source stance sits in its clip (from `stances.parquet`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceTiming {
+    /// Touchdown, clip time (s).
+    pub td_clip_s: f64,
+    /// Liftoff, clip time (s).
+    pub lo_clip_s: f64,
+    /// Unit heading `e_h` (world x, y).
+    pub heading: [f64; 2],
+}
+
 /// Where each stance of `stances.parquet` sits in its clip, in file order (the order of
 /// [`read_stances`]): touchdown, liftoff and heading.
 ///
 /// # Errors
 /// The file cannot be read, or a column is missing, mistyped or null.
-pub fn read_stance_timing(path: &Path) -> Result<Vec<crate::edit::plan::StanceTiming>> {
+pub fn read_stance_timing(path: &Path) -> Result<Vec<StanceTiming>> {
     let t = Table::open(path)?;
     let (td, lo) = (t.f64s("td_clip_s")?, t.f64s("lo_clip_s")?);
     let (hx, hy) = (t.f64s("heading_x")?, t.f64s("heading_y")?);
     Ok((0..t.height())
-        .map(|i| crate::edit::plan::StanceTiming {
+        .map(|i| StanceTiming {
             td_clip_s: td[i],
             lo_clip_s: lo[i],
             heading: [hx[i], hy[i]],

@@ -407,8 +407,9 @@ pub fn clip_character(
         .or_else(|| own_id.filter(|id| has(id)).map(str::to_string))
 }
 
-/// Friction coefficient of contacts taken from a clip (two-pac §1 default).
-const DEFAULT_CLIP_MU: f64 = 0.7;
+/// Friction coefficient of contacts taken from a clip (two-pac §1 default): the crate's
+/// default μ.
+const DEFAULT_CLIP_MU: f64 = crate::math::constants::DEFAULT_MU;
 
 #[cfg(test)]
 mod tests {

@@ -194,7 +194,10 @@ pub fn transitions_table(plan: &Plan, phases: &[Phase]) -> PolarsResult<DataFram
     cols.extend(point_cols(&points));
     cols.push(col(
         "static_feasible",
-        points.iter().map(|p| p.is_static(1e-6)).collect::<Vec<_>>(),
+        points
+            .iter()
+            .map(|p| p.is_static(crate::math::constants::STATIC_TOL))
+            .collect::<Vec<_>>(),
     ));
     cols.push(col(
         "kinematic_margin_m",

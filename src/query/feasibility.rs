@@ -81,8 +81,8 @@ use crate::constraints::{
 use crate::force_model::{basis, ForceModel, GRAVITY};
 use std::f64::consts::TAU;
 
-/// Absolute friction coefficient `μ` of `query run` (§7.5).
-pub const DEFAULT_MU: f64 = 0.7;
+/// Absolute friction coefficient `μ` of `query run` (§7.5): the crate's one default μ.
+pub use crate::math::constants::DEFAULT_MU;
 /// [`contact_point`] gives `None` when `det(AᵀA) ≤ SINGULAR_REL · tr(AᵀA)²`, i.e. when
 /// `I_v² ≤ SINGULAR_REL · |I|²` roughly (no vertical impulse: `u*` is not determined).
 pub const SINGULAR_REL: f64 = 1e-12;

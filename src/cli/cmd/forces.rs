@@ -5,9 +5,9 @@ use anyhow::Context;
 
 use super::super::args::ForcesArgs;
 use super::super::Outcome;
-use super::query::{query_kv, write_table};
 use crate::library::forces::{forces_table, read_force_stances, select_stances};
 use crate::library::schema::STANCES_FILE;
+use crate::pipeline::queries::{query_kv, write_table};
 
 /// Run `forces`.
 ///

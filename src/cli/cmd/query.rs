@@ -5,10 +5,10 @@ use std::path::Path;
 
 use super::super::args::{JumpArgs, RunQueryArgs};
 use super::super::Outcome;
-pub use crate::pipeline::queries::{load_pool, query_kv, write_table};
+use crate::pipeline::queries::{load_pool, query_kv, write_table};
 use crate::pipeline::queries::{run_query, RunQuery, RunReport};
 use crate::query::feasibility::LimitForm;
-pub use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
+use crate::query::limits::{absolute_limits, stance_limits};
 use crate::query::pairs::ranked_jump_pairs;
 use crate::query::pool::Prepared;
 use crate::query::tables::jump_table;

@@ -235,7 +235,7 @@ fn print_summary(phases: &[Phase], r: &Planned, out: &Path) {
     let n_static = p
         .transitions
         .iter()
-        .filter(|t| t.point.is_static(1e-6))
+        .filter(|t| t.point.is_static(crate::math::constants::STATIC_TOL))
         .count();
     let n_viol: usize = p.windows.iter().map(|w| w.violations.len()).sum();
     crate::say!(

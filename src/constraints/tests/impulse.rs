@@ -143,9 +143,16 @@ fn degenerate_models_do_not_panic() {
         if i >= 4 {
             assert!(!c.support_ok, "case {i}: supported");
         }
-        // A NaN force model never passes the unilateral check.
+        // A NaN force model never passes the unilateral check, and its force limit
+        // coefficients stay NaN (f64::max would drop the NaN and report A^F = 0, F_peak = 0).
         if i == 5 {
             assert!(!c.unilateral_ok, "case {i}: unilateral");
+            assert!(
+                c.a_f.iter().all(|a| a.is_nan()),
+                "case {i}: A^F {:?}",
+                c.a_f
+            );
+            assert!(c.f_peak.is_nan(), "case {i}: F_peak {}", c.f_peak);
         }
     }
     // Case 0 is the constant force 1 N on every axis: its coefficients in closed form.
