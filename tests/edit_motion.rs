@@ -43,6 +43,15 @@ fn cycle_of(lib: &Path, clip: &str) -> (String, f64) {
     (l.stances[c.stances[0]].stance_id.clone(), c.v_orig)
 }
 
+/// The 120 Hz fixture run in a library under `dir`: (source clip, library, first stance
+/// of its run cycle, recorded speed).
+fn fixture_run_cycle(dir: &Path) -> (PathBuf, PathBuf, String, f64) {
+    let src = fixture("run_120hz_m_yup");
+    let lib = library(dir, std::slice::from_ref(&src));
+    let (id, v0) = cycle_of(&lib, "run_120hz_m_yup");
+    (src, lib, id, v0)
+}
+
 /// The plan sidecar, by column.
 struct Plan {
     time: Vec<f64>,
@@ -307,8 +316,7 @@ fn rebuilt_speed(dir: &Path, out: &Path) -> f64 {
 #[test]
 fn edited_runs_round_trip_within_the_issue_bounds() {
     let dir = tmp();
-    let lib = library(dir.path(), &[fixture("run_120hz_m_yup")]);
-    let (id, v0) = cycle_of(&lib, "run_120hz_m_yup");
+    let (_, lib, id, v0) = fixture_run_cycle(dir.path());
     // See: issue 14 checks — at 2 m/s the rebuilt cycle ran at 1.89 m/s while k = v/v_orig
     // was taken as is (the periodic requests move the solved times); `refine_run_k` now
     // solves k for the speed. The flights' curvature (0.95 m/s² from −g at 4 m/s before)
@@ -413,9 +421,7 @@ fn first_window(out: &Path) -> (f64, f64, String) {
 #[test]
 fn identity_run_reproduces_the_recorded_motion() {
     let dir = tmp();
-    let src = fixture("run_120hz_m_yup");
-    let lib = library(dir.path(), std::slice::from_ref(&src));
-    let (id, v0) = cycle_of(&lib, "run_120hz_m_yup");
+    let (src, lib, id, v0) = fixture_run_cycle(dir.path());
     let out = dir.path().join("identity.bvh");
     ok(&[
         "edit",
@@ -597,9 +603,7 @@ fn edited_run_of_a_longer_heavier_character_scales_by_dynamic_similarity() {
     // by dynamic similarity (§9). At V = √L · v_orig the request is the recorded cycle at the
     // same Froude number: lengths scale by L, times by √L, and every round-trip bound holds.
     let dir = tmp();
-    let src = fixture("run_120hz_m_yup");
-    let lib = library(dir.path(), std::slice::from_ref(&src));
-    let (id, v0) = cycle_of(&lib, "run_120hz_m_yup");
+    let (src, lib, id, v0) = fixture_run_cycle(dir.path());
     let (length, mass) = (1.25f64, 1.8f64);
     let v = v0 * length.sqrt();
     let out = dir.path().join("tall.bvh");
