@@ -496,10 +496,10 @@ pub struct MapJumpsArgs {
     #[arg(long)]
     pub lib: PathBuf,
     /// Rows: apex heights `start:stop:step`, m.
-    #[arg(long, default_value = "0.6:1.6:0.02")]
+    #[arg(long, default_value = crate::query::map::DEFAULT_HEIGHTS_ARG)]
     pub heights: String,
     /// Columns: horizontal apex speeds `start:stop:step`, m/s.
-    #[arg(long, default_value = "0:5:0.05")]
+    #[arg(long, default_value = crate::query::map::DEFAULT_SPEEDS_ARG)]
     pub speeds: String,
     /// Limit form and μ (§7.5).
     #[command(flatten)]

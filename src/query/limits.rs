@@ -13,9 +13,9 @@ use crate::library::read::StanceLibrary;
 use crate::stances::limits::{limits, ClipFacts, StanceFacts, S_EFF_RANGE};
 use crate::stances::segment::Boundary;
 
-impl From<&crate::stances::limits::Limits> for Limits {
+impl From<&crate::stances::limits::CharacterLimits> for Limits {
     /// The checked part of a character's build-time limits (μ, `F_max`, `χ_min`, `χ_max`).
-    fn from(l: &crate::stances::limits::Limits) -> Self {
+    fn from(l: &crate::stances::limits::CharacterLimits) -> Self {
         Limits {
             mu: l.mu,
             f_max: l.f_max_n,

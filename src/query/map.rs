@@ -154,6 +154,11 @@ pub const DEFAULT_SPEEDS: Axis = Axis {
     stop: 5.0,
     step: 0.05,
 };
+/// [`DEFAULT_HEIGHTS`] as `map jumps --heights` writes it (the option's default; a unit
+/// test checks that it parses to the constant).
+pub const DEFAULT_HEIGHTS_ARG: &str = "0.6:1.6:0.02";
+/// [`DEFAULT_SPEEDS`] as `map jumps --speeds` writes it.
+pub const DEFAULT_SPEEDS_ARG: &str = "0:5:0.05";
 
 /// One stance's verdicts over the grid (row-major, `n_h × n_u`) and its per-row side.
 #[derive(Debug, Clone, PartialEq)]

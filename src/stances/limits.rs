@@ -59,9 +59,11 @@ pub const MIN_CHARACTER_STANCES: usize = 20;
 /// Clips whose effective time scale lies outside this range do not set limits.
 pub const S_EFF_RANGE: (f64, f64) = (0.9, 1.1);
 
-/// The limits of one character.
+/// The build-time record of one character's limits, as the manifest stores them: the
+/// checked values (μ, `F_max`, `χ_min`, `χ_max`; the queries check them as
+/// `query::feasibility::Limits`, converted by `From`) and where they came from.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Limits {
+pub struct CharacterLimits {
     /// Friction coefficient.
     pub mu: f64,
     /// Force limit, N.
@@ -96,7 +98,7 @@ fn eligible(s: &StanceFacts, clip: Option<&ClipFacts>) -> bool {
 pub fn limits(
     stances: &[StanceFacts],
     clips: &BTreeMap<String, ClipFacts>,
-) -> BTreeMap<String, Limits> {
+) -> BTreeMap<String, CharacterLimits> {
     let ok: Vec<&StanceFacts> = stances
         .iter()
         .filter(|s| eligible(s, clips.get(&s.clip)))
@@ -136,7 +138,7 @@ pub fn limits(
                 .iter()
                 .map(|s| s.ext_min * l_scale(s))
                 .fold(f64::INFINITY, f64::min);
-            let lim = Limits {
+            let lim = CharacterLimits {
                 mu: DEFAULT_MU,
                 f_max_n: MARGIN * f_peak,
                 chi_min_m: if ext_min.is_finite() {

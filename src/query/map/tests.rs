@@ -162,3 +162,15 @@ fn axis_parse_refuses_bad_and_huge_ranges() {
     assert!(check_grid("g", 1000, 1000).is_ok());
     assert!(check_grid("g", 1001, 1000).is_err());
 }
+
+#[test]
+fn default_grid_arguments_parse_to_the_default_axes() {
+    assert_eq!(
+        Axis::parse("--heights", DEFAULT_HEIGHTS_ARG).unwrap(),
+        DEFAULT_HEIGHTS
+    );
+    assert_eq!(
+        Axis::parse("--speeds", DEFAULT_SPEEDS_ARG).unwrap(),
+        DEFAULT_SPEEDS
+    );
+}
