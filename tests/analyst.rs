@@ -104,12 +104,20 @@ fn expand(token: &str) -> Vec<String> {
 fn column_tokens_expand_as_the_readme_writes_them() {
     assert_eq!(expand("c0_h/p/v"), ["c0_h", "c0_p", "c0_v"]);
     assert_eq!(expand("ell_r_min/max"), ["ell_r_min", "ell_r_max"]);
-    assert_eq!(expand("com_v{x,y,z}"), ["com_vx", "com_vy", "com_vz"]);
+    assert_eq!(
+        expand("com_v{x,y,z}_mps"),
+        ["com_vx_mps", "com_vy_mps", "com_vz_mps"]
+    );
     assert_eq!(expand("contact_<e>").len(), 4);
     assert_eq!(expand("<e>_{x,y,z}").len(), 12);
     assert_eq!(
-        expand("{left,right}_toe_{x,y}"),
-        ["left_toe_x", "left_toe_y", "right_toe_x", "right_toe_y"]
+        expand("{left,right}_toe_{x,y}_m"),
+        [
+            "left_toe_x_m",
+            "left_toe_y_m",
+            "right_toe_x_m",
+            "right_toe_y_m"
+        ]
     );
 }
 
@@ -451,6 +459,42 @@ fn quiet_prints_nothing_and_json_prints_one_summary_object() {
     assert_eq!(v["clips_reused"].as_u64(), Some(0));
 }
 
+// See: issue 17 item 7 — layout 4 renamed the columns; a library of an older layout must be
+// refused with a message to rebuild, and never reused column by column.
+#[test]
+fn a_library_of_an_older_table_layout_is_refused_and_not_reused() {
+    let demo = Demo::empty();
+    let clip = "fixtures/bvh/run_120hz_m_yup.bvh";
+    let (code, _, err) = demo.sh(&format!("stancelib build {clip} --out lib --quiet"));
+    assert_eq!(code, 0, "{err}");
+    let mpath = demo.dir.path().join("lib/manifest.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&mpath).unwrap()).unwrap();
+    m["schema"] = "stancelib.library/3".into();
+    std::fs::write(&mpath, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+    let (code, _, err) =
+        demo.sh("stancelib query run --lib lib --speed 3 --out runs.parquet --quiet");
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("manifest.json") && err.contains("table layout 3") && err.contains("rebuild"),
+        "{err}"
+    );
+    assert!(!demo.dir.path().join("runs.parquet").exists());
+    let (code, out, err) = demo.sh(&format!(
+        "stancelib build {clip} --out lib --incremental --force --json"
+    ));
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(out.trim()).expect("one JSON object");
+    assert_eq!(v["clips_reused"].as_u64(), Some(0), "{v}");
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&mpath).unwrap()).unwrap();
+    let want = format!(
+        "stancelib.library/{}",
+        stancelib::library::schema::SCHEMA_VERSION
+    );
+    assert_eq!(again["schema"], want.as_str());
+}
+
 /// Width and height of a PNG from its IHDR chunk.
 fn png_size(path: &Path) -> (u32, u32) {
     let b = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -502,9 +546,9 @@ fn equilibrium_png_draws_the_region_slice() {
     let demo = Demo::empty();
     let p = demo.dir.path().join("p.parquet");
     let mut df = DataFrame::new_infer_height(vec![
-        Column::new("x".into(), [0.0, 0.05, 2.0]),
-        Column::new("y".into(), [0.0, 0.0, 2.0]),
-        Column::new("z".into(), [0.9, 0.9, 0.9]),
+        Column::new("x_m".into(), [0.0, 0.05, 2.0]),
+        Column::new("y_m".into(), [0.0, 0.0, 2.0]),
+        Column::new("z_m".into(), [0.9, 0.9, 0.9]),
     ])
     .unwrap();
     ParquetWriter::new(std::fs::File::create(&p).unwrap())

@@ -69,25 +69,25 @@ fn frames_writes_the_documented_tables() {
     assert_eq!(names(&contacts), CONTACTS_COLUMNS.to_vec());
     assert_eq!(
         names(&joints),
-        vec!["clip", "frame", "joint", "x", "y", "z"]
+        vec!["clip", "frame", "joint", "x_m", "y_m", "z_m"]
     );
     let fcols = names(&frames);
     for c in [
         "clip",
         "frame",
-        "time_s",
-        "com_x",
-        "com_vz",
-        "com_az",
-        "ground_z",
+        "time_clip_s",
+        "com_x_m",
+        "com_vz_mps",
+        "com_az_mps2",
+        "ground_z_m",
         "contact_left_foot",
         "contact_right_hand",
         "static_left_foot",
-        "surface_z_left_foot",
-        "left_foot_x",
-        "right_hand_z",
-        "left_toe_x",
-        "right_toe_z",
+        "surface_z_left_foot_m",
+        "left_foot_x_m",
+        "right_hand_z_m",
+        "left_toe_x_m",
+        "right_toe_z_m",
     ] {
         assert!(fcols.iter().any(|f| f == c), "frames.parquet lacks {c}");
     }
@@ -354,9 +354,9 @@ fn force_model_is_selectable_and_recorded_per_stance_and_in_the_manifest() {
             .map(|s| s.map_or(0, |s| s.as_ref().len()))
             .collect()
     };
-    assert!(list_lens(&sa, "poly_v").iter().all(|&n| n >= 3));
+    assert!(list_lens(&sa, "poly_v_n").iter().all(|&n| n >= 3));
     assert!(list_lens(&sa, "harmonic_v").iter().all(|&n| n == 0));
-    assert!(list_lens(&sb, "poly_v").iter().all(|&n| n == 0));
+    assert!(list_lens(&sb, "poly_v_n").iter().all(|&n| n == 0));
     assert!(list_lens(&sb, "harmonic_v").iter().any(|&n| n > 0));
     for (lib, name) in [(&a, "ratio"), (&b, "fourier")] {
         let m: serde_json::Value =

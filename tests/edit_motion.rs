@@ -67,9 +67,9 @@ fn read_plan(out: &Path) -> Plan {
     let f = |n: &str| -> Vec<Option<f64>> { df.column(n).unwrap().f64().unwrap().iter().collect() };
     let v3 = |p: &str| -> Vec<[f64; 3]> {
         let (x, y, z) = (
-            f(&format!("{p}_x")),
-            f(&format!("{p}_y")),
-            f(&format!("{p}_z")),
+            f(&format!("{p}_x_m")),
+            f(&format!("{p}_y_m")),
+            f(&format!("{p}_z_m")),
         );
         (0..x.len())
             .map(|i| [x[i].unwrap(), y[i].unwrap(), z[i].unwrap()])
@@ -84,9 +84,9 @@ fn read_plan(out: &Path) -> Plan {
             .map(|v| v.map(String::from))
             .collect()
     };
-    let (td, lo) = (f("stance_td_s"), f("stance_lo_s"));
+    let (td, lo) = (f("stance_td_clip_s"), f("stance_lo_clip_s"));
     Plan {
-        time: f("time_s").into_iter().map(Option::unwrap).collect(),
+        time: f("time_clip_s").into_iter().map(Option::unwrap).collect(),
         com: v3("com"),
         pose_com: v3("pose_com"),
         window: td.iter().zip(&lo).map(|(a, b)| a.zip(*b)).collect(),

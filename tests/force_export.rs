@@ -43,7 +43,7 @@ fn force_export_is_the_model_on_its_grid_and_integrates_to_the_impulse() {
     assert_eq!(names, FORCES_COLUMNS);
     let ids = t.strings("stance_id").unwrap();
     let col = |n: &str| t.f64s(n).unwrap();
-    let (tau, time) = (col("tau"), col("time_s"));
+    let (tau, time) = (col("tau"), col("time_clip_s"));
     let f_st = [col("f_h_n"), col("f_p_n"), col("f_v_n")];
     let f_w = [col("fx_n"), col("fy_n"), col("fz_n")];
     // Sorted by stance_id, then tau.
@@ -64,7 +64,7 @@ fn force_export_is_the_model_on_its_grid_and_integrates_to_the_impulse() {
     let stances_file = lib.join("stances.parquet");
     let stances = read_force_stances(&stances_file).unwrap();
     let st = Table::open(&stances_file).unwrap();
-    let (j_v, mass) = (st.f64s("j_v").unwrap(), st.f64s("mass_kg").unwrap());
+    let (j_v, mass) = (st.f64s("j_v_mps").unwrap(), st.f64s("mass_kg").unwrap());
     assert!(stances.len() >= 10, "{} stances", stances.len());
     let mut start = 0;
     for (k, fs) in stances.iter().enumerate() {

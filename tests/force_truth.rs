@@ -264,7 +264,10 @@ fn force_models_round_trip_through_parquet() {
         f64col("heading_x"),
         f64col("heading_y"),
     );
-    let c0: Vec<Vec<f64>> = ["c0_h", "c0_p", "c0_v"].iter().map(|n| f64col(n)).collect();
+    let c0: Vec<Vec<f64>> = ["c0_h_n", "c0_p_n", "c0_v_n"]
+        .iter()
+        .map(|n| f64col(n))
+        .collect();
     let mut keys = Vec::new();
     let mut worst = 0.0f64;
     for i in 0..df.height() {
@@ -292,10 +295,10 @@ fn force_models_round_trip_through_parquet() {
                     .get_as_series(i)
                     .unwrap();
                 let h: Vec<i32> = h.i32().unwrap().iter().map(|v| v.unwrap()).collect();
-                let amp = list_f64(&df, &format!("amp_{ax}"), i);
-                let ph = list_f64(&df, &format!("phase_{ax}"), i);
+                let amp = list_f64(&df, &format!("amp_{ax}_n"), i);
+                let ph = list_f64(&df, &format!("phase_{ax}_rad"), i);
                 assert_eq!((h.len(), amp.len()), (ph.len(), ph.len()), "{sid} {ax}");
-                let poly = list_f64(&df, &format!("poly_{ax}"), i);
+                let poly = list_f64(&df, &format!("poly_{ax}_n"), i);
                 (c0[a][i], h, amp, ph, poly)
             })
             .collect();

@@ -26,9 +26,9 @@ fn polytopes_hold_their_points_and_put_the_com_above_the_feet() {
         pts.strings("effector").unwrap(),
     );
     let (x, y, z) = (
-        pts.f64s("x").unwrap(),
-        pts.f64s("y").unwrap(),
-        pts.f64s("z").unwrap(),
+        pts.f64s("x_m").unwrap(),
+        pts.f64s("y_m").unwrap(),
+        pts.f64s("z_m").unwrap(),
     );
     assert!(pts.height() > 1000, "{} kinematic points", pts.height());
     let mut per: BTreeMap<(String, String), usize> = BTreeMap::new();

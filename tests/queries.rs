@@ -415,12 +415,12 @@ fn consecutive_stances_describe_the_same_flight() {
     );
     let f = |c: &str| t.f64s(c).unwrap();
     let (z_c, zs, ze, vs, ve, vp, hx, hy) = (
-        f("z_c"),
-        f("zs"),
-        f("ze"),
-        f("vs"),
-        f("ve"),
-        f("vp"),
+        f("z_c_m"),
+        f("zs_m"),
+        f("ze_m"),
+        f("vs_mps"),
+        f("ve_mps"),
+        f("vp_mps"),
         f("heading_x"),
         f("heading_y"),
     );

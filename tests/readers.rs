@@ -46,12 +46,12 @@ lib = {lib:?}
 t = pq.read_table(lib + "/stances.parquet")
 assert t.num_rows == {n_stances}, t.num_rows
 meta = pq.ParquetFile(lib + "/stances.parquet").metadata.metadata
-assert meta[b"stancelib.schema_version"] == b"3", meta
+assert meta[b"stancelib.schema_version"] == {ver:?}.encode(), meta
 row = t.slice(0, 1).to_pylist()[0]
 assert row["stance_id"] == {sid:?}, row["stance_id"]
 assert abs(row["dt_s"] - {dt}) < 1e-12, row["dt_s"]
-assert abs(row["c0_v"] - {c0v}) < 1e-9 * max(1.0, abs({c0v})), row["c0_v"]
-assert len(row["harmonic_v"]) == len(row["amp_v"]) == len(row["phase_v"])
+assert abs(row["c0_v_n"] - {c0v}) < 1e-9 * max(1.0, abs({c0v})), row["c0_v_n"]
+assert len(row["harmonic_v"]) == len(row["amp_v_n"]) == len(row["phase_v_rad"])
 n = duckdb.sql(f"select count(*) from '{{lib}}/stances.parquet'").fetchall()[0][0]
 assert n == {n_stances}, n
 clips = duckdb.sql(f"select count(*) from '{{lib}}/clips.parquet' where status = 'ok'").fetchall()[0][0]
@@ -67,6 +67,7 @@ assert len(s) == {n_stances} and isinstance(s["effectors"].iloc[0][0], str), s["
 print("ok", n, frames)
 "#,
         lib = lib.display().to_string(),
+        ver = stancelib::library::schema::SCHEMA_VERSION,
         sid = first.stance_id,
         dt = first.dt_s,
         c0v = first.model.axes[2].c0,

@@ -273,9 +273,9 @@ pub(super) fn ring(n: usize) -> String {
 
 pub(super) fn write_points(path: &Path, n: usize) {
     let mut df = DataFrame::new_infer_height(vec![
-        Column::new("x".into(), vec![0.0; n]),
-        Column::new("y".into(), vec![0.0; n]),
-        Column::new("z".into(), vec![1.0; n]),
+        Column::new("x_m".into(), vec![0.0; n]),
+        Column::new("y_m".into(), vec![0.0; n]),
+        Column::new("z_m".into(), vec![1.0; n]),
     ])
     .unwrap();
     ParquetWriter::new(std::fs::File::create(path).unwrap())

@@ -413,7 +413,7 @@ fn run_stance_parameters_match_the_ballistic_truth() {
             let got = [p.zs, p.vs, p.ze, p.ve, p.vp, p.x];
             let m = &s.measured;
             let meas = [m.zs, m.vs, m.ze, m.ve, m.vp, m.x];
-            let names = ["zs", "vs", "ze", "ve", "vp", "x"];
+            let names = ["zs_m", "vs_mps", "ze_m", "ve_mps", "vp_mps", "x_m"];
             let tols = [tol_z, tol_v, tol_z, tol_v, tol_v, tol_x];
             let kind = [1, 0, 1, 0, 0, 2]; // index into worst: v, z, x
             outln!(

@@ -59,10 +59,10 @@ fn equilibrium_reference_case_r2() {
     let (_d, t) = equilibrium(
         &fixture("r2_contacts.json"),
         &[
-            ("x", vec![0.0, 0.0]),
-            ("y", vec![0.0, 0.0]),
-            ("z", vec![1.0, 1.0]),
-            ("ax", vec![0.0, 1000.0]),
+            ("x_m", vec![0.0, 0.0]),
+            ("y_m", vec![0.0, 0.0]),
+            ("z_m", vec![1.0, 1.0]),
+            ("ax_mps2", vec![0.0, 1000.0]),
         ],
     );
     let margin = t.opt_f64("margin_n").unwrap();
@@ -70,7 +70,7 @@ fn equilibrium_reference_case_r2() {
     assert!((margin[1].unwrap() + 77546.0).abs() < 1.0, "{margin:?}");
     assert_eq!(t.bools("in_equilibrium").unwrap(), [true, false]);
     assert_eq!(t.strings("status").unwrap(), ["ok", "ok"]);
-    assert_eq!(t.f64s("z").unwrap(), [1.0, 1.0]);
+    assert_eq!(t.f64s("z_m").unwrap(), [1.0, 1.0]);
 }
 
 #[test]
@@ -86,9 +86,9 @@ fn equilibrium_single_point_contact_only_on_its_vertical() {
     let (_d, t) = equilibrium(
         &c,
         &[
-            ("x", vec![0.2, 0.25, 0.2]),
-            ("y", vec![-0.1, -0.1, 0.0]),
-            ("z", vec![1.0, 1.0, 0.8]),
+            ("x_m", vec![0.2, 0.25, 0.2]),
+            ("y_m", vec![-0.1, -0.1, 0.0]),
+            ("z_m", vec![1.0, 1.0, 0.8]),
         ],
     );
     assert_eq!(
@@ -110,9 +110,9 @@ fn equilibrium_ring_scene_centre_in_far_out() {
     let (_d, t) = equilibrium(
         &fixture("ring_contacts.json"),
         &[
-            ("x", vec![0.0, 3.0]),
-            ("y", vec![0.0, 0.0]),
-            ("z", vec![0.9, 0.9]),
+            ("x_m", vec![0.0, 3.0]),
+            ("y_m", vec![0.0, 0.0]),
+            ("z_m", vec![0.9, 0.9]),
         ],
     );
     let status = t.strings("status").unwrap();
@@ -128,7 +128,7 @@ fn equilibrium_ring_scene_centre_in_far_out() {
 fn equilibrium_missing_column_names_file_and_column() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("p.parquet");
-    write_points(&p, &[("x", vec![0.0]), ("y", vec![0.0])]);
+    write_points(&p, &[("x_m", vec![0.0]), ("y_m", vec![0.0])]);
     let r = dir.path().join("r.parquet");
     let err = fails(&[
         "equilibrium",
@@ -139,7 +139,7 @@ fn equilibrium_missing_column_names_file_and_column() {
         "--out",
         &s(&r),
     ]);
-    assert!(err.contains("p.parquet") && err.contains("'z'"), "{err}");
+    assert!(err.contains("p.parquet") && err.contains("'z_m'"), "{err}");
     assert!(!r.exists());
 }
 
@@ -155,7 +155,7 @@ fn twopac(phases: &Path) -> (tempfile::TempDir, PathBuf, String) {
 }
 
 fn xyz(t: &Table, i: usize) -> [f64; 3] {
-    ["x", "y", "z"].map(|c| t.f64s(c).unwrap()[i])
+    ["x_m", "y_m", "z_m"].map(|c| t.f64s(c).unwrap()[i])
 }
 
 /// The world box of a flat contact's inline box polytope (yaw 0 and axis-aligned rows
@@ -318,7 +318,7 @@ fn twopac_hand_on_wall_runs_and_is_deterministic() {
     // The hand's polytope (wall normal −X, symmetric box) bounds the transitions that
     // keep the hand: z ≤ 1.3 + 0.2 m.
     let kp = trans.i64s("kinematics_phase").unwrap();
-    for (i, z) in trans.f64s("z").unwrap().iter().enumerate() {
+    for (i, z) in trans.f64s("z_m").unwrap().iter().enumerate() {
         if kp[i] != 0 && kp[i] != 4 {
             assert!(
                 *z <= 1.5 + 1e-9 && *z >= 1.3 - 0.75 - 1e-9,
@@ -454,17 +454,17 @@ fn twopac_plans_a_recorded_walk_with_the_library_polytopes() {
         c.i64s("last_frame").unwrap(),
     );
     let (ox, oy, oz, yaw) = (
-        c.f64s("origin_x").unwrap(),
-        c.f64s("origin_y").unwrap(),
-        c.f64s("origin_z").unwrap(),
+        c.f64s("origin_x_m").unwrap(),
+        c.f64s("origin_y_m").unwrap(),
+        c.f64s("origin_z_m").unwrap(),
         c.f64s("yaw_rad").unwrap(),
     );
     let f = Table::open(&lib.join("frames.parquet")).unwrap();
-    let (frame, time) = (f.i64s("frame").unwrap(), f.f64s("time_s").unwrap());
+    let (frame, time) = (f.i64s("frame").unwrap(), f.f64s("time_clip_s").unwrap());
     let com = [
-        f.f64s("com_x").unwrap(),
-        f.f64s("com_y").unwrap(),
-        f.f64s("com_z").unwrap(),
+        f.f64s("com_x_m").unwrap(),
+        f.f64s("com_y_m").unwrap(),
+        f.f64s("com_z_m").unwrap(),
     ];
     let row_of = |k: i64| frame.iter().position(|&x| x == k).unwrap();
     // Events: a foot run starts at first_frame, ends after last_frame; additions first.

@@ -719,7 +719,8 @@ pub struct EquilibriumArgs {
     /// Contacts file (JSON, schema `stancelib.twopac.contacts/1`).
     #[arg(long)]
     pub contacts: PathBuf,
-    /// COM states: Parquet with `x`, `y`, `z` and optionally `ax`, `ay`, `az` (m, m/s²).
+    /// COM states: Parquet with `x_m`, `y_m`, `z_m` and optionally `ax_mps2`, `ay_mps2`,
+    /// `az_mps2` (the columns of `twopac`'s `trajectory.parquet`).
     #[arg(long)]
     pub points: PathBuf,
     /// Output Parquet file.

@@ -6,11 +6,10 @@ use std::path::Path;
 use polars::prelude::*;
 
 use super::read::Table;
-use super::schema::{CLIPS_FILE, FRAMES_FILE};
-use crate::error::{Error, Result};
-
+use super::schema::{clips, flights, frames, CLIPS_FILE, FRAMES_FILE};
 /// The support effectors, in the order of the contact bars.
-pub const EFFECTORS: [&str; 4] = ["left_foot", "right_foot", "left_hand", "right_hand"];
+pub use crate::contacts::EFFECTORS;
+use crate::error::{Error, Result};
 
 /// One flight of `clips.parquet` (`flights`), the fields the plot uses.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,12 +49,21 @@ pub struct ClipView {
 /// A missing or malformed table, or a clip the library does not hold (the error lists a
 /// few clip names it does hold).
 pub fn read_clip_view(lib: &Path, clip: &str) -> Result<ClipView> {
-    let mut names = vec!["clip", "frame", "time_s", "com_z", "com_vx", "com_vy"];
-    let contact_cols: Vec<String> = EFFECTORS.iter().map(|e| format!("contact_{e}")).collect();
+    super::provenance::check_layout(lib)?;
+    let [vx_name, vy_name, _] = frames::COM_V;
+    let mut names = vec![
+        frames::CLIP,
+        frames::FRAME,
+        frames::TIME,
+        frames::COM[2],
+        vx_name,
+        vy_name,
+    ];
+    let contact_cols: Vec<String> = EFFECTORS.iter().map(|e| frames::contact(e)).collect();
     names.extend(contact_cols.iter().map(String::as_str));
     let path = lib.join(FRAMES_FILE);
     let t = Table::open_columns(&path, &names)?;
-    let clips = t.strings("clip")?;
+    let clips = t.strings(frames::CLIP)?;
     let rows: Vec<usize> = (0..clips.len()).filter(|&i| clips[i] == clip).collect();
     if rows.is_empty() {
         let mut known: Vec<&String> = clips.iter().collect();
@@ -63,19 +71,19 @@ pub fn read_clip_view(lib: &Path, clip: &str) -> Result<ClipView> {
         let sample: Vec<&str> = known.iter().take(5).map(|s| s.as_str()).collect();
         return Err(Error::column(
             &path,
-            "clip",
+            frames::CLIP,
             None,
             format!("no clip '{clip}' (clips: {}, …)", sample.join(", ")),
         ));
     }
     let pick = |v: Vec<f64>| rows.iter().map(|&i| v[i]).collect::<Vec<_>>();
-    let (vx, vy) = (pick(t.f64s("com_vx")?), pick(t.f64s("com_vy")?));
-    let frame_all = t.i64s("frame")?;
+    let (vx, vy) = (pick(t.f64s(vx_name)?), pick(t.f64s(vy_name)?));
+    let frame_all = t.i64s(frames::FRAME)?;
     let mut view = ClipView {
         clip: clip.to_string(),
         frame: rows.iter().map(|&i| frame_all[i]).collect(),
-        time_s: pick(t.f64s("time_s")?),
-        com_z: pick(t.f64s("com_z")?),
+        time_s: pick(t.f64s(frames::TIME)?),
+        com_z: pick(t.f64s(frames::COM[2])?),
         speed_xy: vx.iter().zip(&vy).map(|(x, y)| x.hypot(*y)).collect(),
         ..ClipView::default()
     };
@@ -94,8 +102,8 @@ pub fn read_clip_view(lib: &Path, clip: &str) -> Result<ClipView> {
 
 /// The flights and warnings of `clip` from `clips.parquet`.
 fn read_clip_row(path: &Path, clip: &str, view: &mut ClipView) -> Result<()> {
-    let t = Table::open_columns(path, &["clip", "flights", "warnings"])?;
-    let Some(row) = t.strings("clip")?.iter().position(|c| c == clip) else {
+    let t = Table::open_columns(path, &[clips::CLIP, clips::FLIGHTS, clips::WARNINGS])?;
+    let Some(row) = t.strings(clips::CLIP)?.iter().position(|c| c == clip) else {
         return Ok(());
     };
     let bad = |col: &str, e: PolarsError| Error::column(path, col, Some(row), e.to_string());
@@ -106,21 +114,21 @@ fn read_clip_row(path: &Path, clip: &str, view: &mut ClipView) -> Result<()> {
         let l = c.list().map_err(|e| bad(name, e))?;
         Ok(l.get_as_series(row))
     };
-    if let Some(w) = list("warnings")? {
-        let s = w.str().map_err(|e| bad("warnings", e))?;
+    if let Some(w) = list(clips::WARNINGS)? {
+        let s = w.str().map_err(|e| bad(clips::WARNINGS, e))?;
         view.warnings = s.iter().flatten().map(str::to_string).collect();
     }
-    if let Some(f) = list("flights")? {
-        let st = f.struct_().map_err(|e| bad("flights", e))?;
-        let field = |n: &str| st.field_by_name(n).map_err(|e| bad("flights", e));
-        let (first, last) = (field("first_frame")?, field("last_frame")?);
-        let (a_z, ballistic) = (field("a_z")?, field("ballistic")?);
+    if let Some(f) = list(clips::FLIGHTS)? {
+        let st = f.struct_().map_err(|e| bad(clips::FLIGHTS, e))?;
+        let field = |n: &str| st.field_by_name(n).map_err(|e| bad(clips::FLIGHTS, e));
+        let (first, last) = (field(flights::FIRST_FRAME)?, field(flights::LAST_FRAME)?);
+        let (a_z, ballistic) = (field(flights::A_Z)?, field(flights::BALLISTIC)?);
         let (first, last) = (
-            first.i64().map_err(|e| bad("flights", e))?,
-            last.i64().map_err(|e| bad("flights", e))?,
+            first.i64().map_err(|e| bad(clips::FLIGHTS, e))?,
+            last.i64().map_err(|e| bad(clips::FLIGHTS, e))?,
         );
-        let a_z = a_z.f64().map_err(|e| bad("flights", e))?;
-        let ballistic = ballistic.bool().map_err(|e| bad("flights", e))?;
+        let a_z = a_z.f64().map_err(|e| bad(clips::FLIGHTS, e))?;
+        let ballistic = ballistic.bool().map_err(|e| bad(clips::FLIGHTS, e))?;
         for i in 0..st.len() {
             if let (Some(a), Some(b)) = (first.get(i), last.get(i)) {
                 view.flights.push(FlightView {

@@ -6,7 +6,7 @@
 //! by `stance_id`, then `tau` (columns [`FORCES_COLUMNS`]; forces in N, times in s):
 //!
 //! ```text
-//! stance_id, tau, time_s = td_clip_s + tau·dt_s,
+//! stance_id, tau, time_clip_s = td_clip_s + tau·dt_s,
 //! f_h_n, f_p_n, f_v_n   (stance axes)     fx_n, fy_n, fz_n   (world, Z up)
 //! ```
 //!
@@ -20,6 +20,7 @@ use polars::prelude::*;
 
 use super::columns::col;
 use super::read::{read_stances, Table};
+use super::schema::{clips, frames, stances};
 use super::stances::PoolStance;
 use crate::error::{Error, Result};
 use crate::force_model::export::{sample_forces, StanceTimes};
@@ -30,7 +31,7 @@ use crate::stances::params::{Heading, HeadingFrom};
 pub const FORCES_COLUMNS: [&str; 9] = [
     "stance_id",
     "tau",
-    "time_s",
+    "time_clip_s",
     "f_h_n",
     "f_p_n",
     "f_v_n",
@@ -71,17 +72,24 @@ const HEADING_SOURCES: [HeadingFrom; 4] = [
 pub fn read_force_stances(path: &Path) -> Result<Vec<ForceStance>> {
     let pool = read_stances(path)?;
     let t = Table::open(path)?;
-    let ids = t.strings("stance_id")?;
-    let (td, lo, dt) = (t.f64s("td_clip_s")?, t.f64s("lo_clip_s")?, t.f64s("dt_s")?);
-    let (hx, hy) = (t.f64s("heading_x")?, t.f64s("heading_y")?);
-    let (from, last) = (t.strings("heading_from")?, t.i64s("last_frame")?);
+    let ids = t.strings(stances::STANCE_ID)?;
+    let (td, lo, dt) = (
+        t.f64s(stances::TD_CLIP)?,
+        t.f64s(stances::LO_CLIP)?,
+        t.f64s(stances::DT)?,
+    );
+    let (hx, hy) = (t.f64s(stances::HEADING_X)?, t.f64s(stances::HEADING_Y)?);
+    let (from, last) = (
+        t.strings(stances::HEADING_FROM)?,
+        t.i64s(stances::LAST_FRAME)?,
+    );
     pool.into_iter()
         .enumerate()
         .map(|(i, stance)| {
             if ids.get(i) != Some(&stance.stance_id) {
                 return Err(Error::column(
                     path,
-                    "stance_id",
+                    stances::STANCE_ID,
                     Some(i),
                     "rows out of step",
                 ));
@@ -91,7 +99,7 @@ pub fn read_force_stances(path: &Path) -> Result<Vec<ForceStance>> {
                 .find(|h| h.as_str() == from[i])
                 .ok_or_else(|| {
                     let msg = format!("unknown heading source '{}'", from[i]);
-                    Error::column(path, "heading_from", Some(i), msg)
+                    Error::column(path, stances::HEADING_FROM, Some(i), msg)
                 })?;
             Ok(ForceStance {
                 stance,
@@ -134,7 +142,7 @@ pub fn select_stances<'a>(
                     let first = stances.first().map_or("", |s| s.stance.stance_id.as_str());
                     let msg =
                         format!("no stance '{id}' in this library ({n} stances, e.g. '{first}')");
-                    Error::column(path, "stance_id", None, msg)
+                    Error::column(path, stances::STANCE_ID, None, msg)
                 })?;
             found.push(s);
         }
@@ -189,10 +197,10 @@ pub struct ClipAccelerations {
     pub com_a: Vec<[f64; 3]>,
 }
 
-/// The frames of `clip` with `t0 ≤ time_s ≤ t1` (file order, which is frame order).
+/// The frames of `clip` with `t0 ≤ time_clip_s ≤ t1` (file order, which is frame order).
 ///
 /// # Errors
-/// The file cannot be read, or `clip`, `time_s` or a `com_a*` column is missing, mistyped
+/// The file cannot be read, or `clip`, `time_clip_s` or a `com_a*` column is missing, mistyped
 /// or null.
 pub fn read_clip_accelerations(
     path: &Path,
@@ -200,10 +208,11 @@ pub fn read_clip_accelerations(
     t0: f64,
     t1: f64,
 ) -> Result<ClipAccelerations> {
-    let names = ["clip", "time_s", "com_ax", "com_ay", "com_az"];
+    let [nx, ny, nz] = frames::COM_A;
+    let names = [frames::CLIP, frames::TIME, nx, ny, nz];
     let t = Table::open_columns(path, &names)?;
-    let (clips, time_s) = (t.strings("clip")?, t.f64s("time_s")?);
-    let (ax, ay, az) = (t.f64s("com_ax")?, t.f64s("com_ay")?, t.f64s("com_az")?);
+    let (clips, time_s) = (t.strings(frames::CLIP)?, t.f64s(frames::TIME)?);
+    let (ax, ay, az) = (t.f64s(nx)?, t.f64s(ny)?, t.f64s(nz)?);
     let keep =
         (0..time_s.len()).filter(|&i| clips[i] == clip && time_s[i] >= t0 && time_s[i] <= t1);
     let mut out = ClipAccelerations::default();
@@ -220,18 +229,18 @@ pub fn read_clip_accelerations(
 /// The file cannot be read, the clip is absent, or its `up_axis` is null or unknown.
 pub fn read_up_axis(path: &Path, clip: &str) -> Result<UpAxis> {
     let t = Table::open(path)?;
-    let clips = t.strings("clip")?;
+    let clips = t.strings(clips::CLIP)?;
     let row = clips
         .iter()
         .position(|c| c == clip)
-        .ok_or_else(|| Error::column(path, "clip", None, format!("no clip '{clip}'")))?;
+        .ok_or_else(|| Error::column(path, clips::CLIP, None, format!("no clip '{clip}'")))?;
     let value =
-        t.df.column("up_axis")
+        t.df.column(clips::UP_AXIS)
             .ok()
             .and_then(|c| c.str().ok().and_then(|s| s.get(row).map(str::to_string)));
     value.as_deref().and_then(UpAxis::parse).ok_or_else(|| {
         let found = value.unwrap_or_else(|| "null".into());
         let msg = format!("expected +X … −Z, found '{found}'");
-        Error::column(path, "up_axis", Some(row), msg)
+        Error::column(path, clips::UP_AXIS, Some(row), msg)
     })
 }

@@ -10,7 +10,9 @@ use serde::Serialize;
 
 use super::provenance::manifest_sha256;
 use super::read::Table;
-use super::schema::{CLIPS_FILE, ERRORS_FILE, MANIFEST_FILE, STANCES_FILE};
+use super::schema::{
+    clips, errors, stances as S, CLIPS_FILE, ERRORS_FILE, MANIFEST_FILE, STANCES_FILE,
+};
 use crate::error::{Error, Result};
 
 /// Counts of each distinct value, sorted by value.
@@ -88,12 +90,12 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
     let m: serde_json::Value = serde_json::from_str(&text)
         .map_err(|e| Error::invalid(mpath.display().to_string(), e.to_string()))?;
     let s = |k: &str| m.get(k).and_then(|v| v.as_str()).map(str::to_string);
-    let clips = Table::open_columns(&lib.join(CLIPS_FILE), &["status", "character_id"])?;
+    let clips = Table::open_columns(&lib.join(CLIPS_FILE), &[clips::STATUS, clips::CHARACTER_ID])?;
     let stances = Table::open_columns(
         &lib.join(STANCES_FILE),
-        &["label", "boundary_start", "boundary_end", "force_model"],
+        &[S::LABEL, S::BOUNDARY_START, S::BOUNDARY_END, S::FORCE_MODEL],
     )?;
-    let errors = Table::open_columns(&lib.join(ERRORS_FILE), &["stage"])?;
+    let errors = Table::open_columns(&lib.join(ERRORS_FILE), &[errors::STAGE])?;
     Ok(LibraryInfo {
         library: lib.to_path_buf(),
         manifest_sha256: manifest_sha256(lib)?,
@@ -103,13 +105,13 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
         command_line: m
             .get("command_line")
             .and_then(|v| serde_json::from_value(v.clone()).ok()),
-        clips_by_status: column_counts(&clips, "status")?,
-        clips_by_character: column_counts(&clips, "character_id")?,
-        stances_by_label: column_counts(&stances, "label")?,
-        boundary_start: column_counts(&stances, "boundary_start")?,
-        boundary_end: column_counts(&stances, "boundary_end")?,
-        stances_by_force_model: column_counts(&stances, "force_model")?,
-        failures_by_stage: column_counts(&errors, "stage")?,
+        clips_by_status: column_counts(&clips, clips::STATUS)?,
+        clips_by_character: column_counts(&clips, clips::CHARACTER_ID)?,
+        stances_by_label: column_counts(&stances, S::LABEL)?,
+        boundary_start: column_counts(&stances, S::BOUNDARY_START)?,
+        boundary_end: column_counts(&stances, S::BOUNDARY_END)?,
+        stances_by_force_model: column_counts(&stances, S::FORCE_MODEL)?,
+        failures_by_stage: column_counts(&errors, errors::STAGE)?,
         options: m.get("options").cloned().unwrap_or_default(),
         limits: m.get("limits").cloned().unwrap_or_default(),
     })

@@ -4,9 +4,9 @@
 //! from the samples in memory by [`crate::twopac::kinematic`].
 //!
 //! `kinematics.parquet`: one row per facet, `character_id`, `effector`, `nx`, `ny`, `nz`,
-//! `d` (`n·ʳc ≤ d`, unit outward `n`, metres, contact frame), sorted by (`character_id`,
-//! `effector`, `nx`, `ny`, `nz`, `d`). `kinematics_points.parquet`: the points after the
-//! outlier rules, `character_id`, `effector`, `clip`, `frame`, `x`, `y`, `z`, sorted by
+//! `d_m` (`n·ʳc ≤ d`, unit outward `n`, metres, contact frame), sorted by (`character_id`,
+//! `effector`, `nx`, `ny`, `nz`, `d_m`). `kinematics_points.parquet`: the points after the
+//! outlier rules, `character_id`, `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m`, sorted by
 //! (`character_id`, `effector`, `clip`, `frame`).
 
 use std::collections::BTreeMap;
@@ -17,7 +17,7 @@ use polars::prelude::*;
 
 use super::columns::col;
 use super::read::Table;
-use super::schema::KINEMATICS_FILE;
+use super::schema::{clips as C, contacts as CT, frames as F, kinematics as K, KINEMATICS_FILE};
 use crate::error::{Error, Result};
 use crate::kinematics::com_in_contact_frame;
 
@@ -58,11 +58,11 @@ fn i64s(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<i64>>> {
 
 /// Per clip: `frame → COM` (world, m).
 fn com_by_frame(frames: &DataFrame) -> PolarsResult<BTreeMap<String, BTreeMap<i64, [f64; 3]>>> {
-    let (clip, frame) = (strs(frames, "clip")?, i64s(frames, "frame")?);
+    let (clip, frame) = (strs(frames, F::CLIP)?, i64s(frames, F::FRAME)?);
     let xyz = [
-        f64s(frames, "com_x")?,
-        f64s(frames, "com_y")?,
-        f64s(frames, "com_z")?,
+        f64s(frames, F::COM[0])?,
+        f64s(frames, F::COM[1])?,
+        f64s(frames, F::COM[2])?,
     ];
     let mut out: BTreeMap<String, BTreeMap<i64, [f64; 3]>> = BTreeMap::new();
     for i in 0..frames.height() {
@@ -80,8 +80,8 @@ fn com_by_frame(frames: &DataFrame) -> PolarsResult<BTreeMap<String, BTreeMap<i6
 /// Each clip's character (`clip → character_id`) from a clips table, for the clips with a
 /// leg length (the others have no samples).
 fn characters(clips: &DataFrame) -> PolarsResult<BTreeMap<String, String>> {
-    let (names, chars) = (strs(clips, "clip")?, strs(clips, "character_id")?);
-    let legs = f64s(clips, "leg_length_m")?;
+    let (names, chars) = (strs(clips, C::CLIP)?, strs(clips, C::CHARACTER_ID)?);
+    let legs = f64s(clips, C::LEG_LENGTH)?;
     Ok(names
         .into_iter()
         .zip(chars)
@@ -98,9 +98,9 @@ fn characters(clips: &DataFrame) -> PolarsResult<BTreeMap<String, String>> {
 /// The table lacks `clip`, `character_id` or `leg_length_m`.
 pub fn add_character_legs(legs: &mut BTreeMap<String, f64>, clips: &DataFrame) -> PolarsResult<()> {
     let (names, chars, lens) = (
-        strs(clips, "clip")?,
-        strs(clips, "character_id")?,
-        f64s(clips, "leg_length_m")?,
+        strs(clips, C::CLIP)?,
+        strs(clips, C::CHARACTER_ID)?,
+        f64s(clips, C::LEG_LENGTH)?,
     );
     for i in 0..clips.height() {
         if let (Some(_), Some(c), Some(l)) = (&names[i], &chars[i], lens[i]) {
@@ -112,7 +112,7 @@ pub fn add_character_legs(legs: &mut BTreeMap<String, f64>, clips: &DataFrame) -
 
 /// The kinematic samples of whole clips: every contact frame's COM in its contact frame,
 /// before the outlier rules, one row per (character, effector, clip, frame) with
-/// `character_id`, `effector`, `clip`, `frame`, `x`, `y`, `z` (m), sorted by those four
+/// `character_id`, `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m` (m), sorted by those four
 /// keys. This is the per-character summary a shard keeps (`kinematics_samples.parquet`):
 /// the polytopes of a merge are made from the shards' samples.
 ///
@@ -125,17 +125,17 @@ pub fn samples_table(
 ) -> PolarsResult<DataFrame> {
     let coms = com_by_frame(frames)?;
     let character = characters(clips)?;
-    let (clip, eff) = (strs(contacts, "clip")?, strs(contacts, "effector")?);
+    let (clip, eff) = (strs(contacts, CT::CLIP)?, strs(contacts, CT::EFFECTOR)?);
     let (first, last) = (
-        i64s(contacts, "first_frame")?,
-        i64s(contacts, "last_frame")?,
+        i64s(contacts, CT::FIRST_FRAME)?,
+        i64s(contacts, CT::LAST_FRAME)?,
     );
     let origin = [
-        f64s(contacts, "origin_x")?,
-        f64s(contacts, "origin_y")?,
-        f64s(contacts, "origin_z")?,
+        f64s(contacts, CT::ORIGIN_X)?,
+        f64s(contacts, CT::ORIGIN_Y)?,
+        f64s(contacts, CT::ORIGIN_Z)?,
     ];
-    let yaw = f64s(contacts, "yaw_rad")?;
+    let yaw = f64s(contacts, CT::YAW)?;
     let mut rows: Vec<(&str, &str, &str, i64, [f64; 3])> = Vec::new();
     for i in 0..contacts.height() {
         let (Some(c), Some(e), Some(a), Some(b), Some(y)) =
@@ -157,18 +157,21 @@ pub fn samples_table(
     rows.sort_by(|x, y| (x.0, x.1, x.2, x.3).cmp(&(y.0, y.1, y.2, y.3)));
     let p = |a: usize| -> Vec<f64> { rows.iter().map(|r| r.4[a]).collect() };
     DataFrame::new_infer_height(vec![
-        col("character_id", rows.iter().map(|r| r.0).collect::<Vec<_>>()),
-        col("effector", rows.iter().map(|r| r.1).collect::<Vec<_>>()),
-        col("clip", rows.iter().map(|r| r.2).collect::<Vec<_>>()),
-        col("frame", rows.iter().map(|r| r.3).collect::<Vec<_>>()),
-        col("x", p(0)),
-        col("y", p(1)),
-        col("z", p(2)),
+        col(
+            K::CHARACTER_ID,
+            rows.iter().map(|r| r.0).collect::<Vec<_>>(),
+        ),
+        col(K::EFFECTOR, rows.iter().map(|r| r.1).collect::<Vec<_>>()),
+        col(K::CLIP, rows.iter().map(|r| r.2).collect::<Vec<_>>()),
+        col(K::FRAME, rows.iter().map(|r| r.3).collect::<Vec<_>>()),
+        col(K::POINT[0], p(0)),
+        col(K::POINT[1], p(1)),
+        col(K::POINT[2], p(2)),
     ])
 }
 
 /// Sort keys of a samples table (see [`samples_table`]).
-pub const SAMPLES_SORT_KEYS: [&str; 4] = ["character_id", "effector", "clip", "frame"];
+pub const SAMPLES_SORT_KEYS: [&str; 4] = [K::CHARACTER_ID, K::EFFECTOR, K::CLIP, K::FRAME];
 
 /// Samples grouped by (character, effector), in (clip, frame) order, from a samples table
 /// sorted by [`SAMPLES_SORT_KEYS`].
@@ -178,12 +181,16 @@ fn add_groups(groups: &mut Groups, samples: &DataFrame) -> PolarsResult<()> {
     let f64_col =
         |n: &str| -> PolarsResult<Float64Chunked> { Ok(samples.column(n)?.f64()?.clone()) };
     let (ch, eff, clip) = (
-        str_col("character_id")?,
-        str_col("effector")?,
-        str_col("clip")?,
+        str_col(K::CHARACTER_ID)?,
+        str_col(K::EFFECTOR)?,
+        str_col(K::CLIP)?,
     );
-    let frame = samples.column("frame")?.i64()?.clone();
-    let (x, y, z) = (f64_col("x")?, f64_col("y")?, f64_col("z")?);
+    let frame = samples.column(K::FRAME)?.i64()?.clone();
+    let (x, y, z) = (
+        f64_col(K::POINT[0])?,
+        f64_col(K::POINT[1])?,
+        f64_col(K::POINT[2])?,
+    );
     // One shared name per run of a clip's samples (memory: a pointer per sample).
     let mut last_clip: Option<Arc<str>> = None;
     let mut group: Option<((String, String), Vec<Sample>)> = None;
@@ -303,17 +310,17 @@ pub fn kinematics_tables(
     let f = |g: &dyn Fn(&Facet) -> f64| -> Vec<f64> { facets.iter().map(g).collect() };
     let facet_df = DataFrame::new_infer_height(vec![
         col(
-            "character_id",
+            K::CHARACTER_ID,
             facets.iter().map(|r| r.0.clone()).collect::<Vec<_>>(),
         ),
         col(
-            "effector",
+            K::EFFECTOR,
             facets.iter().map(|r| r.1.clone()).collect::<Vec<_>>(),
         ),
-        col("nx", f(&|r| r.2[0])),
-        col("ny", f(&|r| r.2[1])),
-        col("nz", f(&|r| r.2[2])),
-        col("d", f(&|r| r.3)),
+        col(K::NORMAL[0], f(&|r| r.2[0])),
+        col(K::NORMAL[1], f(&|r| r.2[1])),
+        col(K::NORMAL[2], f(&|r| r.2[2])),
+        col(K::OFFSET, f(&|r| r.3)),
     ])?;
     let rows: Vec<(&(String, String), &Sample)> = kept
         .iter()
@@ -330,8 +337,13 @@ pub fn kinematics_tables(
 /// `kinematics.parquet` missing or malformed (the error names the file, column and row).
 pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRows>> {
     let t = Table::open(&lib_dir.join(KINEMATICS_FILE))?;
-    let (ch, eff) = (t.strings("character_id")?, t.strings("effector")?);
-    let (nx, ny, nz, d) = (t.f64s("nx")?, t.f64s("ny")?, t.f64s("nz")?, t.f64s("d")?);
+    let (ch, eff) = (t.strings(K::CHARACTER_ID)?, t.strings(K::EFFECTOR)?);
+    let (nx, ny, nz, d) = (
+        t.f64s(K::NORMAL[0])?,
+        t.f64s(K::NORMAL[1])?,
+        t.f64s(K::NORMAL[2])?,
+        t.f64s(K::OFFSET)?,
+    );
     let mut rows: BTreeMap<(String, String), FacetRows> = BTreeMap::new();
     for i in 0..t.height() {
         let n = [nx[i], ny[i], nz[i]];
@@ -339,7 +351,7 @@ pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRow
         if !((norm - 1.0).abs() <= 1e-6 && d[i].is_finite()) {
             return Err(Error::column(
                 &t.path,
-                "nx",
+                K::NORMAL[0],
                 Some(i),
                 "facet normal is not a unit vector or d is not finite",
             ));
@@ -352,29 +364,29 @@ pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRow
 }
 
 /// The contact samples behind the polytopes, one row per sample: `character_id`,
-/// `effector`, `clip`, `frame`, `x`, `y`, `z` (m).
+/// `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m` (m).
 fn points_table(rows: &[(&(String, String), &Sample)]) -> PolarsResult<DataFrame> {
     let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
     DataFrame::new_infer_height(vec![
         col(
-            "character_id",
+            K::CHARACTER_ID,
             rows.iter().map(|(k, _)| k.0.as_str()).collect::<Vec<_>>(),
         ),
         col(
-            "effector",
+            K::EFFECTOR,
             rows.iter().map(|(k, _)| k.1.as_str()).collect::<Vec<_>>(),
         ),
         col(
-            "clip",
+            K::CLIP,
             rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
         ),
         col(
-            "frame",
+            K::FRAME,
             rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
         ),
-        col("x", p(0)),
-        col("y", p(1)),
-        col("z", p(2)),
+        col(K::POINT[0], p(0)),
+        col(K::POINT[1], p(1)),
+        col(K::POINT[2], p(2)),
     ])
 }
 

@@ -16,7 +16,7 @@ use sha2::{Digest, Sha256};
 
 #[cfg(doc)]
 use super::schema::LIBRARY_MANIFEST_KEY;
-use super::schema::MANIFEST_FILE;
+use super::schema::{MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION};
 use crate::error::{Error, Result};
 use crate::skeleton::com::Sex;
 
@@ -81,6 +81,39 @@ pub fn manifest_sha256(lib: &Path) -> Result<String> {
         .collect())
 }
 
+/// The table layout a library's manifest names (`schema`: `stancelib.library/<version>`),
+/// `None` when the folder has no readable stancelib manifest.
+pub fn library_layout(lib: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(lib.join(MANIFEST_FILE)).ok()?;
+    let m: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let schema = m.get("schema")?.as_str()?;
+    schema
+        .strip_prefix(MANIFEST_SCHEMA_PREFIX)
+        .map(str::to_string)
+}
+
+/// Refuses a library written with another table layout than this tool's
+/// ([`SCHEMA_VERSION`]): its columns have other names (layout 4 renamed them to carry
+/// their units), so reading it would fail column by column or, worse, half-succeed.
+/// A folder without a stancelib manifest passes (its tables are checked as they are read).
+///
+/// # Errors
+/// The manifest names another layout (the message says how to rebuild).
+pub fn check_layout(lib: &Path) -> Result<()> {
+    match library_layout(lib) {
+        Some(v) if v != SCHEMA_VERSION => Err(Error::config(
+            Some(lib.join(MANIFEST_FILE)),
+            None,
+            format!(
+                "the library was written with table layout {v}; this stancelib reads layout \
+                 {SCHEMA_VERSION} (columns renamed with unit suffixes): rebuild it with \
+                 `stancelib build`"
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// The body a library was built with: the de Leva column and the landmark overrides
 /// (manifest `options.ingest.sex`, `options.ingest.landmarks`), so that an edit poses its
 /// motion with the same segment model the library's COM was measured with. A manifest
@@ -89,6 +122,7 @@ pub fn manifest_sha256(lib: &Path) -> Result<String> {
 /// # Errors
 /// The manifest cannot be read or parsed, or names an unknown sex (the field is named).
 pub fn library_body(lib: &Path) -> Result<(Sex, BTreeMap<String, String>)> {
+    check_layout(lib)?;
     let path = lib.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, "cannot read", e))?;
     let m: serde_json::Value = serde_json::from_str(&text)

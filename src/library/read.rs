@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use super::stances::PoolStance;
 pub use super::stances::{read_stance_timing, read_stances};
 
-use super::schema::{CLIPS_FILE, STANCES_FILE};
+use super::schema::{clips, CLIPS_FILE, STANCES_FILE};
 
 /// Read a Parquet file into a DataFrame.
 ///
@@ -250,10 +250,10 @@ pub struct StanceLibrary {
 pub fn read_clip_info(path: &Path) -> Result<BTreeMap<String, ClipInfo>> {
     let t = Table::open(path)?;
     let (names, s_eff, leg, mass) = (
-        t.strings("clip")?,
-        t.opt_f64("s_eff")?,
-        t.opt_f64("leg_length_m")?,
-        t.opt_f64("mass_kg")?,
+        t.strings(clips::CLIP)?,
+        t.opt_f64(clips::S_EFF)?,
+        t.opt_f64(clips::LEG_LENGTH)?,
+        t.opt_f64(clips::MASS)?,
     );
     Ok(names
         .into_iter()
@@ -272,8 +272,10 @@ pub fn read_clip_info(path: &Path) -> Result<BTreeMap<String, ClipInfo>> {
 /// Opens a library folder: its stances and clips.
 ///
 /// # Errors
-/// A missing or unreadable `stances.parquet` or `clips.parquet` (the error names it).
+/// A library of another table layout ([`super::provenance::check_layout`]), a missing or
+/// unreadable `stances.parquet` or `clips.parquet` (the error names it).
 pub fn open_library(dir: &Path) -> Result<StanceLibrary> {
+    super::provenance::check_layout(dir)?;
     Ok(StanceLibrary {
         dir: dir.to_path_buf(),
         stances: read_stances(&dir.join(STANCES_FILE))?,
@@ -301,11 +303,14 @@ pub struct ClipSource {
 pub fn read_clip_sources(path: &Path) -> Result<BTreeMap<String, ClipSource>> {
     let t = Table::open(path)?;
     let (names, paths, sha) = (
-        t.strings("clip")?,
-        t.strings("path")?,
-        t.strings("content_sha256")?,
+        t.strings(clips::CLIP)?,
+        t.strings(clips::PATH)?,
+        t.strings(clips::CONTENT_SHA256)?,
     );
-    let (unit, up) = (t.opt_f64("unit_scale")?, opt_strings(&t, "up_axis")?);
+    let (unit, up) = (
+        t.opt_f64(clips::UNIT_SCALE)?,
+        opt_strings(&t, clips::UP_AXIS)?,
+    );
     Ok(names
         .into_iter()
         .enumerate()

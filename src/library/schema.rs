@@ -1,15 +1,20 @@
-//! Column names of the output tables, in one place (spec com-from-bvh §8).
+//! File names, metadata keys and column names of the library tables, each defined once:
+//! the writers and the readers of a table use these constants.
 //!
-//! `frames.parquet` (sorted by `clip`, `frame`): `clip`, `frame`, `time_s`, `com_{x,y,z}`,
-//! `com_v{x,y,z}`, `com_a{x,y,z}`, `ground_z`, `contact_<e>`, `static_<e>`,
-//! `surface_z_<e>`, `<e>_{x,y,z}`, `{left,right}_toe_{x,y,z}`.
-//! `clips.parquet` (sorted by `clip`): see [`CLIPS_COLUMNS`].
-//! `contacts.parquet` (sorted by `clip`, `effector`, `first_frame`): see [`CONTACTS_COLUMNS`].
-//! `joints.parquet` (sorted by `clip`, `frame`, then file joint order): `clip`, `frame`,
-//! `joint`, `x`, `y`, `z`.
+//! Naming rules (table layout 4):
+//! - every physical quantity ends in its unit: `_m`, `_mps` (m/s), `_mps2` (m/s²), `_n` (N),
+//!   `_n2` (N²), `_nms` (N·m·s), `_s`, `_rad`, `_kg`; dimensionless columns (ratios, μ,
+//!   unit vectors, counts, flags) have none;
+//! - an instant says which clock it is on: `_clip_s` is clip time (s from the file's first
+//!   MOTION row, `frame · frame_time_s`), `_stance_s` is stance time (s from the stance's
+//!   start apex, the paper's `t = 0`); a bare `_s` is a duration (`dt_s`, `duration_s`).
+//!
+//! Sort orders: `frames.parquet` by (`clip`, `frame`); `clips.parquet` by `clip`;
+//! `contacts.parquet` by (`clip`, `effector`, `first_frame`); `joints.parquet` by (`clip`,
+//! `frame`, file joint order); `stances.parquet` by (`clip`, `first_frame`, `label`).
 
 /// Version of the table layout; bumped on any column change.
-pub const SCHEMA_VERSION: &str = "3";
+pub const SCHEMA_VERSION: &str = "4";
 /// Per-frame table.
 pub const FRAMES_FILE: &str = "frames.parquet";
 /// Per-clip table.
@@ -69,167 +74,567 @@ pub fn command_kv(key: &str, options: &serde_json::Value) -> Vec<(String, String
     ]
 }
 
+/// Column names of `frames.parquet`: one row per kept frame.
+pub mod frames {
+    use crate::contacts::EFFECTORS;
+
+    /// Axis suffixes of the position columns.
+    const AXES: [&str; 3] = ["x", "y", "z"];
+    /// `clip`: clip name.
+    pub const CLIP: &str = "clip";
+    /// `frame`: the file's MOTION row index.
+    pub const FRAME: &str = "frame";
+    /// `time_clip_s`: clip time of the frame, s.
+    pub const TIME: &str = "time_clip_s";
+    /// Whole-body COM, world frame (Z up), m.
+    pub const COM: [&str; 3] = ["com_x_m", "com_y_m", "com_z_m"];
+    /// COM velocity, m/s.
+    pub const COM_V: [&str; 3] = ["com_vx_mps", "com_vy_mps", "com_vz_mps"];
+    /// COM acceleration, m/s².
+    pub const COM_A: [&str; 3] = ["com_ax_mps2", "com_ay_mps2", "com_az_mps2"];
+    /// `ground_z_m`: the local floor height under the body, m.
+    pub const GROUND_Z: &str = "ground_z_m";
+    /// The toe points written besides the effectors (`<toe>_{x,y,z}_m`).
+    pub const TOES: [&str; 2] = ["left_toe", "right_toe"];
+
+    /// `contact_<e>`: effector `e` in contact (boolean).
+    pub fn contact(e: &str) -> String {
+        format!("contact_{e}")
+    }
+
+    /// `static_<e>`: effector `e`'s contact triggered by a static point (boolean, null
+    /// without static detection).
+    pub fn is_static(e: &str) -> String {
+        format!("static_{e}")
+    }
+
+    /// `surface_z_<e>_m`: height of the surface under effector `e`, m.
+    pub fn surface_z(e: &str) -> String {
+        format!("surface_z_{e}_m")
+    }
+
+    /// `<point>_{x,y,z}_m`: world position of an effector (ankle or wrist) or toe, m.
+    pub fn position(point: &str, axis: usize) -> String {
+        format!("{point}_{}_m", AXES[axis])
+    }
+
+    /// Every column, in file order.
+    pub fn columns() -> Vec<String> {
+        let mut c: Vec<String> = [CLIP, FRAME, TIME].map(String::from).to_vec();
+        c.extend(
+            COM.iter()
+                .chain(&COM_V)
+                .chain(&COM_A)
+                .map(|s| s.to_string()),
+        );
+        c.push(GROUND_Z.into());
+        c.extend(EFFECTORS.iter().map(|e| contact(e)));
+        for e in EFFECTORS {
+            c.extend([is_static(e), surface_z(e)]);
+        }
+        for p in EFFECTORS.iter().chain(&TOES) {
+            c.extend((0..3).map(|a| position(p, a)));
+        }
+        c
+    }
+}
+
+/// Column names of `joints.parquet` (with `--joints`): one row per clip, frame and joint.
+pub mod joints {
+    /// `joint`: joint name (End Sites as `<parent>/End`).
+    pub const JOINT: &str = "joint";
+    /// World joint position, m.
+    pub const POSITION: [&str; 3] = ["x_m", "y_m", "z_m"];
+}
+
+/// Column names of `kinematics.parquet` (one row per polytope facet) and of
+/// `kinematics_points.parquet` / `kinematics_samples.parquet` (one row per point).
+pub mod kinematics {
+    /// `character_id`: the character.
+    pub const CHARACTER_ID: &str = "character_id";
+    /// `effector`: the contact effector whose frame the polytope is in.
+    pub const EFFECTOR: &str = "effector";
+    /// Facet normal in the contact frame (unit vector).
+    pub const NORMAL: [&str; 3] = ["nx", "ny", "nz"];
+    /// `d_m`: facet offset, `n·c ≤ d`, m.
+    pub const OFFSET: &str = "d_m";
+    /// `clip`: the point's clip.
+    pub const CLIP: &str = "clip";
+    /// `frame`: the point's frame.
+    pub const FRAME: &str = "frame";
+    /// COM relative to the contact in the contact frame, m.
+    pub const POINT: [&str; 3] = ["x_m", "y_m", "z_m"];
+    /// Columns of `kinematics.parquet`, in order.
+    pub const FACET_COLUMNS: [&str; 6] = [
+        CHARACTER_ID,
+        EFFECTOR,
+        NORMAL[0],
+        NORMAL[1],
+        NORMAL[2],
+        OFFSET,
+    ];
+    /// Columns of `kinematics_points.parquet` and `kinematics_samples.parquet`, in order.
+    pub const POINT_COLUMNS: [&str; 7] = [
+        CHARACTER_ID,
+        EFFECTOR,
+        CLIP,
+        FRAME,
+        POINT[0],
+        POINT[1],
+        POINT[2],
+    ];
+}
+
+/// Column names of `errors.parquet`: one row per failed input or stage.
+pub mod errors {
+    /// `path`: the input path as given.
+    pub const PATH: &str = "path";
+    /// `clip`: clip name, when the file got one.
+    pub const CLIP: &str = "clip";
+    /// `stage`: `parse`, `mapping`, `frames` or `stances`.
+    pub const STAGE: &str = "stage";
+    /// `message`: the error, naming the file, line or field.
+    pub const MESSAGE: &str = "message";
+    /// Every column, in file order.
+    pub const COLUMNS: [&str; 4] = [PATH, CLIP, STAGE, MESSAGE];
+}
+
 /// Columns of `clips.parquet`, in order.
-pub const CLIPS_COLUMNS: [&str; 24] = [
-    "path",
-    "clip",
-    "content_sha256",
-    "status",
-    "message",
-    "frames_header",
-    "frames_data",
-    "frames_kept",
-    "leadin_dropped",
-    "frame_time_s",
-    "unit_scale",
-    "unit",
-    "up_axis",
-    "handedness_ok",
-    "leg_length_m",
-    "character_id",
-    "mass_kg",
-    "skeleton",
-    "toe_tip_rule_left",
-    "toe_tip_rule_right",
-    "flights",
-    "flight_az_median",
-    "s_eff",
-    "warnings",
-];
-
+pub const CLIPS_COLUMNS: [&str; 24] = clips::COLUMNS;
 /// Fields of the `flights` struct in `clips.parquet`.
-pub const FLIGHT_FIELDS: [&str; 11] = [
-    "first_frame",
-    "last_frame",
-    "duration_s",
-    "a_z",
-    "a_x",
-    "a_y",
-    "rms_m",
-    "s_eff",
-    "a_z_mean",
-    "ballistic",
-    "tested",
-];
-
+pub const FLIGHT_FIELDS: [&str; 11] = flights::COLUMNS;
 /// Columns of `contacts.parquet`, in order.
-pub const CONTACTS_COLUMNS: [&str; 18] = [
-    "clip",
-    "effector",
-    "first_frame",
-    "last_frame",
-    "t_td_s",
-    "t_lo_s",
-    "td_time_s",
-    "lo_time_s",
-    "static",
-    "speed_led",
-    "surface_z",
-    "origin_x",
-    "origin_y",
-    "origin_z",
-    "yaw_rad",
-    "normal_x",
-    "normal_y",
-    "normal_z",
-];
-
-/// Columns of `stances.parquet`, in order (spec stance-model §11; written by
-/// [`super::stances::stances_table`], read by [`super::stances::read_stances`]).
-pub const STANCES_COLUMNS: [&str; 85] = [
-    "stance_id",
-    "clip",
-    "character_id",
-    "label",
-    "effectors",
-    "first_frame",
-    "last_frame",
-    "td_clip_s",
-    "lo_clip_s",
-    "t_td_s",
-    "t_lo_s",
-    "t_e_s",
-    "dt_s",
-    "boundary_start",
-    "boundary_end",
-    "rest_at_edge",
-    "flight_before",
-    "flight_after",
-    "heading_x",
-    "heading_y",
-    "heading_from",
-    "z_c",
-    "zs",
-    "vs",
-    "ze",
-    "ve",
-    "vp",
-    "x",
-    "vps",
-    "z_td",
-    "z_lo",
-    "ze_measured",
-    "ve_measured",
-    "vp_measured",
-    "x_measured",
-    "mass_kg",
-    "c0_h",
-    "c0_p",
-    "c0_v",
-    "harmonic_h",
-    "harmonic_p",
-    "harmonic_v",
-    "amp_h",
-    "amp_p",
-    "amp_v",
-    "phase_h",
-    "phase_p",
-    "phase_v",
-    "fit_rms_h",
-    "fit_rms_p",
-    "fit_rms_v",
-    "poly_h",
-    "poly_p",
-    "poly_v",
-    "ratio_h",
-    "ratio_p",
-    "force_model",
-    "j_h",
-    "j_p",
-    "j_v",
-    "k_h",
-    "k_p",
-    "k_v",
-    "s_bar_h",
-    "s_bar_p",
-    "s_bar_v",
-    "support_ok",
-    "unilateral_ok",
-    "min_f_v",
-    "a_f",
-    "a_mu",
-    "f_peak",
-    "mu_req",
-    "mu_req_robust",
-    "ext_min",
-    "ext_max",
-    "cp_h",
-    "cp_p",
-    "ang_impulse",
-    "ang_impulse_h0",
-    "ell_r_min",
-    "ell_r_max",
-    "ell_s_min",
-    "ell_s_max",
-    "warnings",
-];
-
+pub const CONTACTS_COLUMNS: [&str; 18] = contacts::COLUMNS;
+/// Columns of `stances.parquet`, in order (written by [`super::stances::stances_table`],
+/// read by [`super::stances::read_stances`]).
+pub const STANCES_COLUMNS: [&str; 85] = stances::COLUMNS;
 /// Columns of `errors.parquet`, in order.
-pub const ERRORS_COLUMNS: [&str; 4] = ["path", "clip", "stage", "message"];
-
+pub const ERRORS_COLUMNS: [&str; 4] = errors::COLUMNS;
 /// Columns of `kinematics.parquet` (one row per facet), in order.
-pub const KINEMATICS_COLUMNS: [&str; 6] = ["character_id", "effector", "nx", "ny", "nz", "d"];
-
+pub const KINEMATICS_COLUMNS: [&str; 6] = kinematics::FACET_COLUMNS;
 /// Columns of `kinematics_points.parquet` and `kinematics_samples.parquet`, in order.
-pub const KINEMATICS_POINTS_COLUMNS: [&str; 7] =
-    ["character_id", "effector", "clip", "frame", "x", "y", "z"];
+pub const KINEMATICS_POINTS_COLUMNS: [&str; 7] = kinematics::POINT_COLUMNS;
+
+/// Column names of `clips.parquet`: one row per input file.
+pub mod clips {
+    /// `path`: The input path as given.
+    pub const PATH: &str = "path";
+    /// `clip`: Clip name (file stem, made unique).
+    pub const CLIP: &str = "clip";
+    /// `content_sha256`: SHA-256 of the file's bytes, hex.
+    pub const CONTENT_SHA256: &str = "content_sha256";
+    /// `status`: `ok`, `skipped` or `error`.
+    pub const STATUS: &str = "status";
+    /// `message`: Why a clip was skipped or failed.
+    pub const MESSAGE: &str = "message";
+    /// `frames_header`: `Frames:` of the file's header.
+    pub const FRAMES_HEADER: &str = "frames_header";
+    /// `frames_data`: MOTION rows actually present.
+    pub const FRAMES_DATA: &str = "frames_data";
+    /// `frames_kept`: Rows kept after the lead-in rule.
+    pub const FRAMES_KEPT: &str = "frames_kept";
+    /// `leadin_dropped`: Rows dropped as lead-in (list).
+    pub const LEADIN_DROPPED: &str = "leadin_dropped";
+    /// `frame_time_s`: `Frame Time:` of the file, s.
+    pub const FRAME_TIME: &str = "frame_time_s";
+    /// `unit_scale`: Metres per file unit (a conversion factor).
+    pub const UNIT_SCALE: &str = "unit_scale";
+    /// `unit`: The detected file unit.
+    pub const UNIT: &str = "unit";
+    /// `up_axis`: The detected up axis (`+Y`, …).
+    pub const UP_AXIS: &str = "up_axis";
+    /// `handedness_ok`: Left and right landmarks on the expected sides.
+    pub const HANDEDNESS_OK: &str = "handedness_ok";
+    /// `leg_length_m`: Leg length `L_leg`, m.
+    pub const LEG_LENGTH: &str = "leg_length_m";
+    /// `character_id`: Character id (`sk-` + 12 hex digits of the skeleton).
+    pub const CHARACTER_ID: &str = "character_id";
+    /// `mass_kg`: Body mass, kg.
+    pub const MASS: &str = "mass_kg";
+    /// `skeleton`: The landmark mapping (JSON).
+    pub const SKELETON: &str = "skeleton";
+    /// `toe_tip_rule_left`: How the left toe tip was found.
+    pub const TOE_TIP_RULE_LEFT: &str = "toe_tip_rule_left";
+    /// `toe_tip_rule_right`: How the right toe tip was found.
+    pub const TOE_TIP_RULE_RIGHT: &str = "toe_tip_rule_right";
+    /// `flights`: Flight fits (list of structs, [`super::flights`]).
+    pub const FLIGHTS: &str = "flights";
+    /// `flight_az_median_mps2`: Median vertical COM acceleration in flight, m/s².
+    pub const FLIGHT_AZ_MEDIAN: &str = "flight_az_median_mps2";
+    /// `s_eff`: Effective time scale of the clip's flights (dimensionless).
+    pub const S_EFF: &str = "s_eff";
+    /// `warnings`: Advisory messages (list).
+    pub const WARNINGS: &str = "warnings";
+    /// Every column, in file order.
+    pub const COLUMNS: [&str; 24] = [
+        PATH,
+        CLIP,
+        CONTENT_SHA256,
+        STATUS,
+        MESSAGE,
+        FRAMES_HEADER,
+        FRAMES_DATA,
+        FRAMES_KEPT,
+        LEADIN_DROPPED,
+        FRAME_TIME,
+        UNIT_SCALE,
+        UNIT,
+        UP_AXIS,
+        HANDEDNESS_OK,
+        LEG_LENGTH,
+        CHARACTER_ID,
+        MASS,
+        SKELETON,
+        TOE_TIP_RULE_LEFT,
+        TOE_TIP_RULE_RIGHT,
+        FLIGHTS,
+        FLIGHT_AZ_MEDIAN,
+        S_EFF,
+        WARNINGS,
+    ];
+}
+
+/// Column names of fields of the `flights` struct of `clips.parquet`.
+pub mod flights {
+    /// `first_frame`: First airborne frame.
+    pub const FIRST_FRAME: &str = "first_frame";
+    /// `last_frame`: Last airborne frame.
+    pub const LAST_FRAME: &str = "last_frame";
+    /// `duration_s`: Flight duration, s.
+    pub const DURATION: &str = "duration_s";
+    /// `a_z_mps2`: Fitted vertical COM acceleration, m/s².
+    pub const A_Z: &str = "a_z_mps2";
+    /// `a_x_mps2`: Fitted horizontal (x) COM acceleration, m/s².
+    pub const A_X: &str = "a_x_mps2";
+    /// `a_y_mps2`: Fitted horizontal (y) COM acceleration, m/s².
+    pub const A_Y: &str = "a_y_mps2";
+    /// `rms_m`: Fit residual RMS, m.
+    pub const RMS: &str = "rms_m";
+    /// `s_eff`: Effective time scale of this flight (dimensionless).
+    pub const S_EFF: &str = "s_eff";
+    /// `a_z_mean_mps2`: Mean of the differentiated vertical COM acceleration, m/s².
+    pub const A_Z_MEAN: &str = "a_z_mean_mps2";
+    /// `ballistic`: The fit is within the ballistic tolerance of −g.
+    pub const BALLISTIC: &str = "ballistic";
+    /// `tested`: Long enough to be tested.
+    pub const TESTED: &str = "tested";
+    /// Every column, in file order.
+    pub const COLUMNS: [&str; 11] = [
+        FIRST_FRAME,
+        LAST_FRAME,
+        DURATION,
+        A_Z,
+        A_X,
+        A_Y,
+        RMS,
+        S_EFF,
+        A_Z_MEAN,
+        BALLISTIC,
+        TESTED,
+    ];
+}
+
+/// Column names of `contacts.parquet`: one row per contact run.
+pub mod contacts {
+    /// `clip`: Clip name.
+    pub const CLIP: &str = "clip";
+    /// `effector`: `left_foot`, `right_foot`, `left_hand` or `right_hand`.
+    pub const EFFECTOR: &str = "effector";
+    /// `first_frame`: First contact frame (file MOTION row).
+    pub const FIRST_FRAME: &str = "first_frame";
+    /// `last_frame`: Last contact frame.
+    pub const LAST_FRAME: &str = "last_frame";
+    /// `td_edge_clip_s`: Touchdown at the frame edge (half a frame before `first_frame`), clip time, s.
+    pub const TD_EDGE: &str = "td_edge_clip_s";
+    /// `lo_edge_clip_s`: Liftoff at the frame edge (half a frame after `last_frame`), clip time, s.
+    pub const LO_EDGE: &str = "lo_edge_clip_s";
+    /// `td_clip_s`: Touchdown, sub-frame estimate, clip time, s.
+    pub const TD: &str = "td_clip_s";
+    /// `lo_clip_s`: Liftoff, sub-frame estimate, clip time, s.
+    pub const LO: &str = "lo_clip_s";
+    /// `static`: The run was triggered by a static point.
+    pub const STATIC: &str = "static";
+    /// `speed_led`: The run was found by the speed rule alone.
+    pub const SPEED_LED: &str = "speed_led";
+    /// `surface_z_m`: Height of the contact surface, m.
+    pub const SURFACE_Z: &str = "surface_z_m";
+    /// `origin_x_m`: Contact-frame origin, world x, m.
+    pub const ORIGIN_X: &str = "origin_x_m";
+    /// `origin_y_m`: Contact-frame origin, world y, m.
+    pub const ORIGIN_Y: &str = "origin_y_m";
+    /// `origin_z_m`: Contact-frame origin, world z, m.
+    pub const ORIGIN_Z: &str = "origin_z_m";
+    /// `yaw_rad`: Contact-frame yaw about the up axis, rad.
+    pub const YAW: &str = "yaw_rad";
+    /// `normal_x`: Surface normal, world x (unit vector).
+    pub const NORMAL_X: &str = "normal_x";
+    /// `normal_y`: Surface normal, world y.
+    pub const NORMAL_Y: &str = "normal_y";
+    /// `normal_z`: Surface normal, world z.
+    pub const NORMAL_Z: &str = "normal_z";
+    /// Every column, in file order.
+    pub const COLUMNS: [&str; 18] = [
+        CLIP,
+        EFFECTOR,
+        FIRST_FRAME,
+        LAST_FRAME,
+        TD_EDGE,
+        LO_EDGE,
+        TD,
+        LO,
+        STATIC,
+        SPEED_LED,
+        SURFACE_Z,
+        ORIGIN_X,
+        ORIGIN_Y,
+        ORIGIN_Z,
+        YAW,
+        NORMAL_X,
+        NORMAL_Y,
+        NORMAL_Z,
+    ];
+}
+
+/// Column names of `stances.parquet`: one row per stance.
+pub mod stances {
+    /// `stance_id`: `<clip>:<label>:<first frame>`.
+    pub const STANCE_ID: &str = "stance_id";
+    /// `clip`: Clip name.
+    pub const CLIP: &str = "clip";
+    /// `character_id`: Character id.
+    pub const CHARACTER_ID: &str = "character_id";
+    /// `label`: `L`, `R`, `LR`, `LR+LH`, …
+    pub const LABEL: &str = "label";
+    /// `effectors`: Effectors in contact (sorted list).
+    pub const EFFECTORS: &str = "effectors";
+    /// `first_frame`: First stance frame.
+    pub const FIRST_FRAME: &str = "first_frame";
+    /// `last_frame`: Last stance frame.
+    pub const LAST_FRAME: &str = "last_frame";
+    /// `td_clip_s`: Touchdown, clip time, s.
+    pub const TD_CLIP: &str = "td_clip_s";
+    /// `lo_clip_s`: Liftoff, clip time, s.
+    pub const LO_CLIP: &str = "lo_clip_s";
+    /// `td_stance_s`: Touchdown, stance time (from the start apex), s.
+    pub const TD_STANCE: &str = "td_stance_s";
+    /// `lo_stance_s`: Liftoff, stance time, s.
+    pub const LO_STANCE: &str = "lo_stance_s";
+    /// `end_apex_stance_s`: End apex `t_e`, stance time, s.
+    pub const END_APEX_STANCE: &str = "end_apex_stance_s";
+    /// `dt_s`: Ground time Δt, s.
+    pub const DT: &str = "dt_s";
+    /// `boundary_start`: What precedes the stance.
+    pub const BOUNDARY_START: &str = "boundary_start";
+    /// `boundary_end`: What follows the stance.
+    pub const BOUNDARY_END: &str = "boundary_end";
+    /// `rest_at_edge`: The stance starts or ends at rest.
+    pub const REST_AT_EDGE: &str = "rest_at_edge";
+    /// `flight_before`: The preceding flight (struct, [`super::flight_ref`]).
+    pub const FLIGHT_BEFORE: &str = "flight_before";
+    /// `flight_after`: The following flight (struct).
+    pub const FLIGHT_AFTER: &str = "flight_after";
+    /// `heading_x`: Heading `e_h`, world x (unit vector).
+    pub const HEADING_X: &str = "heading_x";
+    /// `heading_y`: Heading `e_h`, world y.
+    pub const HEADING_Y: &str = "heading_y";
+    /// `heading_from`: Where the heading came from.
+    pub const HEADING_FROM: &str = "heading_from";
+    /// `z_c_m`: Contact height above the local floor, m.
+    pub const Z_C: &str = "z_c_m";
+    /// `zs_m`: Start apex height above `z_c`, m.
+    pub const ZS: &str = "zs_m";
+    /// `vs_mps`: Start apex horizontal velocity, m/s.
+    pub const VS: &str = "vs_mps";
+    /// `ze_m`: End apex height above `z_c`, m.
+    pub const ZE: &str = "ze_m";
+    /// `ve_mps`: End apex horizontal velocity, m/s.
+    pub const VE: &str = "ve_mps";
+    /// `vp_mps`: End apex lateral velocity, m/s.
+    pub const VP: &str = "vp_mps";
+    /// `x_m`: Apex-to-apex distance, m.
+    pub const X: &str = "x_m";
+    /// `vps_mps`: Start apex lateral velocity, m/s.
+    pub const VPS: &str = "vps_mps";
+    /// `z_td_m`: COM height above `z_c` at touchdown, m.
+    pub const Z_TD: &str = "z_td_m";
+    /// `z_lo_m`: COM height above `z_c` at liftoff, m.
+    pub const Z_LO: &str = "z_lo_m";
+    /// `ze_measured_m`: `ze` from the measured liftoff state, m.
+    pub const ZE_MEASURED: &str = "ze_measured_m";
+    /// `ve_measured_mps`: `ve` from the measured liftoff state, m/s.
+    pub const VE_MEASURED: &str = "ve_measured_mps";
+    /// `vp_measured_mps`: `vp` from the measured liftoff state, m/s.
+    pub const VP_MEASURED: &str = "vp_measured_mps";
+    /// `x_measured_m`: `x` from the measured liftoff state, m.
+    pub const X_MEASURED: &str = "x_measured_m";
+    /// `mass_kg`: Body mass, kg.
+    pub const MASS: &str = "mass_kg";
+    /// Fourier DC term per stance axis, N. (`_h`, `_p`, `_v`)
+    pub const C0: [&str; 3] = ["c0_h_n", "c0_p_n", "c0_v_n"];
+    /// Fourier harmonics per stance axis (integers). (`_h`, `_p`, `_v`)
+    pub const HARMONIC: [&str; 3] = ["harmonic_h", "harmonic_p", "harmonic_v"];
+    /// Fourier amplitudes per stance axis, N. (`_h`, `_p`, `_v`)
+    pub const AMP: [&str; 3] = ["amp_h_n", "amp_p_n", "amp_v_n"];
+    /// Fourier phases per stance axis, rad. (`_h`, `_p`, `_v`)
+    pub const PHASE: [&str; 3] = ["phase_h_rad", "phase_p_rad", "phase_v_rad"];
+    /// Force-fit residual per stance axis, N. (`_h`, `_p`, `_v`)
+    pub const FIT_RMS: [&str; 3] = ["fit_rms_h_n", "fit_rms_p_n", "fit_rms_v_n"];
+    /// Polynomial coefficients of `τ^k` per stance axis, N. (`_h`, `_p`, `_v`)
+    pub const POLY: [&str; 3] = ["poly_h_n", "poly_p_n", "poly_v_n"];
+    /// `ratio_h`: Ratio model `q_h` (coefficients of `τ^k`, dimensionless).
+    pub const RATIO_H: &str = "ratio_h";
+    /// `ratio_p`: Ratio model `q_p`.
+    pub const RATIO_P: &str = "ratio_p";
+    /// `force_model`: `ratio` or `fourier`.
+    pub const FORCE_MODEL: &str = "force_model";
+    /// Impulse `J = (Δt/m)∫f` per stance axis, m/s. (`_h`, `_p`, `_v`)
+    pub const J: [&str; 3] = ["j_h_mps", "j_p_mps", "j_v_mps"];
+    /// Moment `K = (Δt²/m)∫τf` per stance axis, m. (`_h`, `_p`, `_v`)
+    pub const K: [&str; 3] = ["k_h_m", "k_p_m", "k_v_m"];
+    /// `s̄ = K/J` per stance axis, s. (`_h`, `_p`, `_v`)
+    pub const S_BAR: [&str; 3] = ["s_bar_h_s", "s_bar_p_s", "s_bar_v_s"];
+    /// `support_ok`: `J_v > 0`.
+    pub const SUPPORT_OK: &str = "support_ok";
+    /// `unilateral_ok`: No pulling force.
+    pub const UNILATERAL_OK: &str = "unilateral_ok";
+    /// `min_f_v_n`: Smallest vertical force, N.
+    pub const MIN_F_V: &str = "min_f_v_n";
+    /// `a_f_n2`: `max f_a²` per stance axis (list of 3), N².
+    pub const A_F: &str = "a_f_n2";
+    /// `a_mu`: `max (f_t/f_v)²` on the active set (list of 2, dimensionless).
+    pub const A_MU: &str = "a_mu";
+    /// `f_peak_n`: Original peak force, N.
+    pub const F_PEAK: &str = "f_peak_n";
+    /// `mu_req`: Required friction on the 5 % active set.
+    pub const MU_REQ: &str = "mu_req";
+    /// `mu_req_robust`: Required friction on the 20 % active set.
+    pub const MU_REQ_ROBUST: &str = "mu_req_robust";
+    /// `ext_min_m`: Smallest COM–contact distance, m.
+    pub const EXT_MIN: &str = "ext_min_m";
+    /// `ext_max_m`: Largest COM–contact distance, m.
+    pub const EXT_MAX: &str = "ext_max_m";
+    /// `cp_h_m`: Contact point relative to the COM at touchdown, heading axis, m.
+    pub const CP_H: &str = "cp_h_m";
+    /// `cp_p_m`: Contact point relative to the COM at touchdown, lateral axis, m.
+    pub const CP_P: &str = "cp_p_m";
+    /// `ang_impulse_nms`: Angular impulse about the COM (list of 3), N·m·s.
+    pub const ANG_IMPULSE: &str = "ang_impulse_nms";
+    /// `ang_impulse_h0_nms`: Its contact-point-free part `H_0` (list of 3), N·m·s.
+    pub const ANG_IMPULSE_H0: &str = "ang_impulse_h0_nms";
+    /// `ell_r_min`: Appendix B box, χ_max ellipsoid, lower (list of 3, dimensionless).
+    pub const ELL_R_MIN: &str = "ell_r_min";
+    /// `ell_r_max`: Appendix B box, χ_max ellipsoid, upper.
+    pub const ELL_R_MAX: &str = "ell_r_max";
+    /// `ell_s_min`: Appendix B box, χ_min ellipsoid, lower.
+    pub const ELL_S_MIN: &str = "ell_s_min";
+    /// `ell_s_max`: Appendix B box, χ_min ellipsoid, upper.
+    pub const ELL_S_MAX: &str = "ell_s_max";
+    /// `warnings`: Advisory messages (list).
+    pub const WARNINGS: &str = "warnings";
+    /// Every column, in file order.
+    pub const COLUMNS: [&str; 85] = [
+        STANCE_ID,
+        CLIP,
+        CHARACTER_ID,
+        LABEL,
+        EFFECTORS,
+        FIRST_FRAME,
+        LAST_FRAME,
+        TD_CLIP,
+        LO_CLIP,
+        TD_STANCE,
+        LO_STANCE,
+        END_APEX_STANCE,
+        DT,
+        BOUNDARY_START,
+        BOUNDARY_END,
+        REST_AT_EDGE,
+        FLIGHT_BEFORE,
+        FLIGHT_AFTER,
+        HEADING_X,
+        HEADING_Y,
+        HEADING_FROM,
+        Z_C,
+        ZS,
+        VS,
+        ZE,
+        VE,
+        VP,
+        X,
+        VPS,
+        Z_TD,
+        Z_LO,
+        ZE_MEASURED,
+        VE_MEASURED,
+        VP_MEASURED,
+        X_MEASURED,
+        MASS,
+        C0[0],
+        C0[1],
+        C0[2],
+        HARMONIC[0],
+        HARMONIC[1],
+        HARMONIC[2],
+        AMP[0],
+        AMP[1],
+        AMP[2],
+        PHASE[0],
+        PHASE[1],
+        PHASE[2],
+        FIT_RMS[0],
+        FIT_RMS[1],
+        FIT_RMS[2],
+        POLY[0],
+        POLY[1],
+        POLY[2],
+        RATIO_H,
+        RATIO_P,
+        FORCE_MODEL,
+        J[0],
+        J[1],
+        J[2],
+        K[0],
+        K[1],
+        K[2],
+        S_BAR[0],
+        S_BAR[1],
+        S_BAR[2],
+        SUPPORT_OK,
+        UNILATERAL_OK,
+        MIN_F_V,
+        A_F,
+        A_MU,
+        F_PEAK,
+        MU_REQ,
+        MU_REQ_ROBUST,
+        EXT_MIN,
+        EXT_MAX,
+        CP_H,
+        CP_P,
+        ANG_IMPULSE,
+        ANG_IMPULSE_H0,
+        ELL_R_MIN,
+        ELL_R_MAX,
+        ELL_S_MIN,
+        ELL_S_MAX,
+        WARNINGS,
+    ];
+}
+
+/// Column names of fields of the `flight_before`/`flight_after` structs of `stances.parquet`.
+pub mod flight_ref {
+    /// `first_frame`: First airborne frame.
+    pub const FIRST_FRAME: &str = "first_frame";
+    /// `last_frame`: Last airborne frame.
+    pub const LAST_FRAME: &str = "last_frame";
+    /// `n_int`: Interior frames of the fit.
+    pub const N_INT: &str = "n_int";
+    /// `free`: The flight's fit was free (not pinned to −g).
+    pub const FREE: &str = "free";
+    /// `a_z_mps2`: Fitted vertical COM acceleration, m/s².
+    pub const A_Z: &str = "a_z_mps2";
+    /// `vel_mps`: World COM velocity at the stance edge (list of 3), m/s.
+    pub const VEL: &str = "vel_mps";
+    /// Every column, in file order.
+    pub const COLUMNS: [&str; 6] = [FIRST_FRAME, LAST_FRAME, N_INT, FREE, A_Z, VEL];
+}

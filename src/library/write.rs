@@ -43,12 +43,16 @@ pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
         fr.iter().flat_map(|(_, f)| g(f)).collect()
     };
     let mut cols = vec![
-        col("clip", clip),
-        col("frame", cat_i64(&|f| &f.frame)),
-        col("time_s", cat_f64(&|f| f.time_s.clone())),
+        col(frames::CLIP, clip),
+        col(frames::FRAME, cat_i64(&|f| &f.frame)),
+        col(frames::TIME, cat_f64(&|f| f.time_s.clone())),
     ];
-    for (prefix, get) in [("com_", 0usize), ("com_v", 1), ("com_a", 2)] {
-        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+    for (names, get) in [
+        (frames::COM, 0usize),
+        (frames::COM_V, 1),
+        (frames::COM_A, 2),
+    ] {
+        for (a, name) in names.iter().enumerate() {
             let v = cat_f64(&|f| {
                 let src = match get {
                     0 => &f.com,
@@ -57,16 +61,16 @@ pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
                 };
                 src.iter().map(|p| p[a]).collect()
             });
-            cols.push(col(&format!("{prefix}{axis}"), v));
+            cols.push(col(name, v));
         }
     }
-    cols.push(col("ground_z", cat_f64(&|f| f.ground_z.clone())));
+    cols.push(col(frames::GROUND_Z, cat_f64(&|f| f.ground_z.clone())));
     for (e, name) in EFFECTORS.iter().enumerate() {
         let v: Vec<bool> = fr
             .iter()
             .flat_map(|(_, f)| f.contact[e].iter().copied())
             .collect();
-        cols.push(col(&format!("contact_{name}"), v));
+        cols.push(col(&frames::contact(name), v));
     }
     for (e, name) in EFFECTORS.iter().enumerate() {
         let v: Vec<Option<bool>> = fr
@@ -76,7 +80,7 @@ pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
                 None => vec![None; f.frame.len()],
             })
             .collect();
-        cols.push(col(&format!("static_{name}"), v));
+        cols.push(col(&frames::is_static(name), v));
         let z: Vec<Option<f64>> = fr
             .iter()
             .flat_map(|(_, f)| match &f.surface_z {
@@ -84,10 +88,10 @@ pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
                 None => vec![None; f.frame.len()],
             })
             .collect();
-        cols.push(col(&format!("surface_z_{name}"), z));
+        cols.push(col(&frames::surface_z(name), z));
     }
     for (e, name) in EFFECTORS.iter().enumerate() {
-        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        for a in 0..3 {
             let v: Vec<Option<f64>> = fr
                 .iter()
                 .flat_map(|(_, f)| match &f.effector_pos[e] {
@@ -95,13 +99,13 @@ pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
                     None => vec![None; f.frame.len()],
                 })
                 .collect();
-            cols.push(col(&format!("{name}_{axis}"), v));
+            cols.push(col(&frames::position(name, a), v));
         }
     }
-    for (k, side) in ["left", "right"].iter().enumerate() {
-        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+    for (k, toe) in frames::TOES.iter().enumerate() {
+        for a in 0..3 {
             cols.push(col(
-                &format!("{side}_toe_{axis}"),
+                &frames::position(toe, a),
                 cat_f64(&|f| f.toe[k].iter().map(|p| p[a]).collect()),
             ));
         }
@@ -112,17 +116,17 @@ pub fn frames_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
 fn flights_dtype() -> DataType {
     let f = |n: &str, t: DataType| Field::new(n.into(), t);
     let fields = vec![
-        f("first_frame", DataType::Int64),
-        f("last_frame", DataType::Int64),
-        f("duration_s", DataType::Float64),
-        f("a_z", DataType::Float64),
-        f("a_x", DataType::Float64),
-        f("a_y", DataType::Float64),
-        f("rms_m", DataType::Float64),
-        f("s_eff", DataType::Float64),
-        f("a_z_mean", DataType::Float64),
-        f("ballistic", DataType::Boolean),
-        f("tested", DataType::Boolean),
+        f(flights::FIRST_FRAME, DataType::Int64),
+        f(flights::LAST_FRAME, DataType::Int64),
+        f(flights::DURATION, DataType::Float64),
+        f(flights::A_Z, DataType::Float64),
+        f(flights::A_X, DataType::Float64),
+        f(flights::A_Y, DataType::Float64),
+        f(flights::RMS, DataType::Float64),
+        f(flights::S_EFF, DataType::Float64),
+        f(flights::A_Z_MEAN, DataType::Float64),
+        f(flights::BALLISTIC, DataType::Boolean),
+        f(flights::TESTED, DataType::Boolean),
     ];
     DataType::List(Box::new(DataType::Struct(fields)))
 }
@@ -138,20 +142,20 @@ fn flights_series(r: &ClipRecord) -> PolarsResult<Option<Series>> {
         };
     }
     let fields = [
-        s!("first_frame", |f| f.first_frame),
-        s!("last_frame", |f| f.last_frame),
-        s!("duration_s", |f| f.duration_s),
-        s!("a_z", |f| f.a_z),
-        s!("a_x", |f| f.a_x),
-        s!("a_y", |f| f.a_y),
-        s!("rms_m", |f| f.rms_m),
-        s!("s_eff", |f| f.s_eff),
-        s!("a_z_mean", |f| f.a_z_mean),
-        s!("ballistic", |f| f.ballistic),
-        s!("tested", |f| f.tested),
+        s!(flights::FIRST_FRAME, |f| f.first_frame),
+        s!(flights::LAST_FRAME, |f| f.last_frame),
+        s!(flights::DURATION, |f| f.duration_s),
+        s!(flights::A_Z, |f| f.a_z),
+        s!(flights::A_X, |f| f.a_x),
+        s!(flights::A_Y, |f| f.a_y),
+        s!(flights::RMS, |f| f.rms_m),
+        s!(flights::S_EFF, |f| f.s_eff),
+        s!(flights::A_Z_MEAN, |f| f.a_z_mean),
+        s!(flights::BALLISTIC, |f| f.ballistic),
+        s!(flights::TESTED, |f| f.tested),
     ];
     Ok(Some(
-        StructChunked::from_series("flights".into(), fl.len(), fields.iter())?.into_series(),
+        StructChunked::from_series(clips::FLIGHTS.into(), fl.len(), fields.iter())?.into_series(),
     ))
 }
 
@@ -182,65 +186,68 @@ pub fn clips_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
         .into_iter()
         .collect();
     let cols = vec![
-        col("path", s(&|r| Some(r.path.clone()))),
-        col("clip", s(&|r| Some(r.clip.clone()))),
-        col("content_sha256", s(&|r| Some(r.content_sha256.clone()))),
-        col("status", s(&|r| Some(r.status.as_str().to_string()))),
-        col("message", s(&|r| r.message.clone())),
-        col("frames_header", i(&|r| r.summary.frames_header)),
+        col(clips::PATH, s(&|r| Some(r.path.clone()))),
+        col(clips::CLIP, s(&|r| Some(r.clip.clone()))),
         col(
-            "frames_data",
+            clips::CONTENT_SHA256,
+            s(&|r| Some(r.content_sha256.clone())),
+        ),
+        col(clips::STATUS, s(&|r| Some(r.status.as_str().to_string()))),
+        col(clips::MESSAGE, s(&|r| r.message.clone())),
+        col(clips::FRAMES_HEADER, i(&|r| r.summary.frames_header)),
+        col(
+            clips::FRAMES_DATA,
             i(&|r| parsed(r).then_some(r.summary.frames_data)),
         ),
         col(
-            "frames_kept",
+            clips::FRAMES_KEPT,
             i(&|r| parsed(r).then_some(r.summary.frames_kept)),
         ),
         leadin
             .into_series()
             .cast(&DataType::List(Box::new(DataType::Int64)))?
-            .with_name("leadin_dropped".into())
+            .with_name(clips::LEADIN_DROPPED.into())
             .into(),
         col(
-            "frame_time_s",
+            clips::FRAME_TIME,
             f(&|r| parsed(r).then_some(r.summary.frame_time_s)),
         ),
-        col("unit_scale", f(&|r| r.summary.unit_scale)),
-        col("unit", s(&|r| r.summary.unit.clone())),
-        col("up_axis", s(&|r| r.summary.up_axis.clone())),
+        col(clips::UNIT_SCALE, f(&|r| r.summary.unit_scale)),
+        col(clips::UNIT, s(&|r| r.summary.unit.clone())),
+        col(clips::UP_AXIS, s(&|r| r.summary.up_axis.clone())),
         col(
-            "handedness_ok",
+            clips::HANDEDNESS_OK,
             records
                 .iter()
                 .map(|r| r.summary.handedness_ok)
                 .collect::<Vec<_>>(),
         ),
-        col("leg_length_m", f(&|r| r.summary.leg_length_m)),
-        col("character_id", s(&|r| r.summary.character_id.clone())),
+        col(clips::LEG_LENGTH, f(&|r| r.summary.leg_length_m)),
+        col(clips::CHARACTER_ID, s(&|r| r.summary.character_id.clone())),
         col(
-            "mass_kg",
+            clips::MASS,
             records.iter().map(|r| r.mass_kg).collect::<Vec<_>>(),
         ),
-        col("skeleton", s(&|r| r.summary.skeleton.clone())),
+        col(clips::SKELETON, s(&|r| r.summary.skeleton.clone())),
         col(
-            "toe_tip_rule_left",
+            clips::TOE_TIP_RULE_LEFT,
             s(&|r| r.summary.toe_tip_rule[0].clone()),
         ),
         col(
-            "toe_tip_rule_right",
+            clips::TOE_TIP_RULE_RIGHT,
             s(&|r| r.summary.toe_tip_rule[1].clone()),
         ),
         flights
             .into_series()
             .cast(&flights_dtype())?
-            .with_name("flights".into())
+            .with_name(clips::FLIGHTS.into())
             .into(),
-        col("flight_az_median", f(&|r| r.summary.flight_az_median)),
-        col("s_eff", f(&|r| r.summary.s_eff)),
+        col(clips::FLIGHT_AZ_MEDIAN, f(&|r| r.summary.flight_az_median)),
+        col(clips::S_EFF, f(&|r| r.summary.s_eff)),
         warnings
             .into_series()
             .cast(&DataType::List(Box::new(DataType::String)))?
-            .with_name("warnings".into())
+            .with_name(clips::WARNINGS.into())
             .into(),
     ];
     DataFrame::new_infer_height(cols)
@@ -259,51 +266,51 @@ pub fn contacts_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
         rows.iter().map(|(_, c)| g(c)).collect()
     };
     DataFrame::new_infer_height(vec![
-        col("clip", rows.iter().map(|r| r.0).collect::<Vec<_>>()),
+        col(contacts::CLIP, rows.iter().map(|r| r.0).collect::<Vec<_>>()),
         col(
-            "effector",
+            contacts::EFFECTOR,
             rows.iter().map(|r| r.1.effector).collect::<Vec<_>>(),
         ),
         col(
-            "first_frame",
+            contacts::FIRST_FRAME,
             rows.iter().map(|r| r.1.first_frame).collect::<Vec<_>>(),
         ),
         col(
-            "last_frame",
+            contacts::LAST_FRAME,
             rows.iter().map(|r| r.1.last_frame).collect::<Vec<_>>(),
         ),
         col(
-            "t_td_s",
+            contacts::TD_EDGE,
             rows.iter().map(|r| r.1.t_td_s).collect::<Vec<_>>(),
         ),
         col(
-            "t_lo_s",
+            contacts::LO_EDGE,
             rows.iter().map(|r| r.1.t_lo_s).collect::<Vec<_>>(),
         ),
         col(
-            "td_time_s",
+            contacts::TD,
             rows.iter().map(|r| r.1.td_time_s).collect::<Vec<_>>(),
         ),
         col(
-            "lo_time_s",
+            contacts::LO,
             rows.iter().map(|r| r.1.lo_time_s).collect::<Vec<_>>(),
         ),
         col(
-            "static",
+            contacts::STATIC,
             rows.iter().map(|r| r.1.is_static).collect::<Vec<_>>(),
         ),
         col(
-            "speed_led",
+            contacts::SPEED_LED,
             rows.iter().map(|r| r.1.speed_led).collect::<Vec<_>>(),
         ),
-        col("surface_z", f(&|c| c.surface_z)),
-        col("origin_x", f(&|c| c.origin[0])),
-        col("origin_y", f(&|c| c.origin[1])),
-        col("origin_z", f(&|c| c.origin[2])),
-        col("yaw_rad", f(&|c| c.yaw_rad)),
-        col("normal_x", f(&|c| c.normal[0])),
-        col("normal_y", f(&|c| c.normal[1])),
-        col("normal_z", f(&|c| c.normal[2])),
+        col(contacts::SURFACE_Z, f(&|c| c.surface_z)),
+        col(contacts::ORIGIN_X, f(&|c| c.origin[0])),
+        col(contacts::ORIGIN_Y, f(&|c| c.origin[1])),
+        col(contacts::ORIGIN_Z, f(&|c| c.origin[2])),
+        col(contacts::YAW, f(&|c| c.yaw_rad)),
+        col(contacts::NORMAL_X, f(&|c| c.normal[0])),
+        col(contacts::NORMAL_Y, f(&|c| c.normal[1])),
+        col(contacts::NORMAL_Z, f(&|c| c.normal[2])),
     ])
 }
 
@@ -329,12 +336,12 @@ pub fn joints_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
         }
     }
     DataFrame::new_infer_height(vec![
-        col("clip", clip),
-        col("frame", frame),
-        col("joint", joint),
-        col("x", x),
-        col("y", y),
-        col("z", z),
+        col(frames::CLIP, clip),
+        col(frames::FRAME, frame),
+        col(joints::JOINT, joint),
+        col(joints::POSITION[0], x),
+        col(joints::POSITION[1], y),
+        col(joints::POSITION[2], z),
     ])
 }
 

@@ -35,9 +35,11 @@ use super::shard::{inputs_fingerprint, shard_of, Shard};
 use super::sink::{combine, pe, strings, ClipCursor, LibrarySink, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
+use crate::library::provenance::library_layout;
 use crate::library::read::read_parquet;
 use crate::library::schema::{
-    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, MANIFEST_FILE, STANCES_FILE,
+    clips, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, MANIFEST_FILE,
+    SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
@@ -228,16 +230,20 @@ fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTree
     if current.is_none() || manifest.as_ref().and_then(|m| m.get("options")) != current.as_ref() {
         return BTreeSet::new();
     }
+    // Rows of another table layout cannot be copied into this one.
+    if library_layout(out).as_deref() != Some(SCHEMA_VERSION) {
+        return BTreeSet::new();
+    }
     let Ok(clips) = read_parquet(&out.join(CLIPS_FILE)) else {
         return BTreeSet::new();
     };
-    let prev: BTreeMap<String, (String, String, String)> = strings(&clips, "clip")
+    let prev: BTreeMap<String, (String, String, String)> = strings(&clips, clips::CLIP)
         .into_iter()
         .zip(
-            strings(&clips, "path")
+            strings(&clips, clips::PATH)
                 .into_iter()
-                .zip(strings(&clips, "content_sha256"))
-                .zip(strings(&clips, "status")),
+                .zip(strings(&clips, clips::CONTENT_SHA256))
+                .zip(strings(&clips, clips::STATUS)),
         )
         .map(|(c, ((p, h), s))| (c, (p, h, s)))
         .collect();

@@ -28,9 +28,9 @@ use crate::library::kinematics::{
 };
 use crate::library::read::parquet_rows;
 use crate::library::schema::{
-    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, KINEMATICS_FILE,
-    KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX,
-    SCHEMA_VERSION, STANCES_FILE,
+    clips, contacts, errors, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE,
+    FRAMES_FILE, JOINTS_FILE, KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE,
+    MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::schema::{
     INPUTS_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION, TOOL_VERSION_KEY,
@@ -51,12 +51,12 @@ pub(crate) fn pe(name: &str, e: PolarsError) -> Error {
 pub(crate) fn sort_keys(name: &str) -> &'static [&'static str] {
     match name {
         // Joint rows keep the skeleton's order within a frame (the sort is stable).
-        FRAMES_FILE | JOINTS_FILE => &["clip", "frame"],
-        CONTACTS_FILE => &["clip", "effector", "first_frame"],
-        CLIPS_FILE => &["clip"],
-        STANCES_FILE => &["clip", "first_frame", "label"],
+        FRAMES_FILE | JOINTS_FILE => &[frames::CLIP, frames::FRAME],
+        CONTACTS_FILE => &[contacts::CLIP, contacts::EFFECTOR, contacts::FIRST_FRAME],
+        CLIPS_FILE => &[clips::CLIP],
+        STANCES_FILE => &[S::CLIP, S::FIRST_FRAME, S::LABEL],
         KINEMATICS_SAMPLES_FILE => &SAMPLES_SORT_KEYS,
-        _ => &["path", "stage", "message"],
+        _ => &[errors::PATH, errors::STAGE, errors::MESSAGE],
     }
 }
 
@@ -157,16 +157,16 @@ fn floats(df: &DataFrame, col: &str) -> Vec<Option<f64>> {
 /// The facts the limits need of the stances of a stance table.
 fn stance_facts(s: &DataFrame) -> Vec<StanceFacts> {
     let (clip, ch, b0, b1) = (
-        strings(s, "clip"),
-        strings(s, "character_id"),
-        strings(s, "boundary_start"),
-        strings(s, "boundary_end"),
+        strings(s, S::CLIP),
+        strings(s, S::CHARACTER_ID),
+        strings(s, S::BOUNDARY_START),
+        strings(s, S::BOUNDARY_END),
     );
     let (m, fp, e0, e1) = (
-        floats(s, "mass_kg"),
-        floats(s, "f_peak"),
-        floats(s, "ext_min"),
-        floats(s, "ext_max"),
+        floats(s, S::MASS),
+        floats(s, S::F_PEAK),
+        floats(s, S::EXT_MIN),
+        floats(s, S::EXT_MAX),
     );
     (0..s.height())
         .map(|i| StanceFacts {
@@ -248,10 +248,10 @@ impl LibrarySink {
         add_character_legs(&mut self.legs, &t.clips).map_err(|e| pe(CLIPS_FILE, e))?;
         self.stance_facts.extend(stance_facts(&t.stances));
         let c = &t.clips;
-        for (k, (s_eff, leg)) in strings(c, "clip").into_iter().zip(
-            floats(c, "s_eff")
+        for (k, (s_eff, leg)) in strings(c, clips::CLIP).into_iter().zip(
+            floats(c, clips::S_EFF)
                 .into_iter()
-                .zip(floats(c, "leg_length_m")),
+                .zip(floats(c, clips::LEG_LENGTH)),
         ) {
             self.clip_facts.insert(
                 k,
@@ -262,11 +262,11 @@ impl LibrarySink {
             );
         }
         self.inputs.extend(
-            strings(c, "clip")
+            strings(c, clips::CLIP)
                 .into_iter()
-                .zip(strings(c, "content_sha256")),
+                .zip(strings(c, clips::CONTENT_SHA256)),
         );
-        self.status.extend(strings(c, "status"));
+        self.status.extend(strings(c, clips::STATUS));
         self.n_stances += t.stances.height();
         if t.errors.height() > 0 {
             self.errors.push(std::mem::take(&mut t.errors));

@@ -20,7 +20,7 @@ pub fn form_name(f: QpForm) -> &'static str {
     }
 }
 
-/// `equilibrium`'s `R.parquet` (§8.2): `x, y, z, in_equilibrium, margin_n, status`, rows
+/// `equilibrium`'s `R.parquet` (§8.2): `x_m, y_m, z_m, in_equilibrium, margin_n, status`, rows
 /// in the order of the points.
 ///
 /// # Errors
@@ -28,9 +28,9 @@ pub fn form_name(f: QpForm) -> &'static str {
 pub fn equilibrium_table(com: &[[f64; 3]], verdicts: &[Verdict]) -> PolarsResult<DataFrame> {
     let c = |k: usize| com.iter().map(|p| p[k]).collect::<Vec<f64>>();
     DataFrame::new_infer_height(vec![
-        col("x", c(0)),
-        col("y", c(1)),
-        col("z", c(2)),
+        col("x_m", c(0)),
+        col("y_m", c(1)),
+        col("z_m", c(2)),
         col(
             "in_equilibrium",
             verdicts
@@ -81,9 +81,9 @@ pub fn trajectory_table(rows: &[TrajectoryRow]) -> PolarsResult<DataFrame> {
             "phase",
             rows.iter().map(|r| r.phase as i64).collect::<Vec<_>>(),
         ),
-        col("x", v(&|r| r.state.pos[0])),
-        col("y", v(&|r| r.state.pos[1])),
-        col("z", v(&|r| r.state.pos[2])),
+        col("x_m", v(&|r| r.state.pos[0])),
+        col("y_m", v(&|r| r.state.pos[1])),
+        col("z_m", v(&|r| r.state.pos[2])),
         col("vx_mps", v(&|r| r.state.vel[0])),
         col("vy_mps", v(&|r| r.state.vel[1])),
         col("vz_mps", v(&|r| r.state.vel[2])),
@@ -127,9 +127,9 @@ fn slacks(p: &TransitionPoint) -> (Option<f64>, Option<f64>) {
 fn point_cols(points: &[TransitionPoint]) -> Vec<Column> {
     let c = |k: usize| points.iter().map(|p| p.com[k]).collect::<Vec<f64>>();
     vec![
-        col("x", c(0)),
-        col("y", c(1)),
-        col("z", c(2)),
+        col("x_m", c(0)),
+        col("y_m", c(1)),
+        col("z_m", c(2)),
         col(
             "slack_m",
             points.iter().map(|p| slacks(p).0).collect::<Vec<_>>(),
@@ -324,12 +324,12 @@ pub fn windows_table(plan: &Plan, phases: &[Phase]) -> PolarsResult<DataFrame> {
         col("duration_s", f(&|x| x.duration_s)),
         col("u_end", f(&|x| x.u_end)),
         col("t_end_s", f(&|x| x.t_start_s + x.u_end * x.duration_s)),
-        ctrl("control_x", &full, 0)?,
-        ctrl("control_y", &full, 1)?,
-        ctrl("control_z", &full, 2)?,
-        ctrl("kept_x", &kept, 0)?,
-        ctrl("kept_y", &kept, 1)?,
-        ctrl("kept_z", &kept, 2)?,
+        ctrl("control_x_m", &full, 0)?,
+        ctrl("control_y_m", &full, 1)?,
+        ctrl("control_z_m", &full, 2)?,
+        ctrl("kept_x_m", &kept, 0)?,
+        ctrl("kept_y_m", &kept, 1)?,
+        ctrl("kept_z_m", &kept, 2)?,
         list_col("kept_violation_m", viol.clone(), DataType::Float64)?,
         col(
             "guaranteed",

@@ -1,5 +1,6 @@
 //! The query outputs as tables: `query run`, `query jump` and `map jumps` (spec
-//! stance-model §6.8–§6.10). Column names carry their unit (`_m`, `_s`, `_mps`, `_n`).
+//! stance-model §6.8–§6.10). Column names carry their unit (`_m`, `_s`, `_mps`, `_n`);
+//! stance times (`td_stance_s`, …) are on the scaled stance's clock, from its start apex.
 //!
 //! Per-stance values of a run cycle are lists in the order of `stance_ids`; a stance
 //! without an admissible solution has nulls there and its reason in `violated`.
@@ -12,6 +13,7 @@ use super::map::{Agreement, JumpMap};
 use super::pool::Prepared;
 use super::run::{RunCandidate, ScaledStance};
 use crate::library::columns::{col, list_col};
+use crate::library::schema::stances as S;
 
 /// Name of a violated constraint in the `violated` columns.
 pub fn violation_name(v: Violation) -> &'static str {
@@ -126,9 +128,9 @@ pub fn run_table(rows: &[RunRow]) -> PolarsResult<DataFrame> {
         lists("beta_h", &|s| s.solution.beta[0])?,
         lists("beta_v", &|s| s.solution.beta[2])?,
         lists("beta_p", &|s| s.solution.beta[1])?,
-        lists("t_td_s", &|s| s.solution.t_td)?,
-        lists("t_lo_s", &|s| s.solution.t_lo)?,
-        lists("t_e_s", &|s| s.solution.t_e)?,
+        lists(S::TD_STANCE, &|s| s.solution.t_td)?,
+        lists(S::LO_STANCE, &|s| s.solution.t_lo)?,
+        lists(S::END_APEX_STANCE, &|s| s.solution.t_e)?,
         col("mu_min", o(&|r| r.agg(|v| v.mu_req, true))),
         col("peak_force_n", o(&|r| r.agg(|v| v.f_peak, true))),
         col("ext_min_m", o(&|r| r.agg(|v| v.ext_min, false))),
@@ -244,9 +246,12 @@ pub fn jump_table(rows: &[JumpRow]) -> PolarsResult<DataFrame> {
             col(&format!("beta_h{n}"), side(k, &|s| s.solution.beta[0])),
             col(&format!("beta_v{n}"), side(k, &|s| s.solution.beta[2])),
             col(&format!("beta_p{n}"), side(k, &|s| s.solution.beta[1])),
-            col(&format!("t_td{n}_s"), side(k, &|s| s.solution.t_td)),
-            col(&format!("t_lo{n}_s"), side(k, &|s| s.solution.t_lo)),
-            col(&format!("t_e{n}_s"), side(k, &|s| s.solution.t_e)),
+            col(&format!("td{n}_stance_s"), side(k, &|s| s.solution.t_td)),
+            col(&format!("lo{n}_stance_s"), side(k, &|s| s.solution.t_lo)),
+            col(
+                &format!("end_apex{n}_stance_s"),
+                side(k, &|s| s.solution.t_e),
+            ),
             col(&format!("x{n}_m"), o(&x)),
             col(&format!("peak_force{n}_n"), side(k, &|s| s.verdict.f_peak)),
             col(&format!("mu_req{n}"), side(k, &|s| s.verdict.mu_req)),

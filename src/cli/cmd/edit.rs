@@ -189,14 +189,14 @@ fn plan_table(e: &Edit) -> anyhow::Result<DataFrame> {
         (0..3)
             .map(|a| {
                 let v: Vec<Option<f64>> = (0..f.len()).map(|i| g(i).map(|p| p[a])).collect();
-                Column::new(format!("{name}_{}", ["x", "y", "z"][a]).into(), v)
+                Column::new(format!("{name}_{}_m", ["x", "y", "z"][a]).into(), v)
             })
             .collect()
     };
     let dt = e.edited.motion.frame_time_s;
     let mut cols = vec![
         Column::new(
-            "time_s".into(),
+            "time_clip_s".into(),
             (0..f.len()).map(|i| i as f64 * dt).collect::<Vec<_>>(),
         ),
         Column::new(
@@ -217,7 +217,7 @@ fn plan_table(e: &Edit) -> anyhow::Result<DataFrame> {
     cols.extend(v3("pose_com", &|i| Some(f[i].com_pose)));
     cols.extend(v3("contact", &|i| f[i].contact));
     cols.extend(v3("foot", &|i| f[i].foot));
-    for (n, name) in ["stance_td_s", "stance_lo_s"].iter().enumerate() {
+    for (n, name) in ["stance_td_clip_s", "stance_lo_clip_s"].iter().enumerate() {
         let v: Vec<Option<f64>> = f
             .iter()
             .map(|x| x.window.map(|w| if n == 0 { w.0 } else { w.1 }))

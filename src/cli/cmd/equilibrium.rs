@@ -25,7 +25,7 @@ pub(crate) fn read_text(path: &Path) -> anyhow::Result<String> {
 /// COM positions (m) and accelerations (m/s²), one per row.
 type ComStates = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 
-/// The COM positions and accelerations of `P.parquet` (`ax`, `ay`, `az` default 0).
+/// The COM positions and accelerations of `P.parquet` (`ax_mps2`, `ay_mps2`, `az_mps2` default 0).
 fn read_points(path: &Path) -> anyhow::Result<ComStates> {
     let rows = parquet_rows(path)?;
     if rows > MAX_COM_STATES {
@@ -52,14 +52,16 @@ fn read_points(path: &Path) -> anyhow::Result<ComStates> {
             .map(|i| [cols[0][i], cols[1][i], cols[2][i]])
             .collect())
     };
-    Ok((xyz(["x", "y", "z"], false)?, xyz(["ax", "ay", "az"], true)?))
+    let pos = ["x_m", "y_m", "z_m"];
+    let acc = ["ax_mps2", "ay_mps2", "az_mps2"];
+    Ok((xyz(pos, false)?, xyz(acc, true)?))
 }
 
 /// Run `equilibrium`.
 ///
 /// # Errors
 /// An unreadable or invalid contacts file, an unreadable points table or one without
-/// `x`, `y`, `z` (float64, no nulls), an unwritable output.
+/// `x_m`, `y_m`, `z_m` (float64, no nulls), an unwritable output.
 pub fn run(a: EquilibriumArgs) -> anyhow::Result<Outcome> {
     let text = read_text(&a.contacts)?;
     let file = parse_contacts(&text).with_context(|| a.contacts.display().to_string())?;
