@@ -173,18 +173,20 @@ fn model_with(c0: [f64; 3], phi: f64) -> ForceModel {
     }
 }
 
+/// The request of the degenerate-branch tests: a steady 3 m/s stance, 1.5 m apex to apex.
+const BASE: Request = Request {
+    zs: 1.0,
+    vs: 3.0,
+    ze: 1.0,
+    ve: 3.0,
+    vp: 0.0,
+    vps: 0.0,
+    x: 1.5,
+};
+
 #[test]
-fn degenerate_branches() {
-    let refs = Refs::default();
-    let base = Request {
-        zs: 1.0,
-        vs: 3.0,
-        ze: 1.0,
-        ve: 3.0,
-        vp: 0.0,
-        vps: 0.0,
-        x: 1.5,
-    };
+fn degenerate_branch_no_support() {
+    let (refs, base) = (Refs::default(), BASE);
     // (i) no support: J_v ≤ 0, and J_v = 0 exactly.
     for c0_v in [-100.0, 0.0] {
         let m = model_with([50.0, 0.0, c0_v], 0.3);
@@ -194,6 +196,11 @@ fn degenerate_branches() {
             Err(Infeasible::NoSupport)
         );
     }
+}
+
+#[test]
+fn degenerate_branch_no_net_horizontal_impulse_or_moment() {
+    let (refs, base) = (Refs::default(), BASE);
     // (ii) J_h = 0 (no DC), K_h > 0: φ = π/2 gives −sin 2πτ, brake then push.
     let m = model_with([0.0, 30.0, 1400.0], std::f64::consts::FRAC_PI_2);
     let shape = StanceShape::from_model(&m, false, false, None);
@@ -242,6 +249,11 @@ fn degenerate_branches() {
     .unwrap();
     assert_eq!(s.beta[0], 0.7);
     check_by_simulation(&m, &exact, &s, "branch (ii), K_h = 0");
+}
+
+#[test]
+fn degenerate_branch_no_net_perpendicular_impulse() {
+    let (refs, base) = (Refs::default(), BASE);
     // (iii) J_p = 0: vp must equal vps, β_p = β_p,ref.
     let m = model_with([50.0, 0.0, 1400.0], 0.4);
     let shape = StanceShape::from_model(&m, false, false, None);
@@ -259,6 +271,11 @@ fn degenerate_branches() {
     .unwrap();
     assert_eq!(s.beta[1], 0.4);
     check_by_simulation(&m, &base, &s, "branch (iii)");
+}
+
+#[test]
+fn degenerate_branches_running_in_place_and_reversal() {
+    let (refs, base) = (Refs::default(), BASE);
     // (iv) running in place: vs = ve = x = 0, Δz = 0 → T = β_v,ref J_v/g, β_h = 0.
     let m = model_with([50.0, 20.0, 1400.0], 0.4);
     let shape = StanceShape::from_model(&m, true, true, None);
