@@ -53,6 +53,13 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 16;
 /// Longest reach of a leg as a fraction of thigh plus shank (a straight knee has no
 /// bending direction; 0.999 leaves 2.6° of flexion).
 pub const DEFAULT_MAX_REACH: f64 = 0.999;
+/// Most extra plantarflexion of a foot turned about its toe tip to reach its target, degrees.
+/// When a planned COM is farther from the contact point than the leg reaches with the
+/// reference's foot pitch (a jump higher than recorded, the end of a push-off), the foot
+/// turns about its toe tip (the heel rises) until the ankle is within reach, so the toe
+/// stays on the floor where the reference's is; 50° is about the ankle's range of
+/// plantarflexion beyond standing.
+pub const DEFAULT_MAX_TOE_PIVOT_DEG: f64 = 50.0;
 /// Default number of steady run cycles.
 pub const DEFAULT_CYCLES: usize = 4;
 /// Most run cycles of one edit (each a second or so of motion: a cap on the output).
@@ -73,6 +80,8 @@ pub struct EditOptions {
     pub max_iterations: usize,
     /// [`DEFAULT_MAX_REACH`].
     pub max_reach: f64,
+    /// [`DEFAULT_MAX_TOE_PIVOT_DEG`].
+    pub max_toe_pivot_deg: f64,
 }
 
 impl Default for EditOptions {
@@ -82,6 +91,7 @@ impl Default for EditOptions {
             com_solve_tol_m: DEFAULT_COM_SOLVE_TOL_M,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             max_reach: DEFAULT_MAX_REACH,
+            max_toe_pivot_deg: DEFAULT_MAX_TOE_PIVOT_DEG,
         }
     }
 }
