@@ -60,6 +60,13 @@ pub const DEFAULT_MAX_REACH: f64 = 0.999;
 /// stays on the floor where the reference's is; 50° is about the ankle's range of
 /// plantarflexion beyond standing.
 pub const DEFAULT_MAX_TOE_PIVOT_DEG: f64 = 50.0;
+/// Resting band of a planted foot point, m: from the first to the last frame of a stance
+/// where the ankle or the toe tip is within this of its lowest height in the stance, its
+/// horizontal motion is the capture's slide and is removed from the planted foot
+/// (`pose::Reference::foot_drift`). Twice the 5 mm resting band of the round-trip check:
+/// output frames fall between source frames, and a toe that rests twice (flat, then again
+/// at toe-off, as the CMU run's does) must be held across the rise between.
+pub const FOOT_REST_BAND_M: f64 = 0.01;
 /// Default number of steady run cycles.
 pub const DEFAULT_CYCLES: usize = 4;
 /// Most run cycles of one edit (each a second or so of motion: a cap on the output).

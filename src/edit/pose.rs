@@ -53,6 +53,28 @@ pub struct StanceSource {
     pub anchor: V3,
     /// Feet in contact: left, right.
     pub feet: [bool; 2],
+    /// Horizontal drift of each source foot's resting points from touchdown, one entry per
+    /// source frame from `floor(td / Δt)` ([`Reference::foot_drift`]; m, Z up).
+    pub drift: [Vec<[f64; 2]>; 2],
+}
+
+impl StanceSource {
+    /// The drift of foot `side` at clip time `t` (s), linear between frames; 0 before the
+    /// stance, its last value after it.
+    pub fn drift_at(&self, side: usize, t: f64, frame_time_s: f64) -> [f64; 2] {
+        let d = &self.drift[side];
+        let Some(last) = d.last() else {
+            return [0.0; 2];
+        };
+        let f0 = (self.td_clip_s / frame_time_s).floor();
+        let x = (t / frame_time_s - f0).max(0.0);
+        let i = x.floor() as usize;
+        if i + 1 >= d.len() {
+            return *last;
+        }
+        let w = x - i as f64;
+        [0, 1].map(|a| d[i][a] + w * (d[i + 1][a] - d[i][a]))
+    }
 }
 
 /// The reference motion: the source clip's joint rotations per frame.
@@ -77,6 +99,8 @@ pub struct Reference {
     pub com: Vec<V3>,
     /// Source ankles per frame (left, right): position (m, Z up), world rotation (file).
     pub feet: Vec<[(V3, Quat); 2]>,
+    /// Source toe tips per frame (left, right; m, Z up), as the ingest places them.
+    pub toe_tips: Vec<[V3; 2]>,
 }
 
 impl Reference {
@@ -144,6 +168,7 @@ impl Reference {
         let mut quats = Vec::with_capacity(n * nj);
         let mut com = Vec::with_capacity(n);
         let mut feet = Vec::with_capacity(n);
+        let mut toe_tips = Vec::with_capacity(n);
         let mut ws = crate::skeleton::fk::FkWorkspace::new(sk);
         let np = sk.n_points();
         let (mut file, mut pts) = (vec![[0.0; 3]; np], vec![[0.0; 3]; np]);
@@ -157,6 +182,7 @@ impl Reference {
             com.push(body.com(&pts));
             let wq = world_quats(sk, &quats[f * nj..(f + 1) * nj]);
             feet.push([0, 1].map(|k| (pts[legs[k][2]], wq[legs[k][2]])));
+            toe_tips.push(body.toe_tips(&pts));
         }
         Ok(Reference {
             body,
@@ -168,6 +194,60 @@ impl Reference {
             toes,
             com,
             feet,
+            toe_tips,
+        })
+    }
+
+    /// Horizontal drift of the source feet over a stance from clip time `td` to `lo` (s),
+    /// per foot (left, right) and source frame from `floor(td / Δt)` to `ceil(lo / Δt)`:
+    /// ```text
+    /// h_p(f) = z_p(f) − min over the stance of z_p,    p ∈ {ankle, toe tip}
+    /// I_p = [first, last frame with h_p ≤ b],           b = FOOT_REST_BAND_M
+    /// D(f) = D(f−1) + Σ_{p: f−1, f ∈ I_p} Δx_p(f) / #{p: f−1, f ∈ I_p}   (0 when none),  D(first) = 0
+    /// ```
+    /// (`Δx_p`: the point's horizontal step.) Between the first and the last frame where a
+    /// foot point rests on the floor (within `b` of its lowest height) its horizontal motion
+    /// is the capture's slide, so removing `D` holds it in place: the heel while the foot
+    /// lands and rests, the toe tip until it rolls off (heel up), their mean while both
+    /// rest. A point on its way down or up does not count; `D` is a sum of steps, so the
+    /// foot's position stays continuous.
+    pub fn foot_drift(&self, td: f64, lo: f64) -> [Vec<[f64; 2]>; 2] {
+        let n = self.motion.n_frames();
+        let dt = self.motion.frame_time_s;
+        let f0 = ((td / dt).floor().max(0.0) as usize).min(n - 1);
+        let f1 = ((lo / dt).ceil().max(0.0) as usize).clamp(f0, n - 1);
+        [0, 1].map(|side| {
+            let tracks: [Vec<V3>; 2] = [
+                (f0..=f1).map(|f| self.feet[f][side].0).collect(),
+                (f0..=f1).map(|f| self.toe_tips[f][side]).collect(),
+            ];
+            let b = super::FOOT_REST_BAND_M;
+            let rests: Vec<(usize, usize)> = tracks
+                .iter()
+                .map(|p| {
+                    let zmin = p.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
+                    let on = |v: &V3| v[2] - zmin <= b;
+                    let first = p.iter().position(on).unwrap_or(0);
+                    let last = p.iter().rposition(on).unwrap_or(0);
+                    (first, last)
+                })
+                .collect();
+            let mut d = vec![[0.0; 2]];
+            for i in 1..tracks[0].len() {
+                let (mut step, mut count) = ([0.0; 2], 0.0);
+                for (p, &(first, last)) in tracks.iter().zip(&rests) {
+                    if first < i && i <= last {
+                        count += 1.0;
+                        for a in 0..2 {
+                            step[a] += p[i][a] - p[i - 1][a];
+                        }
+                    }
+                }
+                let prev = d[i - 1];
+                let k = if count > 0.0 { 1.0 / count } else { 0.0 };
+                d.push([0, 1].map(|a| prev[a] + step[a] * k));
+            }
+            d
         })
     }
 
@@ -366,7 +446,9 @@ fn anchored(
 ) -> (V3, Quat) {
     let body = &r.body;
     let (p, q) = r.foot_at(t_src, side);
-    let rel = rot::rotate(rot::axis_angle([0.0, 0.0, 1.0], yaw), sub(p, s.anchor));
+    let [dx, dy] = s.drift_at(side, t_src, r.motion.frame_time_s);
+    let planted = sub(p, [s.anchor[0] + dx, s.anchor[1] + dy, s.anchor[2]]);
+    let rel = rot::rotate(rot::axis_angle([0.0, 0.0, 1.0], yaw), planted);
     let c_plan = path.stances[k].contact_point();
     (
         body.to_file(add(c_plan, rel)),
