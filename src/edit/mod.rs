@@ -19,6 +19,20 @@
 //! - A support foot follows the reference foot's motion about the source contact point,
 //!   moved to the planned contact point and turned by the heading change; its orientation
 //!   (the toe's pitch, level when the reference's is) is the reference's, turned.
+//! - The capture's foot slide is not reproduced: between the first and the last frame where
+//!   the ankle or toe tip rests (within [`FOOT_REST_BAND_M`] of its lowest height in the
+//!   stance), its horizontal motion is removed from the planted foot, so the heel holds
+//!   while the foot lands and the toe tip while it rolls off (the CMU run's markers slid
+//!   1–2.6 cm while resting; the edits slid 17 mm with them).
+//! - A foot whose ankle is beyond the leg's reach turns about its toe tip (heel up, at most
+//!   [`DEFAULT_MAX_TOE_PIVOT_DEG`]) instead of leaving the floor: a jump higher than
+//!   recorded plans the COM farther from the contact point than the recorded push reaches
+//!   with the foot flat (1.10 m against 0.97 m at 1.2 × the apex; the jump query allows
+//!   1.05 × the stance's own extension), and without the pivot the feet left the floor
+//!   4.7 frames early. The toe keeps the reference toe's path, so contacts begin and end
+//!   on the plan. A plan beyond the reach of the leg on its upright foot is still reported
+//!   (a CMU run at 1.1 × its speed lifts off 2 frames early: the COM 3 % beyond the
+//!   recorded extension at liftoff).
 //! - The root carries the COM exactly: the COM is affine in the root translation, so one
 //!   root shift corrects it, and root shift and leg IK alternate until the COM error is
 //!   below [`DEFAULT_COM_TOL_M`]; frames that do not get there are reported.

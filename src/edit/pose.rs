@@ -10,7 +10,10 @@
 //!            lower case source, upper case plan)
 //!            q_j = slerp(q_j(t_A), q_j(t_B), w),  w = 3u² − 2u³,  u = (t − LO_k)/(TD_k' − LO_k)
 //! heading    q_root ← yaw(Δψ)·q_root,  Δψ = ψ_plan − ψ_source (blended by w in flight)
-//! feet       ankle* = c_plan + yaw(Δψ)(ankle_src − c_src),  foot orientation = yaw(Δψ)·src
+//! feet       ankle* = c_plan + yaw(Δψ)(ankle_src − c_src − D),  foot orientation = yaw(Δψ)·src
+//!            D: the source foot's slide while resting (Reference::foot_drift)
+//!            beyond reach (|ankle* − H| > reach): turn the foot about its toe tip T,
+//!            heel up, by the smallest φ ≤ φ_max with |ankle*(φ) − H| = reach (pivot_angle)
 //!            knee: rotate the shank about n = (H − K) × (A − K) to |A − H| = |ankle* − H|
 //!            hip:  the smallest rotation taking A − H onto ankle* − H
 //! root       t_root ← t_root + to_file(c_plan − COM(q))  (COM is affine in t_root)
@@ -238,8 +241,8 @@ impl Reference {
                 for (p, &(first, last)) in tracks.iter().zip(&rests) {
                     if first < i && i <= last {
                         count += 1.0;
-                        for a in 0..2 {
-                            step[a] += p[i][a] - p[i - 1][a];
+                        for (a, st) in step.iter_mut().enumerate() {
+                            *st += p[i][a] - p[i - 1][a];
                         }
                     }
                 }
