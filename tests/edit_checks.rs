@@ -52,10 +52,9 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
     let dir = tempfile::tempdir().unwrap();
     let lib = library(dir.path(), &[data.join("bvh/run/cmu_09_01_run_mb.bvh")]);
     let (id, v0) = cycle_of(&lib, "cmu_09_01_run_mb");
-    for (scale, misses, most_unconverged) in [
-        (1.0, &[][..], 2),
-        (1.1, &[("event_frames", 2.5)][..], 12),
-    ] {
+    for (scale, misses, most_unconverged) in
+        [(1.0, &[][..], 2), (1.1, &[("event_frames", 2.5)][..], 12)]
+    {
         let v = scale * v0;
         let out = dir.path().join(format!("cmu_{scale}.bvh"));
         edit_cycle(&lib, &id, v, &out);
