@@ -19,7 +19,7 @@ fn tmp() -> tempfile::TempDir {
 }
 
 /// A library of the given BVH files in `dir/lib`.
-fn library(dir: &Path, files: &[PathBuf]) -> PathBuf {
+pub(super) fn library(dir: &Path, files: &[PathBuf]) -> PathBuf {
     let lib = dir.join("lib");
     let mut args: Vec<String> = vec!["build".into()];
     args.extend(files.iter().map(|f| f.display().to_string()));
@@ -29,12 +29,12 @@ fn library(dir: &Path, files: &[PathBuf]) -> PathBuf {
     lib
 }
 
-fn fixture(name: &str) -> PathBuf {
+pub(super) fn fixture(name: &str) -> PathBuf {
     root().join("fixtures/bvh").join(format!("{name}.bvh"))
 }
 
 /// The first run cycle of `clip` in a library: (first stance id, recorded speed).
-fn cycle_of(lib: &Path, clip: &str) -> (String, f64) {
+pub(super) fn cycle_of(lib: &Path, clip: &str) -> (String, f64) {
     let l = open_library(lib).unwrap();
     let c = run_cycles(&l.stances)
         .into_iter()
@@ -113,18 +113,18 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// What the round trip measured (printed, then asserted by the callers).
 #[derive(Debug, Default)]
-struct Figures {
-    com_rms_m: f64,
-    com_max_m: f64,
-    event_err_frames: f64,
-    slide_max_m: f64,
-    joint_step_max_deg: f64,
-    flight_az_err: f64,
-    unconverged: usize,
+pub(super) struct Figures {
+    pub(super) com_rms_m: f64,
+    pub(super) com_max_m: f64,
+    pub(super) event_err_frames: f64,
+    pub(super) slide_max_m: f64,
+    pub(super) joint_step_max_deg: f64,
+    pub(super) flight_az_err: f64,
+    pub(super) unconverged: usize,
 }
 
 /// Re-ingests `out` and measures it against its plan.
-fn measure(out: &Path) -> Figures {
+pub(super) fn measure(out: &Path) -> Figures {
     let plan = read_plan(out);
     let (summary, frames, contacts) = reingest(out);
     let dt = summary.frame_time_s;
@@ -269,7 +269,7 @@ fn local_quats(b: &stancelib::bvh::Bvh) -> Vec<Quat> {
 /// The issue's bounds on one written motion, except `misses`: bounds this edit is known
 /// not to meet, each with the figure measured when it was written (asserted as a ceiling,
 /// printed as a miss; the report of issue 14 lists them with their cause).
-fn assert_bounds_except(f: &Figures, misses: &[(&str, f64)]) {
+pub(super) fn assert_bounds_except(f: &Figures, misses: &[(&str, f64)]) {
     let bound = |name: &str, value: f64, issue: f64| {
         let ceiling = misses.iter().find(|m| m.0 == name).map(|m| m.1);
         match ceiling {
@@ -292,7 +292,7 @@ fn assert_bounds_except(f: &Figures, misses: &[(&str, f64)]) {
 
 /// Runs an edit that may finish with frames reported as not converged (exit 1: a support
 /// foot out of reach); any other outcome fails.
-fn edit(args: &[&str]) {
+pub(super) fn edit(args: &[&str]) {
     let (code, out, err) = stancelib(args);
     assert!(
         code == 0 || code == 1,
@@ -339,7 +339,7 @@ fn edited_runs_round_trip_within_the_issue_bounds() {
 
 /// `edit run` of the cycle starting at stance `id` at `v` m/s into `out`, infeasible
 /// requests written anyway (see [`edit`]).
-fn edit_cycle(lib: &Path, id: &str, v: f64, out: &Path) {
+pub(super) fn edit_cycle(lib: &Path, id: &str, v: f64, out: &Path) {
     edit(&[
         "edit",
         "run",
@@ -504,7 +504,7 @@ fn infeasible_run_is_refused_naming_the_constraint_and_writes_nothing() {
 }
 
 /// The first liftoff stance followed by a landing stance: their indices.
-fn first_jump(s: &[stancelib::query::pool::PoolStance]) -> Option<(usize, usize)> {
+pub(super) fn first_jump(s: &[stancelib::query::pool::PoolStance]) -> Option<(usize, usize)> {
     (1..s.len()).find_map(|i| {
         (stancelib::query::jump::is_liftoff(&s[i - 1]) && stancelib::query::jump::is_landing(&s[i]))
             .then_some((i - 1, i))
@@ -520,10 +520,11 @@ fn edited_jumps_reach_the_requested_apex_and_round_trip() {
     let s = &l.stances;
     let (i, j) = first_jump(s).expect("a recorded jump");
     let (h0, d0) = stancelib::query::jump::recorded_jump(&s[i], &s[j]);
-    // Known miss (measured 2026-12-02): at 1.2 × the recorded apex the support feet are out
-    // of reach at the end of the push and start of the landing (11 frames reported): the
-    // re-detected contact edges move by up to 4.5 frames.
-    for (scale, misses) in [(1.0, &[][..]), (1.2, &[("event_frames", 5.0)][..])] {
+    // See: issue 14 checks — at 1.2 × the recorded apex the plan puts the COM up to 1.10 m
+    // from the contact point (the recorded push reaches 0.97 m with the foot flat): the
+    // legs could not reach, the feet left 4.7 frames early and landed 4.4 late. The foot
+    // now turns about its toe tip (`edit::DEFAULT_MAX_TOE_PIVOT_DEG`): every bound holds.
+    for (scale, misses) in [(1.0, &[][..]), (1.2, &[][..])] {
         let out = dir.path().join(format!("jump_{scale}.bvh"));
         edit(&[
             "edit",
@@ -577,9 +578,8 @@ fn edited_run_of_a_real_cmu_clip_round_trips() {
         let out = dir.path().join(format!("cmu_{v:.2}.bvh"));
         edit_cycle(&lib, &id, v, &out);
         let f = measure(&out);
-        // The COM, flight curvature, joint-step and NaN bounds hold here; contact timing
-        // and slide are printed by `measure` (the source clip's own heel–toe roll and
-        // mocap noise move its contact edges) and reported with issue 14.
+        // The COM, flight curvature, joint-step and NaN bounds; slide and contact timing
+        // are asserted in `edit_checks`.
         assert!(f.com_rms_m <= 0.01 && f.com_max_m <= 0.02, "{f:?}");
         assert!(f.flight_az_err <= 0.5, "{f:?}");
         assert!(f.joint_step_max_deg <= 30.0, "{f:?}");

@@ -46,6 +46,8 @@
 //!   states, transitions inside kinematic boxes, timings.json, bad JSON with its path.
 //!
 //! # Edited motion
+//! - `edit_checks`: issue 14 — the remaining checks: a jump higher than recorded lifts off and
+//!   lands on time on its toes, every frame converged; a real run's support foot holds still.
 //! - `edit_motion`: issue 14 — `edit run`/`edit jump` BVH re-ingested: COM on the plan,
 //!   planted feet, contact timing, speed, jump apex, flight curvature, joint steps, identity.
 //!
@@ -104,6 +106,7 @@ mod queries;
 mod kinematics;
 mod twopac;
 // Edited motion
+mod edit_checks;
 mod edit_motion;
 // Command line and documentation
 mod analyst;

@@ -19,6 +19,20 @@
 //! - A support foot follows the reference foot's motion about the source contact point,
 //!   moved to the planned contact point and turned by the heading change; its orientation
 //!   (the toe's pitch, level when the reference's is) is the reference's, turned.
+//! - The capture's foot slide is not reproduced: between the first and the last frame where
+//!   the ankle or toe tip rests (within [`FOOT_REST_BAND_M`] of its lowest height in the
+//!   stance), its horizontal motion is removed from the planted foot, so the heel holds
+//!   while the foot lands and the toe tip while it rolls off (the CMU run's markers slid
+//!   1–2.6 cm while resting; the edits slid 17 mm with them).
+//! - A foot whose ankle is beyond the leg's reach turns about its toe tip (heel up, at most
+//!   [`DEFAULT_MAX_TOE_PIVOT_DEG`]) instead of leaving the floor: a jump higher than
+//!   recorded plans the COM farther from the contact point than the recorded push reaches
+//!   with the foot flat (1.10 m against 0.97 m at 1.2 × the apex; the jump query allows
+//!   1.05 × the stance's own extension), and without the pivot the feet left the floor
+//!   4.7 frames early. The toe keeps the reference toe's path, so contacts begin and end
+//!   on the plan. A plan beyond the reach of the leg on its upright foot is still reported
+//!   (a CMU run at 1.1 × its speed lifts off 2 frames early: the COM 3 % beyond the
+//!   recorded extension at liftoff).
 //! - The root carries the COM exactly: the COM is affine in the root translation, so one
 //!   root shift corrects it, and root shift and leg IK alternate until the COM error is
 //!   below [`DEFAULT_COM_TOL_M`]; frames that do not get there are reported.
@@ -53,6 +67,20 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 16;
 /// Longest reach of a leg as a fraction of thigh plus shank (a straight knee has no
 /// bending direction; 0.999 leaves 2.6° of flexion).
 pub const DEFAULT_MAX_REACH: f64 = 0.999;
+/// Most extra plantarflexion of a foot turned about its toe tip to reach its target, degrees.
+/// When a planned COM is farther from the contact point than the leg reaches with the
+/// reference's foot pitch (a jump higher than recorded, the end of a push-off), the foot
+/// turns about its toe tip (the heel rises) until the ankle is within reach, so the toe
+/// stays on the floor where the reference's is; 50° is about the ankle's range of
+/// plantarflexion beyond standing.
+pub const DEFAULT_MAX_TOE_PIVOT_DEG: f64 = 50.0;
+/// Resting band of a planted foot point, m: from the first to the last frame of a stance
+/// where the ankle or the toe tip is within this of its lowest height in the stance, its
+/// horizontal motion is the capture's slide and is removed from the planted foot
+/// (`pose::Reference::foot_drift`). Twice the 5 mm resting band of the round-trip check:
+/// output frames fall between source frames, and a toe that rests twice (flat, then again
+/// at toe-off, as the CMU run's does) must be held across the rise between.
+pub const FOOT_REST_BAND_M: f64 = 0.01;
 /// Default number of steady run cycles.
 pub const DEFAULT_CYCLES: usize = 4;
 /// Most run cycles of one edit (each a second or so of motion: a cap on the output).
@@ -73,6 +101,8 @@ pub struct EditOptions {
     pub max_iterations: usize,
     /// [`DEFAULT_MAX_REACH`].
     pub max_reach: f64,
+    /// [`DEFAULT_MAX_TOE_PIVOT_DEG`].
+    pub max_toe_pivot_deg: f64,
 }
 
 impl Default for EditOptions {
@@ -82,6 +112,7 @@ impl Default for EditOptions {
             com_solve_tol_m: DEFAULT_COM_SOLVE_TOL_M,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             max_reach: DEFAULT_MAX_REACH,
+            max_toe_pivot_deg: DEFAULT_MAX_TOE_PIVOT_DEG,
         }
     }
 }

@@ -232,6 +232,7 @@ pub fn place(
                 heading_rad: hy.atan2(hx),
                 anchor,
                 feet: feet_of(&s.label),
+                drift: reference.foot_drift(t.td_clip_s, t.lo_clip_s),
             }
         })
         .collect();

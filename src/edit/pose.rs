@@ -10,7 +10,10 @@
 //!            lower case source, upper case plan)
 //!            q_j = slerp(q_j(t_A), q_j(t_B), w),  w = 3u² − 2u³,  u = (t − LO_k)/(TD_k' − LO_k)
 //! heading    q_root ← yaw(Δψ)·q_root,  Δψ = ψ_plan − ψ_source (blended by w in flight)
-//! feet       ankle* = c_plan + yaw(Δψ)(ankle_src − c_src),  foot orientation = yaw(Δψ)·src
+//! feet       ankle* = c_plan + yaw(Δψ)(ankle_src − c_src − D),  foot orientation = yaw(Δψ)·src
+//!            D: the source foot's slide while resting (Reference::foot_drift)
+//!            beyond reach (|ankle* − H| > reach): turn the foot about its toe tip T,
+//!            heel up, by the smallest φ ≤ φ_max with |ankle*(φ) − H| = reach (pivot_angle)
 //!            knee: rotate the shank about n = (H − K) × (A − K) to |A − H| = |ankle* − H|
 //!            hip:  the smallest rotation taking A − H onto ankle* − H
 //! root       t_root ← t_root + to_file(c_plan − COM(q))  (COM is affine in t_root)
@@ -53,6 +56,28 @@ pub struct StanceSource {
     pub anchor: V3,
     /// Feet in contact: left, right.
     pub feet: [bool; 2],
+    /// Horizontal drift of each source foot's resting points from touchdown, one entry per
+    /// source frame from `floor(td / Δt)` ([`Reference::foot_drift`]; m, Z up).
+    pub drift: [Vec<[f64; 2]>; 2],
+}
+
+impl StanceSource {
+    /// The drift of foot `side` at clip time `t` (s), linear between frames; 0 before the
+    /// stance, its last value after it.
+    pub fn drift_at(&self, side: usize, t: f64, frame_time_s: f64) -> [f64; 2] {
+        let d = &self.drift[side];
+        let Some(last) = d.last() else {
+            return [0.0; 2];
+        };
+        let f0 = (self.td_clip_s / frame_time_s).floor();
+        let x = (t / frame_time_s - f0).max(0.0);
+        let i = x.floor() as usize;
+        if i + 1 >= d.len() {
+            return *last;
+        }
+        let w = x - i as f64;
+        [0, 1].map(|a| d[i][a] + w * (d[i + 1][a] - d[i][a]))
+    }
 }
 
 /// The reference motion: the source clip's joint rotations per frame.
@@ -70,10 +95,15 @@ pub struct Reference {
     pub legs: [[usize; 3]; 2],
     /// Root joint.
     pub root: usize,
+    /// Toe-tip point of each leg (left, right) when it moves with the ankle (a point below
+    /// it in the tree): the pivot of [`DEFAULT_MAX_TOE_PIVOT_DEG`](super::DEFAULT_MAX_TOE_PIVOT_DEG).
+    pub toes: [Option<usize>; 2],
     /// Source COM per frame (m, Z up).
     pub com: Vec<V3>,
     /// Source ankles per frame (left, right): position (m, Z up), world rotation (file).
     pub feet: Vec<[(V3, Quat); 2]>,
+    /// Source toe tips per frame (left, right; m, Z up), as the ingest places them.
+    pub toe_tips: Vec<[V3; 2]>,
 }
 
 impl Reference {
@@ -131,10 +161,17 @@ impl Reference {
                 }
             }
         }
+        let toes = [0, 1].map(|k| {
+            body.toe[k].filter(|&p| {
+                let j = if p < nj { p } else { sk.end_sites[p - nj].0 };
+                j == legs[k][2] || below(legs[k][2], j)
+            })
+        });
         let n = motion.n_frames();
         let mut quats = Vec::with_capacity(n * nj);
         let mut com = Vec::with_capacity(n);
         let mut feet = Vec::with_capacity(n);
+        let mut toe_tips = Vec::with_capacity(n);
         let mut ws = crate::skeleton::fk::FkWorkspace::new(sk);
         let np = sk.n_points();
         let (mut file, mut pts) = (vec![[0.0; 3]; np], vec![[0.0; 3]; np]);
@@ -148,6 +185,7 @@ impl Reference {
             com.push(body.com(&pts));
             let wq = world_quats(sk, &quats[f * nj..(f + 1) * nj]);
             feet.push([0, 1].map(|k| (pts[legs[k][2]], wq[legs[k][2]])));
+            toe_tips.push(body.toe_tips(&pts));
         }
         Ok(Reference {
             body,
@@ -156,8 +194,63 @@ impl Reference {
             axes,
             legs,
             root,
+            toes,
             com,
             feet,
+            toe_tips,
+        })
+    }
+
+    /// Horizontal drift of the source feet over a stance from clip time `td` to `lo` (s),
+    /// per foot (left, right) and source frame from `floor(td / Δt)` to `ceil(lo / Δt)`:
+    /// ```text
+    /// h_p(f) = z_p(f) − min over the stance of z_p,    p ∈ {ankle, toe tip}
+    /// I_p = [first, last frame with h_p ≤ b],           b = FOOT_REST_BAND_M
+    /// D(f) = D(f−1) + Σ_{p: f−1, f ∈ I_p} Δx_p(f) / #{p: f−1, f ∈ I_p}   (0 when none),  D(first) = 0
+    /// ```
+    /// (`Δx_p`: the point's horizontal step.) Between the first and the last frame where a
+    /// foot point rests on the floor (within `b` of its lowest height) its horizontal motion
+    /// is the capture's slide, so removing `D` holds it in place: the heel while the foot
+    /// lands and rests, the toe tip until it rolls off (heel up), their mean while both
+    /// rest. A point on its way down or up does not count; `D` is a sum of steps, so the
+    /// foot's position stays continuous.
+    pub fn foot_drift(&self, td: f64, lo: f64) -> [Vec<[f64; 2]>; 2] {
+        let n = self.motion.n_frames();
+        let dt = self.motion.frame_time_s;
+        let f0 = ((td / dt).floor().max(0.0) as usize).min(n - 1);
+        let f1 = ((lo / dt).ceil().max(0.0) as usize).clamp(f0, n - 1);
+        [0, 1].map(|side| {
+            let tracks: [Vec<V3>; 2] = [
+                (f0..=f1).map(|f| self.feet[f][side].0).collect(),
+                (f0..=f1).map(|f| self.toe_tips[f][side]).collect(),
+            ];
+            let b = super::FOOT_REST_BAND_M;
+            let rests: Vec<(usize, usize)> = tracks
+                .iter()
+                .map(|p| {
+                    let zmin = p.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
+                    let on = |v: &V3| v[2] - zmin <= b;
+                    let first = p.iter().position(on).unwrap_or(0);
+                    let last = p.iter().rposition(on).unwrap_or(0);
+                    (first, last)
+                })
+                .collect();
+            let mut d = vec![[0.0; 2]];
+            for i in 1..tracks[0].len() {
+                let (mut step, mut count) = ([0.0; 2], 0.0);
+                for (p, &(first, last)) in tracks.iter().zip(&rests) {
+                    if first < i && i <= last {
+                        count += 1.0;
+                        for (a, st) in step.iter_mut().enumerate() {
+                            *st += p[i][a] - p[i - 1][a];
+                        }
+                    }
+                }
+                let prev = d[i - 1];
+                let k = if count > 0.0 { 1.0 / count } else { 0.0 };
+                d.push([0, 1].map(|a| prev[a] + step[a] * k));
+            }
+            d
         })
     }
 
@@ -356,7 +449,9 @@ fn anchored(
 ) -> (V3, Quat) {
     let body = &r.body;
     let (p, q) = r.foot_at(t_src, side);
-    let rel = rot::rotate(rot::axis_angle([0.0, 0.0, 1.0], yaw), sub(p, s.anchor));
+    let [dx, dy] = s.drift_at(side, t_src, r.motion.frame_time_s);
+    let planted = sub(p, [s.anchor[0] + dx, s.anchor[1] + dy, s.anchor[2]]);
+    let rel = rot::rotate(rot::axis_angle([0.0, 0.0, 1.0], yaw), planted);
     let c_plan = path.stances[k].contact_point();
     (
         body.to_file(add(c_plan, rel)),
@@ -548,15 +643,16 @@ fn place_feet(
     ws: &mut PoseWorkspace,
     pulls: &[Option<(V3, Quat, f64)>; 2],
     planted: [bool; 2],
-    max_reach: f64,
+    opts: &EditOptions,
 ) -> f64 {
     let body = &r.body;
+    let max_reach = opts.max_reach;
     let goal: [Option<(V3, Quat)>; 2] = std::array::from_fn(|side| {
         pulls[side].map(|(p, q, w)| {
             let ankle = r.legs[side][2];
             let (fp, fq) = (ws.file[ankle], ws.world_q[ankle]);
             let pos = std::array::from_fn(|i| fp[i] + w * (p[i] - fp[i]));
-            (pos, rot::slerp(fq, q, w))
+            toe_pivot(r, ws, side, (pos, rot::slerp(fq, q, w)), opts)
         })
     });
     for (side, g) in goal.iter().enumerate() {
@@ -613,7 +709,7 @@ pub fn pose_frame(
         ws.pose.q.copy_from_slice(&ws.free_q);
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
         if pulls.iter().any(Option::is_some) {
-            foot_err = place_feet(r, ws, &pulls, planted, opts.max_reach);
+            foot_err = place_feet(r, ws, &pulls, planted, opts);
         }
         com_pose = body.com(&ws.pts);
         let e = sub(com_plan, com_pose);
@@ -650,6 +746,74 @@ pub fn pose_frame(
         foot_error_m: foot_err,
         iterations,
         converged: err_m <= opts.com_tol_m && foot_err <= opts.com_tol_m,
+    }
+}
+
+/// The foot goal `(ankle, orientation)` (file frame) of leg `side`, turned about its toe
+/// tip (heel up, [`pivot_angle`]) when the ankle is beyond the leg's reach from the hip as
+/// FK left it in `ws`; unchanged when it is within reach or the leg has no toe below its
+/// ankle.
+fn toe_pivot(
+    r: &Reference,
+    ws: &PoseWorkspace,
+    side: usize,
+    goal: (V3, Quat),
+    opts: &EditOptions,
+) -> (V3, Quat) {
+    let Some(tp) = r.toes[side] else { return goal };
+    let [hip, knee, ankle] = r.legs[side];
+    let (h, k, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
+    let reach = opts.max_reach * (norm(sub(h, k)) + norm(sub(a, k)));
+    let (p, q) = goal;
+    if norm(sub(p, h)) <= reach {
+        return goal;
+    }
+    let toe_ankle = rot::rotate(rot::conj(ws.world_q[ankle]), sub(ws.file[tp], a));
+    let toe = add(p, rot::rotate(q, toe_ankle));
+    let axis = cross(up_file(&r.body), sub(toe, p));
+    let n = norm(axis);
+    if n == 0.0 {
+        return goal;
+    }
+    let axis = axis.map(|v| v / n);
+    let u = sub(p, toe);
+    let phi = pivot_angle(toe, u, axis, h, reach, opts.max_toe_pivot_deg.to_radians());
+    let turn = rot::axis_angle(axis, phi);
+    (add(toe, rot::rotate(turn, u)), rot::mul(turn, q))
+}
+
+/// The smallest turn `φ ∈ [0, φ_max]` (rad) about `axis` (unit, ⟂ `u`) through the toe
+/// tip `toe` that brings the ankle `toe + u` within `reach` of the hip `hip`:
+/// ```text
+/// ankle(φ) = T + u cos φ + (n × u) sin φ,   |ankle(φ) − H|² = R²
+///   ⇔ A cos φ + B sin φ = C,  A = 2(T − H)·u,  B = 2(T − H)·(n × u),  C = R² − |T − H|² − |u|²
+/// ```
+/// the first root above 0; without one (the hip too far even from the nearest ankle
+/// position) the turn to that nearest position; both capped at `φ_max`.
+fn pivot_angle(toe: V3, u: V3, axis: V3, hip: V3, reach: f64, max_rad: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let th = sub(toe, hip);
+    let w = cross(axis, u);
+    let (a, b) = (2.0 * dot(th, u), 2.0 * dot(th, w));
+    let c = reach * reach - dot(th, th) - dot(u, u);
+    let m = a.hypot(b);
+    if m == 0.0 {
+        return 0.0;
+    }
+    let psi = b.atan2(a);
+    let phi = if c / m >= -1.0 {
+        let d = (c / m).min(1.0).acos();
+        [psi - d, psi + d]
+            .map(|x| x.rem_euclid(TAU))
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    } else {
+        (psi + PI).rem_euclid(TAU)
+    };
+    if phi > PI {
+        0.0
+    } else {
+        phi.min(max_rad)
     }
 }
 
@@ -736,5 +900,48 @@ pub fn pose_motion(
             values,
         },
         frames,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ankle 8 cm above the floor, toe tip 19 cm ahead on it, Z up, pivot axis +y.
+    const TOE: V3 = [0.19, 0.0, 0.0];
+    const U: V3 = [-0.19, 0.0, 0.08];
+    const AXIS: V3 = [0.0, 1.0, 0.0];
+
+    fn ankle_at(phi: f64) -> V3 {
+        add(TOE, rot::rotate(rot::axis_angle(AXIS, phi), U))
+    }
+
+    #[test]
+    fn toe_pivot_puts_the_ankle_at_the_reach_with_the_heel_up() {
+        let hip = [0.0, 0.0, 0.98];
+        for reach in [0.88, 0.85, 0.8] {
+            let phi = pivot_angle(TOE, U, AXIS, hip, reach, 50f64.to_radians());
+            let a = ankle_at(phi);
+            // Closed form against the quaternion rotation: roundoff (1e-12 m).
+            assert!((norm(sub(a, hip)) - reach).abs() < 1e-12, "reach {reach}");
+            assert!(phi > 0.0 && a[2] > U[2], "heel up: φ {phi}, ankle {a:?}");
+            // The first root: every smaller turn leaves the ankle out of reach.
+            assert!(norm(sub(ankle_at(0.999 * phi), hip)) > reach);
+        }
+    }
+
+    #[test]
+    fn toe_pivot_out_of_range_turns_to_the_nearest_ankle_or_the_cap() {
+        let hip = [0.0, 0.0, 0.98];
+        let cap = 50f64.to_radians();
+        // 0.3 m: no turn reaches; the nearest ankle position lies past the cap.
+        assert_eq!(pivot_angle(TOE, U, AXIS, hip, 0.3, cap), cap);
+        let phi = pivot_angle(TOE, U, AXIS, hip, 0.3, std::f64::consts::PI);
+        let d = |p: f64| norm(sub(ankle_at(p), hip));
+        // The nearest point of the circle (sampled at 0.001 rad around it).
+        assert!(
+            d(phi) <= d(phi - 1e-3) && d(phi) <= d(phi + 1e-3),
+            "φ {phi}"
+        );
     }
 }
