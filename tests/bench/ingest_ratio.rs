@@ -25,8 +25,20 @@
 //! to time it as a whole process beside the `stancelib` binary.
 //!
 //! # Results
-//! The figures of each run are in the notes of issue 15; the machine the benches run on is
-//! shared, so only ratios measured in one run compare.
+//! 2026-12-02, 2-core x86_64 sandbox shared with three other engineers (load 2.4–3.0),
+//! profiling profile, bulk CMU set, 3 rounds, this bench built from the commit before
+//! issue 15 (base) and from the issue 15 branch (head), run base, head, base, head:
+//!
+//! ```text
+//!                      base pass 1   base pass 2   head pass 1   head pass 2   head (3rd run)
+//! frames, 2 threads    0.791 s 4.25× 0.715 s 4.24× 0.467 s 4.56× 0.650 s 3.31× 0.546 s 3.35×
+//! build,  2 threads    1.200 s 5.98× 1.016 s 6.15× 0.932 s 8.91× 1.041 s 5.42× 0.937 s 5.61×
+//! frames, 1 thread     0.948 s 3.62× 0.709 s 3.80× 0.607 s 3.42× 0.770 s 3.65× 0.635 s 3.46×
+//! build,  1 thread     1.125 s 4.29× 1.043 s 5.51× 0.940 s 5.21× 1.068 s 4.89× 0.984 s 5.28×
+//! ```
+//! (wall, × the parse limit of the same round). The limit itself sped up only 1.12–1.45×
+//! with 2 threads: the second core was not free, so the 2-thread speed-up and the 2-thread
+//! ratios mean little here; rerun on a quiet machine.
 
 mod parse_limit;
 

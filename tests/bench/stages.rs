@@ -55,6 +55,16 @@
 //! ```
 //! Proposals 2 and 4 (AVX2 batched sin/cos, four frames per lane) reach the 1.5 M goal but
 //! add a runtime-dispatched SIMD path; not adopted yet.
+//!
+//! Issue 15 adopted proposal 4 (`fk::forward_frames`, module `skeleton::fk::simd`).
+//! 2026-12-02, same machine (load ≈ 1), profiling profile, `--measurement-time 4`:
+//!
+//! ```text
+//! fk_com/full_batched                     1.40 ms   1.96 M frames/s   what the ingest runs
+//! fk_com/full_libm_reference              3.09 ms    890 k frames/s   the FK before issue 15
+//! fk_com/full                             3.19 ms    863 k frames/s   one frame per call
+//! fk_com/full_proposal_4_four_frames_per_lane  1.36 ms  2.03 M frames/s
+//! ```
 //! `perf` of `full`: 52 % in `fk::forward` itself, 39 % in glibc `__sincos_fma`, 3 % in
 //! `com::com`. Inside `fk::forward` the hot spots are the reloads of the rotation matrix
 //! that `rotate_right` keeps on the stack: it indexes columns with the runtime pair
