@@ -74,6 +74,10 @@
 //! - `structure_stages`: items 1, 4 — the contact stage's entry points give the ingest's
 //!   contacts; batch ingest errors keep their kind.
 //!
+//! # Speed (issue 15)
+//! - `speed`: the batched SIMD FK equals its scalar fallback bit for bit and the libm FK to
+//!   1e-12 m on the shared clips.
+//!
 //! # Regressions and helpers
 //! - `regression`: one test per review finding, named after it.
 //! - `util`: shared helpers: the shared-data gate and skips, fixtures and their library, the
@@ -120,6 +124,8 @@ mod safety_outputs;
 // Structure (issue 13)
 mod structure_edges;
 mod structure_stages;
+// Speed (issue 15)
+mod speed;
 // Regressions and helpers
 mod regression;
 mod util;

@@ -73,7 +73,8 @@ pub fn parse_reader<R: Read>(reader: R) -> Result<Bvh> {
     let hierarchy = header.finish(lines.line)?;
     let (frames_header, frame_time_s) = read_motion_header(&mut lines)?;
     let n_channels = hierarchy.n_channels();
-    let values = read_rows(&mut lines, n_channels)?;
+    let hint = frames_header.map_or(0, |h| usize::try_from(h).unwrap_or(usize::MAX));
+    let values = read_rows(&mut lines, n_channels, hint)?;
     let motion = Motion {
         frames_header,
         frame_time_s,
@@ -184,6 +185,30 @@ impl<R: Read> LineReader<R> {
                 return Ok(true);
             }
         }
+    }
+
+    /// The next line as a slice and its 1-based number; `None` at end of file. A line that
+    /// lies whole in the buffer, ended by LF, CRLF or a CR before other text, is returned
+    /// in place (no copy); any other goes through [`LineReader::next`] into `buf`.
+    fn next_slice(&mut self) -> Result<Option<(&[u8], usize)>> {
+        if self.pending_empty == 0 && self.pos < self.end {
+            let avail = &self.chunk[self.pos..self.end];
+            if let Some(i) = avail.iter().position(|&b| b == b'\n' || b == b'\r') {
+                let brk = match (avail[i], avail.get(i + 1)) {
+                    (b'\n', _) => Some(1),
+                    (b'\r', Some(b'\n')) => Some(2),
+                    (b'\r', Some(b)) if *b != b'\r' => Some(1),
+                    _ => None, // CR at the buffer's end, or CR CR: the general path
+                };
+                if let Some(k) = brk {
+                    let start = self.pos;
+                    self.pos += i + k;
+                    self.line += 1;
+                    return Ok(Some((&self.chunk[start..start + i], self.line)));
+                }
+            }
+        }
+        Ok(self.next()?.then_some((&self.buf[..], self.line)))
     }
 
     /// After a CR: further CRs then LF make one break with it; otherwise each further CR
@@ -546,13 +571,18 @@ fn read_motion_header<R: Read>(lines: &mut LineReader<R>) -> Result<(Option<u64>
     }
 }
 
-/// Read every data row; values are appended row-major.
-fn read_rows<R: Read>(lines: &mut LineReader<R>, n: usize) -> Result<Vec<f64>> {
-    let mut values = Vec::new();
+/// Most values reserved up front from the `Frames:` header (2²² values, 32 MiB of address
+/// space, not touched until filled): a header that lies costs no more than this.
+const MAX_RESERVED_VALUES: usize = 1 << 22;
+
+/// Read every data row; values are appended row-major. `frames_hint` (the `Frames:` header,
+/// 0 without one) sizes the first allocation.
+fn read_rows<R: Read>(lines: &mut LineReader<R>, n: usize, frames_hint: usize) -> Result<Vec<f64>> {
+    let mut values = Vec::with_capacity(frames_hint.saturating_mul(n).min(MAX_RESERVED_VALUES));
     let mut short: Option<(usize, usize)> = None;
-    while lines.next()? {
+    while let Some((row, line)) = lines.next_slice()? {
         let start = values.len();
-        let count = parse_row(&lines.buf, &mut values, lines.line)?;
+        let count = parse_row(row, &mut values, line)?;
         if count == 0 {
             continue;
         }
@@ -563,11 +593,11 @@ fn read_rows<R: Read>(lines: &mut LineReader<R>, n: usize) -> Result<Vec<f64>> {
             values.truncate(start);
             if count > n {
                 return Err(Error::bvh(
-                    lines.line,
+                    line,
                     format!("expected {n} values, found {count}"),
                 ));
             }
-            short = Some((lines.line, count));
+            short = Some((line, count));
         }
     }
     if let Some((l, c)) = short {
@@ -594,35 +624,48 @@ fn echo_bytes(raw: &[u8]) -> String {
 }
 
 /// Split one row on ASCII whitespace and parse every token; returns the token count.
+/// Each number is scanned once: `parse_partial` reads it and says where it ends, which
+/// must be whitespace or the end of the row.
 fn parse_row(buf: &[u8], out: &mut Vec<f64>, line: usize) -> Result<usize> {
     let mut count = 0;
     let mut i = 0;
     let len = buf.len();
-    while i < len {
+    loop {
         while i < len && buf[i].is_ascii_whitespace() {
             i += 1;
         }
-        let s = i;
-        while i < len && !buf[i].is_ascii_whitespace() {
-            i += 1;
-        }
-        if s == i {
+        if i == len {
             break;
         }
-        let tok = &buf[s..i];
-        match fast_float2::parse::<f64, _>(tok) {
-            Ok(v) if v.is_finite() => out.push(v),
-            Ok(_) => {
-                return Err(Error::bvh(
-                    line,
-                    format!("value {}: non-finite '{}'", count + 1, echo_bytes(tok)),
-                ))
+        let rest = &buf[i..];
+        match fast_float2::parse_partial::<f64, _>(rest) {
+            Ok((v, n)) if rest.get(n).is_none_or(u8::is_ascii_whitespace) => {
+                if !v.is_finite() {
+                    return Err(Error::bvh(
+                        line,
+                        format!(
+                            "value {}: non-finite '{}'",
+                            count + 1,
+                            echo_bytes(&rest[..n])
+                        ),
+                    ));
+                }
+                out.push(v);
+                i += n;
             }
-            Err(_) => {
+            _ => {
+                let end = rest
+                    .iter()
+                    .position(u8::is_ascii_whitespace)
+                    .unwrap_or(rest.len());
                 return Err(Error::bvh(
                     line,
-                    format!("value {}: '{}' is not a number", count + 1, echo_bytes(tok)),
-                ))
+                    format!(
+                        "value {}: '{}' is not a number",
+                        count + 1,
+                        echo_bytes(&rest[..end])
+                    ),
+                ));
             }
         }
         count += 1;

@@ -45,15 +45,15 @@ pub fn facing(hip_l: V3, hip_r: V3) -> V3 {
     }
 }
 
-/// FK over the kept frames into one flat array (frames × points), file units and axes.
+/// FK over the kept frames into one flat array (frames × points), file units and axes
+/// ([`fk::forward_frames`]: several frames per SIMD batch).
 pub(super) fn fk_frames(skel: &Skeleton, bvh: &Bvh, skip: usize) -> Vec<V3> {
     let np = skel.n_points();
     let n = bvh.motion.n_frames() - skip;
     let mut out = vec![[0.0; 3]; n * np];
     let mut ws = fk::FkWorkspace::new(skel);
-    for (f, chunk) in out.chunks_exact_mut(np).enumerate() {
-        fk::forward(skel, &mut ws, bvh.motion.row(skip + f), chunk);
-    }
+    let nc = bvh.motion.n_channels;
+    fk::forward_frames(skel, &mut ws, &bvh.motion.values[skip * nc..], &mut out);
     out
 }
 

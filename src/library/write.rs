@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use polars::prelude::*;
+use rayon::prelude::*;
 
 use super::columns::col;
 
@@ -446,10 +447,13 @@ pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()>
         (SCHEMA_VERSION_KEY.to_string(), SCHEMA_VERSION.to_string()),
         (TOOL_VERSION_KEY.to_string(), TOOL_VERSION.to_string()),
     ];
-    for (name, df) in tables.iter_mut() {
-        write_atomic(dir, name, df, &kv)?;
-    }
-    Ok(())
+    // Side by side on the caller's pool (each table its own file); the first failure in
+    // table order is reported.
+    let written: Vec<Result<()>> = tables
+        .par_iter_mut()
+        .map(|(name, df)| write_atomic(dir, name, df, &kv))
+        .collect();
+    written.into_iter().collect()
 }
 
 #[cfg(test)]

@@ -1,5 +1,5 @@
 //! Pure numerical helpers shared by the stages: Savitzky–Golay differentiation,
-//! order statistics and small polynomial least-squares fits.
+//! order statistics, small polynomial least-squares fits and branch-free sin/cos.
 
 pub mod constants;
 pub mod polyfit;
@@ -7,4 +7,5 @@ pub mod savgol;
 pub mod spline;
 pub mod stats;
 pub mod svd;
+pub mod trig;
 pub mod v3;

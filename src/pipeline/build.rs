@@ -207,16 +207,30 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions, bar: &Progress)
 impl Tables {
     /// The tables of a build; `joints.parquet` too when the ingest kept joint positions
     /// (`--joints`: the same table as `frames --joints` writes).
+    /// The tables are assembled side by side on the worker pool.
     fn from_report(r: &BuildReport, joints: bool) -> Result<Tables> {
+        let rec = &r.records;
+        let ((frames, contacts), ((clips, stances), (errors, joints))) = rayon::join(
+            || rayon::join(|| frames_table(rec), || contacts_table(rec)),
+            || {
+                rayon::join(
+                    || rayon::join(|| clips_table(rec), || stances_table(&r.stances)),
+                    || {
+                        rayon::join(
+                            || errors_table(&r.errors),
+                            || joints.then(|| joints_table(rec)),
+                        )
+                    },
+                )
+            },
+        );
         Ok(Tables {
-            frames: frames_table(&r.records).map_err(|e| pe(FRAMES_FILE, e))?,
-            contacts: contacts_table(&r.records).map_err(|e| pe(CONTACTS_FILE, e))?,
-            clips: clips_table(&r.records).map_err(|e| pe(CLIPS_FILE, e))?,
-            stances: stances_table(&r.stances).map_err(|e| pe(STANCES_FILE, e))?,
-            errors: errors_table(&r.errors).map_err(|e| pe(ERRORS_FILE, e))?,
-            joints: joints
-                .then(|| joints_table(&r.records).map_err(|e| pe(JOINTS_FILE, e)))
-                .transpose()?,
+            frames: frames.map_err(|e| pe(FRAMES_FILE, e))?,
+            contacts: contacts.map_err(|e| pe(CONTACTS_FILE, e))?,
+            clips: clips.map_err(|e| pe(CLIPS_FILE, e))?,
+            stances: stances.map_err(|e| pe(STANCES_FILE, e))?,
+            errors: errors.map_err(|e| pe(ERRORS_FILE, e))?,
+            joints: joints.transpose().map_err(|e| pe(JOINTS_FILE, e))?,
         })
     }
 }

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use polars::prelude::*;
+use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::library::kinematics::{
@@ -271,10 +272,14 @@ impl LibrarySink {
         if t.errors.height() > 0 {
             self.errors.push(std::mem::take(&mut t.errors));
         }
-        for ((_, df), (_, w)) in t.named().into_iter().zip(self.writers.iter_mut()) {
-            w.push(df)?;
-        }
-        Ok(())
+        // The tables are written side by side on the worker pool (each its own file).
+        let pushed: Vec<Result<()>> = t
+            .named()
+            .into_par_iter()
+            .zip(self.writers.par_iter_mut())
+            .map(|((_, df), (_, w))| w.push(df))
+            .collect();
+        pushed.into_iter().collect()
     }
 
     /// Add error rows (any order).

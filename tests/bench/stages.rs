@@ -55,6 +55,16 @@
 //! ```
 //! Proposals 2 and 4 (AVX2 batched sin/cos, four frames per lane) reach the 1.5 M goal but
 //! add a runtime-dispatched SIMD path; not adopted yet.
+//!
+//! Issue 15 adopted proposal 4 (`fk::forward_frames`, module `skeleton::fk::simd`).
+//! 2026-12-02, same machine (load ≈ 1), profiling profile, `--measurement-time 4`:
+//!
+//! ```text
+//! fk_com/full_batched                     1.40 ms   1.96 M frames/s   what the ingest runs
+//! fk_com/full_libm_reference              3.09 ms    890 k frames/s   the FK before issue 15
+//! fk_com/full                             3.19 ms    863 k frames/s   one frame per call
+//! fk_com/full_proposal_4_four_frames_per_lane  1.36 ms  2.03 M frames/s
+//! ```
 //! `perf` of `full`: 52 % in `fk::forward` itself, 39 % in glibc `__sincos_fma`, 3 % in
 //! `com::com`. Inside `fk::forward` the hot spots are the reloads of the rotation matrix
 //! that `rotate_right` keeps on the stack: it indexes columns with the runtime pair
@@ -66,6 +76,8 @@
 //! from libm) compiled for AVX2+FMA behind a runtime check; variant 4 runs four frames
 //! per call, one per SIMD lane. Building each local rotation off the dependency chain and
 //! then one `parent · local` product was 15–20 % slower than variant 1 and was dropped.
+
+mod parse_limit;
 
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -80,6 +92,8 @@ use stancelib::skeleton::fk::{self, FkWorkspace};
 use stancelib::skeleton::landmarks::{self, Landmarks, Limb, Mapping};
 use stancelib::skeleton::units::CMU_UNIT_M;
 use stancelib::skeleton::Skeleton;
+
+use parse_limit::baseline_split_parse;
 
 /// The benchmarked clip, relative to the crate root.
 const CLIP: &str = "../shared/data/bvh/jump/cmu_01_01_forward_jumps_mb.bvh";
@@ -231,22 +245,6 @@ fn close_joint(s: &mut String, depth: usize, end: Option<[f64; 3]>) {
 // ---------------------------------------------------------------------------------------
 // (a) parse
 
-/// The baseline: skip to the line after `Frame Time:`, then split every line on ASCII
-/// whitespace and parse each token with `fast_float2`. No validation, no line numbers.
-fn baseline_split_parse(bytes: &[u8]) -> Vec<f64> {
-    let text = std::str::from_utf8(bytes).expect("utf-8");
-    let at = text.find("Frame Time").expect("Frame Time line");
-    let body = &text[at..];
-    let body = &body[body.find('\n').expect("newline") + 1..];
-    let mut out = Vec::new();
-    for line in body.lines() {
-        for tok in line.split_ascii_whitespace() {
-            out.push(fast_float2::parse::<f64, _>(tok).expect("number"));
-        }
-    }
-    out
-}
-
 fn bench_parse(c: &mut Criterion) {
     let (bytes, label) = clip_bytes();
     let ours = bvh::parse_reader(&bytes[..]).expect("clip parses");
@@ -390,6 +388,37 @@ fn bench_fk_com(c: &mut Criterion) {
     g.bench_function(BenchmarkId::new("full", &label), |b| {
         b.iter(|| {
             fk_com_all(&p, &mut ws, &mut pts, &mut pts_m, &mut out, &mut contacts);
+            black_box((&out, &contacts));
+        })
+    });
+    // What ingest runs: `fk::forward_frames` over every frame (FK_LANES frames per SIMD
+    // batch), then units, contact points and COM per frame.
+    let rows = &p.bvh.motion.values;
+    let mut all = vec![[0.0; 3]; n * np];
+    g.bench_function(BenchmarkId::new("full_batched", &label), |b| {
+        b.iter(|| {
+            fk::forward_frames(&p.skel, &mut ws, black_box(rows), &mut all);
+            out.clear();
+            contacts.clear();
+            for fp in all.chunks_exact(np) {
+                out.push(units_com(&p, fp, &mut pts_m));
+                contacts.push(contact_points(&p, &pts_m));
+            }
+            black_box((&out, &contacts));
+        })
+    });
+    // The libm FK `fk::forward` ran before issue 15 (`fk::forward_reference`).
+    let mut rot = vec![fk::IDENTITY; p.skel.n_joints()];
+    g.bench_function(BenchmarkId::new("full_libm_reference", &label), |b| {
+        b.iter(|| {
+            let m = &p.bvh.motion;
+            out.clear();
+            contacts.clear();
+            for f in 0..n {
+                fk::forward_reference(&p.skel, &mut rot, black_box(m.row(f)), &mut pts);
+                out.push(units_com(&p, &pts, &mut pts_m));
+                contacts.push(contact_points(&p, &pts_m));
+            }
             black_box((&out, &contacts));
         })
     });

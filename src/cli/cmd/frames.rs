@@ -33,8 +33,10 @@ pub fn execute(
     opts: &IngestOptions,
     threads: usize,
 ) -> anyhow::Result<Outcome> {
-    let records = worker_pool(files, threads)?.install(|| ingest_all(files, opts));
-    write_all(out, &records, opts.joints)
+    let pool = worker_pool(files, threads)?;
+    let records = pool.install(|| ingest_all(files, opts));
+    // On the same workers: the tables and their columns are encoded in parallel.
+    pool.install(|| write_all(out, &records, opts.joints))
         .with_context(|| format!("writing tables to {}", out.display()))?;
     let outcome = report(&records, out);
     crate::cli::summary_json(&summary(&records, out, "frames"));
