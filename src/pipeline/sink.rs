@@ -6,7 +6,8 @@
 //! ```text
 //! limits:      per stance  (clip, character_id, mass_kg, f_peak, ext_min, ext_max, unsupported)
 //!              per clip    (s_eff, leg_length_m)
-//! kinematics:  per contact frame (character_id, effector, clip, frame, x, y, z)   [samples]
+//! kinematics:  per contact frame (frame, x, y, z) in a scratch file, indexed per
+//!              (character_id, effector, clip)                          [samples, on disk]
 //!              per character (leg length of its first clip)
 //! manifest:    per clip (content hash, status); errors rows
 //! ```
@@ -23,8 +24,7 @@ use polars::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::library::kinematics::{
-    add_character_legs, kinematics_tables, samples_table, Facet, Sample, SampleStore,
-    SAMPLES_SORT_KEYS,
+    add_character_legs, facets_table, points_frame, samples_table, Facet, Sample, SAMPLES_SORT_KEYS,
 };
 use crate::library::read::parquet_rows;
 use crate::library::schema::{
@@ -35,6 +35,8 @@ use crate::library::schema::{
 use crate::library::schema::{
     INPUTS_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION, TOOL_VERSION_KEY,
 };
+use crate::library::scratch::{scratch_name, Scratch};
+use crate::library::spill::SampleSpill;
 use crate::library::stances::{errors_table, stances_table};
 use crate::library::stream::{read_rows, TableWriter};
 use crate::library::write::{
@@ -42,6 +44,10 @@ use crate::library::write::{
 };
 use crate::stances::limits::{limits, ClipFacts, StanceFacts};
 use crate::twopac::kinematic::kinematic_polytope;
+
+/// The scratch file of a library's kinematic samples, in its temporary folder
+/// ([`SampleSpill`]; removed before the folder is swapped into place).
+const SPILL_FILE: &str = "kinematics_samples.spill";
 
 pub(crate) fn pe(name: &str, e: PolarsError) -> Error {
     Error::io(name, "cannot build table", e)
@@ -187,7 +193,7 @@ pub(crate) struct LibrarySink {
     writers: Vec<(&'static str, TableWriter)>,
     template: Tables,
     errors: Vec<DataFrame>,
-    samples: SampleStore,
+    samples: SampleSpill,
     legs: BTreeMap<String, f64>,
     stance_facts: Vec<StanceFacts>,
     clip_facts: BTreeMap<String, ClipFacts>,
@@ -218,7 +224,7 @@ impl LibrarySink {
             writers,
             template,
             errors: Vec::new(),
-            samples: SampleStore::default(),
+            samples: SampleSpill::create(&dir.join(scratch_name(SPILL_FILE, Scratch::Tmp)))?,
             legs: BTreeMap::new(),
             stance_facts: Vec::new(),
             clip_facts: BTreeMap::new(),
@@ -241,9 +247,7 @@ impl LibrarySink {
         if self.compute_samples {
             let s = samples_table(&t.frames, &t.contacts, &t.clips)
                 .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
-            self.samples
-                .add(&s)
-                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+            self.samples.add(&s)?;
         }
         add_character_legs(&mut self.legs, &t.clips).map_err(|e| pe(CLIPS_FILE, e))?;
         self.stance_facts.extend(stance_facts(&t.stances));
@@ -282,11 +286,10 @@ impl LibrarySink {
         self.errors.push(df);
     }
 
-    /// Add kinematic samples (any order; sorted at the end).
+    /// Add kinematic samples: a samples table sorted by [`SAMPLES_SORT_KEYS`], or a slice
+    /// of one (tables and slices in any order; a clip's rows in one table, in order).
     pub fn push_samples(&mut self, df: &DataFrame) -> Result<()> {
-        self.samples
-            .add(df)
-            .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))
+        self.samples.add(df)
     }
 
     /// Write the remaining tables, the footers and `manifest.json`; `shard` is recorded in
@@ -316,18 +319,11 @@ impl LibrarySink {
             w.finish(&kv)?;
         }
         write_atomic(&dir, ERRORS_FILE, &mut errors, &kv)?;
-        let mut samples = std::mem::take(&mut self.samples);
+        self.samples.seal()?;
         if self.keep_samples {
-            let mut table = samples
-                .table()
-                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
-            write_atomic(&dir, KINEMATICS_SAMPLES_FILE, &mut table, &kv)?;
+            write_samples(&self.samples, &dir, &kv)?;
         }
-        let (mut facets, mut points) =
-            kinematics(samples, &self.legs).map_err(|e| pe(KINEMATICS_FILE, e))?;
-        write_atomic(&dir, KINEMATICS_FILE, &mut facets, &kv)?;
-        write_atomic(&dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
-        drop((facets, points));
+        kinematics(&self.samples, &self.legs, &dir, &kv)?;
         let count = |s: &str| self.status.iter().filter(|v| *v == s).count();
         let mut manifest = serde_json::json!({
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
@@ -354,21 +350,70 @@ impl LibrarySink {
     }
 }
 
-/// The two kinematics tables (`(facets, points)`) of `samples` with each character's leg
-/// length (m): per (character, effector) the outlier rules and the polytope
-/// ([`kinematic_polytope`]); a group with fewer than 4 non-coplanar points after the rules
-/// has points but no facets (an error at query time).
+/// Rows of a group's samples appended to `w`, a row group's worth at a time.
+struct GroupRows<'a> {
+    key: &'a (String, String),
+    rows: Vec<Sample>,
+    w: &'a mut TableWriter,
+}
+
+impl GroupRows<'_> {
+    fn add(&mut self, s: &Sample) -> Result<()> {
+        self.rows.push(s.clone());
+        if self.rows.len() >= ROW_GROUP_ROWS {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        let df = points_frame(self.key, &self.rows).map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
+        self.rows.clear();
+        self.w.push(&df)
+    }
+}
+
+/// `kinematics_samples.parquet` (a shard's summary): every sample, by group.
+fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Result<()> {
+    let empty =
+        points_frame(&Default::default(), &[]).map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+    let mut w = TableWriter::create(dir, KINEMATICS_SAMPLES_FILE, &empty)?;
+    for (key, _) in spill.groups() {
+        let mut rows = GroupRows {
+            key,
+            rows: Vec::new(),
+            w: &mut w,
+        };
+        spill.read_group(key, &mut |b| b.iter().try_for_each(|s| rows.add(s)))?;
+        rows.flush()?;
+    }
+    w.finish(kv)
+}
+
+/// The two kinematics tables of the spilled samples with each character's leg length (m),
+/// written into `dir`: per (character, effector) the outlier rules and the polytope
+/// ([`kinematic_polytope`]) on the group's points (held for the group alone: see the
+/// module docs of [`crate::twopac::kinematic`]), then the kept samples streamed from the
+/// spill; a group with fewer than 4 non-coplanar points after the rules has points but no
+/// facets (an error at query time).
 fn kinematics(
-    samples: SampleStore,
+    spill: &SampleSpill,
     legs: &BTreeMap<String, f64>,
-) -> PolarsResult<(DataFrame, DataFrame)> {
-    let groups = samples.into_groups();
-    let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
+    dir: &Path,
+    kv: &[(String, String)],
+) -> Result<()> {
+    let empty =
+        points_frame(&Default::default(), &[]).map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
+    let mut w = TableWriter::create(dir, KINEMATICS_POINTS_FILE, &empty)?;
     let mut facets: Vec<Facet> = Vec::new();
-    for (key, g) in &groups {
-        let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
+    for (key, n) in spill.groups() {
+        let mut pts: Vec<[f64; 3]> = Vec::with_capacity(n as usize);
+        spill.read_group(key, &mut |b| {
+            pts.extend(b.iter().map(|s| s.rc));
+            Ok(())
+        })?;
         let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
-        let (keep, poly) = kinematic_polytope(&pts, leg);
+        let (keep, poly) = kinematic_polytope(pts, leg);
         if let Some(p) = poly {
             facets.extend(
                 p.a.iter()
@@ -376,16 +421,26 @@ fn kinematics(
                     .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d)),
             );
         }
-        kept.push((
+        let mut rows = GroupRows {
             key,
-            g.iter()
-                .zip(keep)
-                .filter(|(_, k)| *k)
-                .map(|(s, _)| s)
-                .collect(),
-        ));
+            rows: Vec::new(),
+            w: &mut w,
+        };
+        let mut at = 0;
+        spill.read_group(key, &mut |b| {
+            for s in b {
+                if keep[at] {
+                    rows.add(s)?;
+                }
+                at += 1;
+            }
+            Ok(())
+        })?;
+        rows.flush()?;
     }
-    kinematics_tables(facets, &kept)
+    w.finish(kv)?;
+    let mut facets = facets_table(facets).map_err(|e| pe(KINEMATICS_FILE, e))?;
+    write_atomic(dir, KINEMATICS_FILE, &mut facets, kv)
 }
 
 /// `parts` stacked and sorted as table `name` (`empty` when there are none).
