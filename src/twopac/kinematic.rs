@@ -13,6 +13,20 @@
 //! contact at `(p, R)` uses `K_w = K_e Rᵀ`, `k_w = k_e + K_e Rᵀ p`
 //! ([`Polytope::to_world_yaw`]).
 //!
+//! # Memory: why one group's points are held
+//! A library build keeps the samples on disk and reduces one (character, effector) at a
+//! time; that group's points are then in memory (~200 bytes a point with the hull's
+//! copies). The outlier rule alone would need only bounded state (a streamed centroid in
+//! file order, and the P99.5 order statistics by a radix selection over the distances),
+//! but the hull would not: parry's quickhull normalises the points by the covariance of
+//! **all** of them (interior points included), picks its first triangle from that
+//! normalisation, and takes each facet's farthest point from that facet's conflict list,
+//! which can be a point inside the final hull (the point farther out may sit in another
+//! facet's list). So a hull of a bounded subset (the boundary points, say) gives the same
+//! polytope only up to the order of its triangles and their vertices, and the rounding of
+//! the normals and offsets follows that order: the bytes of `kinematics.parquet` would
+//! change. Exact identity with the in-memory build therefore keeps one group's points.
+//!
 //! # References
 //! spec two-pac §3; com-from-bvh §7.5 (contact frames).
 
