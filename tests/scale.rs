@@ -23,7 +23,7 @@ fn fixture_inputs() -> Vec<PathBuf> {
 
 /// `n` real clips of the bulk CMU set (every `step`-th, so several subjects), or `None`
 /// (skipped outside CI) when the shared data is absent.
-fn real_subset(test: &str, n: usize) -> Option<Vec<PathBuf>> {
+pub(super) fn real_subset(test: &str, n: usize) -> Option<Vec<PathBuf>> {
     let data = shared_or_skip(test)?;
     let all = stancelib::pipeline::batch::discover(&[data.join("bvh-bulk/cmu")]).unwrap();
     let step = (all.len() / n).max(1);
@@ -40,7 +40,7 @@ fn files_of(lib: &Path) -> Vec<String> {
 }
 
 /// Two libraries hold the same files with the same bytes (manifests: but the wall time).
-fn assert_same_library(a: &Path, b: &Path) {
+pub(super) fn assert_same_library(a: &Path, b: &Path) {
     assert_eq!(
         files_of(a),
         files_of(b),
@@ -67,7 +67,7 @@ fn assert_same_library(a: &Path, b: &Path) {
 }
 
 /// `stancelib build` of `inputs` into `out` with `extra` options; the exit code.
-fn build_cli(inputs: &[PathBuf], out: &Path, extra: &[&str]) -> i32 {
+pub(super) fn build_cli(inputs: &[PathBuf], out: &Path, extra: &[&str]) -> i32 {
     let mut args: Vec<String> = vec!["build".into()];
     args.extend(inputs.iter().map(|p| s(p)));
     args.extend(["--out".into(), s(out)]);
@@ -82,7 +82,7 @@ fn build_cli(inputs: &[PathBuf], out: &Path, extra: &[&str]) -> i32 {
 }
 
 /// Build every shard of `n` into `dir/shard-I`, merge into `dir/merged`; the merged path.
-fn shard_and_merge(inputs: &[PathBuf], dir: &Path, n: usize, extra: &[&str]) -> PathBuf {
+pub(super) fn shard_and_merge(inputs: &[PathBuf], dir: &Path, n: usize, extra: &[&str]) -> PathBuf {
     let mut shards = Vec::new();
     for i in 1..=n {
         let out = dir.join(format!("shard-{i}"));

@@ -34,6 +34,8 @@
 //!   plates of the treadmill run); unknown stances exit 2 and write nothing.
 //! - `scale`: issue 16 — streaming build (any batch size and thread count), `--shard I/N`
 //!   and `merge` equal to one build byte for byte, merge refusals, the Spark driver.
+//! - `scale_memory`: issue 16 items 1–2 — kinematic samples spilled to disk, not held:
+//!   no scratch left behind, shards whose samples span several row groups merge exactly.
 //!
 //! # Queries
 //! - `queries`: the run-at-speed sweep, recorded jumps feasible as recorded, the jump map and
@@ -104,6 +106,7 @@ mod force_export;
 mod golden;
 mod readers;
 mod scale;
+mod scale_memory;
 // Queries
 mod queries;
 // 2PAC

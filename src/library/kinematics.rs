@@ -1,7 +1,8 @@
 //! The kinematic tables (spec two-pac §3): `kinematics_samples.parquet` (a shard's
 //! samples), `kinematics.parquet` (the polytopes' facets) and `kinematics_points.parquet`
-//! (the points behind them), written and read back. The polytopes themselves are built
-//! from the samples in memory by [`crate::twopac::kinematic`].
+//! (the points behind them), written and read back. While a library is written its
+//! samples wait in a scratch file ([`super::spill`]); the polytopes are built from them one
+//! (character, effector) at a time by [`crate::twopac::kinematic`].
 //!
 //! `kinematics.parquet`: one row per facet, `character_id`, `effector`, `nx`, `ny`, `nz`,
 //! `d_m` (`n·ʳc ≤ d`, unit outward `n`, metres, contact frame), sorted by (`character_id`,
@@ -32,8 +33,6 @@ pub struct Sample {
     pub rc: [f64; 3],
 }
 
-/// Samples by (character, effector).
-pub type Groups = BTreeMap<(String, String), Vec<Sample>>;
 /// One facet row: character, effector, unit outward normal, offset (m).
 pub type Facet = (String, String, [f64; 3], f64);
 /// The facets of one polytope: unit outward normals and offsets (m), `n·ʳc ≤ d`.
@@ -112,7 +111,7 @@ pub fn add_character_legs(legs: &mut BTreeMap<String, f64>, clips: &DataFrame) -
 
 /// The kinematic samples of whole clips: every contact frame's COM in its contact frame,
 /// before the outlier rules, one row per (character, effector, clip, frame) with
-/// `character_id`, `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m` (m), sorted by those four
+/// `character_id`, `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m`, sorted by those four
 /// keys. This is the per-character summary a shard keeps (`kinematics_samples.parquet`):
 /// the polytopes of a merge are made from the shards' samples.
 ///
@@ -157,10 +156,7 @@ pub fn samples_table(
     rows.sort_by(|x, y| (x.0, x.1, x.2, x.3).cmp(&(y.0, y.1, y.2, y.3)));
     let p = |a: usize| -> Vec<f64> { rows.iter().map(|r| r.4[a]).collect() };
     DataFrame::new_infer_height(vec![
-        col(
-            K::CHARACTER_ID,
-            rows.iter().map(|r| r.0).collect::<Vec<_>>(),
-        ),
+        col(K::CHARACTER_ID, rows.iter().map(|r| r.0).collect::<Vec<_>>()),
         col(K::EFFECTOR, rows.iter().map(|r| r.1).collect::<Vec<_>>()),
         col(K::CLIP, rows.iter().map(|r| r.2).collect::<Vec<_>>()),
         col(K::FRAME, rows.iter().map(|r| r.3).collect::<Vec<_>>()),
@@ -173,132 +169,12 @@ pub fn samples_table(
 /// Sort keys of a samples table (see [`samples_table`]).
 pub const SAMPLES_SORT_KEYS: [&str; 4] = [K::CHARACTER_ID, K::EFFECTOR, K::CLIP, K::FRAME];
 
-/// Samples grouped by (character, effector), in (clip, frame) order, from a samples table
-/// sorted by [`SAMPLES_SORT_KEYS`].
-fn add_groups(groups: &mut Groups, samples: &DataFrame) -> PolarsResult<()> {
-    let str_col =
-        |n: &str| -> PolarsResult<StringChunked> { Ok(samples.column(n)?.str()?.clone()) };
-    let f64_col =
-        |n: &str| -> PolarsResult<Float64Chunked> { Ok(samples.column(n)?.f64()?.clone()) };
-    let (ch, eff, clip) = (
-        str_col(K::CHARACTER_ID)?,
-        str_col(K::EFFECTOR)?,
-        str_col(K::CLIP)?,
-    );
-    let frame = samples.column(K::FRAME)?.i64()?.clone();
-    let (x, y, z) = (
-        f64_col(K::POINT[0])?,
-        f64_col(K::POINT[1])?,
-        f64_col(K::POINT[2])?,
-    );
-    // One shared name per run of a clip's samples (memory: a pointer per sample).
-    let mut last_clip: Option<Arc<str>> = None;
-    let mut group: Option<((String, String), Vec<Sample>)> = None;
-    let rows = ch
-        .iter()
-        .zip(eff.iter())
-        .zip(clip.iter())
-        .zip(frame.iter())
-        .zip(x.iter().zip(y.iter()).zip(z.iter()));
-    for ((((c, e), k), f), ((x, y), z)) in rows {
-        let (Some(c), Some(e), Some(k), Some(f), Some(x), Some(y), Some(z)) = (c, e, k, f, x, y, z)
-        else {
-            continue;
-        };
-        let name = match &last_clip {
-            Some(l) if &**l == k => l.clone(),
-            _ => {
-                let l: Arc<str> = Arc::from(k);
-                last_clip = Some(l.clone());
-                l
-            }
-        };
-        if group
-            .as_ref()
-            .is_none_or(|(key, _)| key.0 != c || key.1 != e)
-        {
-            if let Some((key, g)) = group.take() {
-                groups.entry(key).or_default().extend(g);
-            }
-            group = Some(((c.to_string(), e.to_string()), Vec::new()));
-        }
-        if let Some((_, g)) = group.as_mut() {
-            g.push(Sample {
-                clip: name,
-                frame: f,
-                rc: [x, y, z],
-            });
-        }
-    }
-    if let Some((key, g)) = group.take() {
-        groups.entry(key).or_default().extend(g);
-    }
-    Ok(())
-}
-
-/// Kinematic samples kept across batches or shards, compactly (a shared clip name, the
-/// frame and the point: 48 bytes a sample), grouped by (character, effector).
-#[derive(Debug, Default)]
-pub struct SampleStore {
-    groups: Groups,
-}
-
-impl SampleStore {
-    /// Add the rows of a samples table (see [`samples_table`]; any order of batches).
-    ///
-    /// # Errors
-    /// The table lacks a column or has it with another type.
-    pub fn add(&mut self, samples: &DataFrame) -> PolarsResult<()> {
-        add_groups(&mut self.groups, samples)
-    }
-
-    /// Samples held.
-    pub fn len(&self) -> usize {
-        self.groups.values().map(Vec::len).sum()
-    }
-
-    /// No samples held.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Each group in (clip, frame) order (stable: rows of one clip and frame keep theirs).
-    fn sort(&mut self) {
-        for g in self.groups.values_mut() {
-            g.sort_by(|a, b| (&a.clip, a.frame).cmp(&(&b.clip, b.frame)));
-        }
-    }
-
-    /// The samples table, sorted by [`SAMPLES_SORT_KEYS`] (a shard's summary).
-    ///
-    /// # Errors
-    /// A column cannot be built.
-    pub fn table(&mut self) -> PolarsResult<DataFrame> {
-        self.sort();
-        let rows: Vec<(&(String, String), &Sample)> = self
-            .groups
-            .iter()
-            .flat_map(|(k, g)| g.iter().map(move |s| (k, s)))
-            .collect();
-        points_table(&rows)
-    }
-
-    /// The samples grouped by (character, effector), each group in (clip, frame) order.
-    pub fn into_groups(mut self) -> Groups {
-        self.sort();
-        self.groups
-    }
-}
-
-/// The two kinematics tables `(facets, points)`: the facets of every polytope (sorted by
-/// character, effector, normal, offset) and the samples kept behind them, in group order.
+/// The facets table (`kinematics.parquet`) of every polytope's facets, sorted by
+/// character, effector, normal and offset.
 ///
 /// # Errors
 /// A column cannot be built.
-pub fn kinematics_tables(
-    mut facets: Vec<Facet>,
-    kept: &[(&(String, String), Vec<&Sample>)],
-) -> PolarsResult<(DataFrame, DataFrame)> {
+pub fn facets_table(mut facets: Vec<Facet>) -> PolarsResult<DataFrame> {
     facets.sort_by(|x, y| {
         (&x.0, &x.1)
             .cmp(&(&y.0, &y.1))
@@ -308,7 +184,7 @@ pub fn kinematics_tables(
             .then(x.3.total_cmp(&y.3))
     });
     let f = |g: &dyn Fn(&Facet) -> f64| -> Vec<f64> { facets.iter().map(g).collect() };
-    let facet_df = DataFrame::new_infer_height(vec![
+    DataFrame::new_infer_height(vec![
         col(
             K::CHARACTER_ID,
             facets.iter().map(|r| r.0.clone()).collect::<Vec<_>>(),
@@ -321,13 +197,7 @@ pub fn kinematics_tables(
         col(K::NORMAL[1], f(&|r| r.2[1])),
         col(K::NORMAL[2], f(&|r| r.2[2])),
         col(K::OFFSET, f(&|r| r.3)),
-    ])?;
-    let rows: Vec<(&(String, String), &Sample)> = kept
-        .iter()
-        .flat_map(|(k, g)| g.iter().map(move |s| (*k, *s)))
-        .collect();
-    let points_df = points_table(&rows)?;
-    Ok((facet_df, points_df))
+    ])
 }
 
 /// The facets of a library's kinematic polytopes by (`character_id`, `effector`): unit
@@ -338,12 +208,7 @@ pub fn kinematics_tables(
 pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRows>> {
     let t = Table::open(&lib_dir.join(KINEMATICS_FILE))?;
     let (ch, eff) = (t.strings(K::CHARACTER_ID)?, t.strings(K::EFFECTOR)?);
-    let (nx, ny, nz, d) = (
-        t.f64s(K::NORMAL[0])?,
-        t.f64s(K::NORMAL[1])?,
-        t.f64s(K::NORMAL[2])?,
-        t.f64s(K::OFFSET)?,
-    );
+    let (nx, ny, nz, d) = (t.f64s(K::NORMAL[0])?, t.f64s(K::NORMAL[1])?, t.f64s(K::NORMAL[2])?, t.f64s(K::OFFSET)?);
     let mut rows: BTreeMap<(String, String), FacetRows> = BTreeMap::new();
     for i in 0..t.height() {
         let n = [nx[i], ny[i], nz[i]];
@@ -363,27 +228,19 @@ pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRow
     Ok(rows)
 }
 
-/// The contact samples behind the polytopes, one row per sample: `character_id`,
-/// `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m` (m).
-fn points_table(rows: &[(&(String, String), &Sample)]) -> PolarsResult<DataFrame> {
-    let p = |a: usize| -> Vec<f64> { rows.iter().map(|(_, s)| s.rc[a]).collect() };
+/// Rows of one (character, effector) group's samples in the layout of
+/// `kinematics_points.parquet` and `kinematics_samples.parquet`: `character_id`,
+/// `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m`.
+///
+/// # Errors
+/// A column cannot be built.
+pub fn points_frame(key: &(String, String), rows: &[Sample]) -> PolarsResult<DataFrame> {
+    let p = |a: usize| -> Vec<f64> { rows.iter().map(|s| s.rc[a]).collect() };
     DataFrame::new_infer_height(vec![
-        col(
-            K::CHARACTER_ID,
-            rows.iter().map(|(k, _)| k.0.as_str()).collect::<Vec<_>>(),
-        ),
-        col(
-            K::EFFECTOR,
-            rows.iter().map(|(k, _)| k.1.as_str()).collect::<Vec<_>>(),
-        ),
-        col(
-            K::CLIP,
-            rows.iter().map(|(_, s)| &*s.clip).collect::<Vec<&str>>(),
-        ),
-        col(
-            K::FRAME,
-            rows.iter().map(|(_, s)| s.frame).collect::<Vec<_>>(),
-        ),
+        col(K::CHARACTER_ID, vec![key.0.as_str(); rows.len()]),
+        col(K::EFFECTOR, vec![key.1.as_str(); rows.len()]),
+        col(K::CLIP, rows.iter().map(|s| &*s.clip).collect::<Vec<&str>>()),
+        col(K::FRAME, rows.iter().map(|s| s.frame).collect::<Vec<_>>()),
         col(K::POINT[0], p(0)),
         col(K::POINT[1], p(1)),
         col(K::POINT[2], p(2)),
@@ -403,12 +260,9 @@ mod schema_tests {
                 .map(|n| n.to_string())
                 .collect()
         };
-        let (facets, points) = kinematics_tables(Vec::new(), &[]).unwrap();
+        let facets = facets_table(Vec::new()).unwrap();
+        let points = points_frame(&Default::default(), &[]).unwrap();
         assert_eq!(names(&facets), KINEMATICS_COLUMNS);
         assert_eq!(names(&points), KINEMATICS_POINTS_COLUMNS);
-        assert_eq!(
-            names(&SampleStore::default().table().unwrap()),
-            KINEMATICS_POINTS_COLUMNS
-        );
     }
 }

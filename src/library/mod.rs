@@ -17,6 +17,7 @@ pub mod provenance;
 pub mod read;
 pub mod schema;
 pub mod scratch;
+pub mod spill;
 pub mod stances;
 pub mod stream;
 pub mod write;

@@ -206,6 +206,22 @@ fn clip_plan(libs: &[ShardLib]) -> Result<Vec<(String, usize)>> {
     Ok(plan.into_iter().map(|(c, (_, f))| (c, f)).collect())
 }
 
+/// Spill a shard's samples table into `sink` a row group's worth at a time (never the
+/// whole table in memory).
+fn push_samples(sink: &mut LibrarySink, path: &Path) -> Result<()> {
+    let total = crate::library::read::parquet_rows(path)?;
+    let mut at = 0;
+    while at < total {
+        let rows = crate::library::stream::read_rows(path, at, ROW_GROUP_ROWS)?;
+        if rows.height() == 0 {
+            break;
+        }
+        at += rows.height();
+        sink.push_samples(&rows)?;
+    }
+    Ok(())
+}
+
 /// Merge the shard libraries `shards` into the library `out` under `rules` (module docs).
 ///
 /// # Errors
@@ -238,7 +254,7 @@ pub fn merge_into(shards: &[PathBuf], out: &Path, rules: &OutputRules) -> Result
         let mut cursors: Vec<Vec<ClipCursor>> = Vec::new();
         for lib in &libs {
             sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
-            sink.push_samples(&read_parquet(&lib.dir.join(KINEMATICS_SAMPLES_FILE))?)?;
+            push_samples(&mut sink, &lib.dir.join(KINEMATICS_SAMPLES_FILE))?;
             let names: Vec<&str> = sink.template().named().iter().map(|(n, _)| *n).collect();
             cursors.push(
                 names

@@ -6,7 +6,8 @@
 //! ```text
 //! limits:      per stance  (clip, character_id, mass_kg, f_peak, ext_min, ext_max, unsupported)
 //!              per clip    (s_eff, leg_length_m)
-//! kinematics:  per contact frame (character_id, effector, clip, frame, x, y, z)   [samples]
+//! kinematics:  per contact frame (frame, x, y, z) in a scratch file, indexed per
+//!              (character_id, effector, clip)                          [samples, on disk]
 //!              per character (leg length of its first clip)
 //! manifest:    per clip (content hash, status); errors rows
 //! ```
@@ -24,8 +25,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::library::kinematics::{
-    add_character_legs, kinematics_tables, samples_table, Facet, Sample, SampleStore,
-    SAMPLES_SORT_KEYS,
+    add_character_legs, facets_table, points_frame, samples_table, Facet, Sample, SAMPLES_SORT_KEYS,
 };
 use crate::library::read::parquet_rows;
 use crate::library::schema::{
@@ -36,6 +36,8 @@ use crate::library::schema::{
 use crate::library::schema::{
     INPUTS_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION, TOOL_VERSION_KEY,
 };
+use crate::library::scratch::{scratch_name, Scratch};
+use crate::library::spill::SampleSpill;
 use crate::library::stances::{errors_table, stances_table};
 use crate::library::stream::{read_rows, TableWriter};
 use crate::library::write::{
@@ -43,6 +45,10 @@ use crate::library::write::{
 };
 use crate::stances::limits::{limits, ClipFacts, StanceFacts};
 use crate::twopac::kinematic::kinematic_polytope;
+
+/// The scratch file of a library's kinematic samples, in its temporary folder
+/// ([`SampleSpill`]; removed before the folder is swapped into place).
+const SPILL_FILE: &str = "kinematics_samples.spill";
 
 pub(crate) fn pe(name: &str, e: PolarsError) -> Error {
     Error::io(name, "cannot build table", e)
@@ -188,7 +194,7 @@ pub(crate) struct LibrarySink {
     writers: Vec<(&'static str, TableWriter)>,
     template: Tables,
     errors: Vec<DataFrame>,
-    samples: SampleStore,
+    samples: SampleSpill,
     legs: BTreeMap<String, f64>,
     stance_facts: Vec<StanceFacts>,
     clip_facts: BTreeMap<String, ClipFacts>,
@@ -219,7 +225,7 @@ impl LibrarySink {
             writers,
             template,
             errors: Vec::new(),
-            samples: SampleStore::default(),
+            samples: SampleSpill::create(&dir.join(scratch_name(SPILL_FILE, Scratch::Tmp)))?,
             legs: BTreeMap::new(),
             stance_facts: Vec::new(),
             clip_facts: BTreeMap::new(),
@@ -242,9 +248,7 @@ impl LibrarySink {
         if self.compute_samples {
             let s = samples_table(&t.frames, &t.contacts, &t.clips)
                 .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
-            self.samples
-                .add(&s)
-                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+            self.samples.add(&s)?;
         }
         add_character_legs(&mut self.legs, &t.clips).map_err(|e| pe(CLIPS_FILE, e))?;
         self.stance_facts.extend(stance_facts(&t.stances));
@@ -287,11 +291,10 @@ impl LibrarySink {
         self.errors.push(df);
     }
 
-    /// Add kinematic samples (any order; sorted at the end).
+    /// Add kinematic samples: a samples table sorted by [`SAMPLES_SORT_KEYS`], or a slice
+    /// of one (tables and slices in any order; a clip's rows in one table, in order).
     pub fn push_samples(&mut self, df: &DataFrame) -> Result<()> {
-        self.samples
-            .add(df)
-            .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))
+        self.samples.add(df)
     }
 
     /// Write the remaining tables, the footers and `manifest.json`; `shard` is recorded in
@@ -321,18 +324,11 @@ impl LibrarySink {
             w.finish(&kv)?;
         }
         write_atomic(&dir, ERRORS_FILE, &mut errors, &kv)?;
-        let mut samples = std::mem::take(&mut self.samples);
+        self.samples.seal()?;
         if self.keep_samples {
-            let mut table = samples
-                .table()
-                .map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
-            write_atomic(&dir, KINEMATICS_SAMPLES_FILE, &mut table, &kv)?;
+            write_samples(&self.samples, &dir, &kv)?;
         }
-        let (mut facets, mut points) =
-            kinematics(samples, &self.legs).map_err(|e| pe(KINEMATICS_FILE, e))?;
-        write_atomic(&dir, KINEMATICS_FILE, &mut facets, &kv)?;
-        write_atomic(&dir, KINEMATICS_POINTS_FILE, &mut points, &kv)?;
-        drop((facets, points));
+        kinematics(&self.samples, &self.legs, &dir, &kv)?;
         let count = |s: &str| self.status.iter().filter(|v| *v == s).count();
         let mut manifest = serde_json::json!({
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
@@ -359,21 +355,70 @@ impl LibrarySink {
     }
 }
 
-/// The two kinematics tables (`(facets, points)`) of `samples` with each character's leg
-/// length (m): per (character, effector) the outlier rules and the polytope
-/// ([`kinematic_polytope`]); a group with fewer than 4 non-coplanar points after the rules
-/// has points but no facets (an error at query time).
+/// Rows of a group's samples appended to `w`, a row group's worth at a time.
+struct GroupRows<'a> {
+    key: &'a (String, String),
+    rows: Vec<Sample>,
+    w: &'a mut TableWriter,
+}
+
+impl GroupRows<'_> {
+    fn add(&mut self, s: &Sample) -> Result<()> {
+        self.rows.push(s.clone());
+        if self.rows.len() >= ROW_GROUP_ROWS {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        let df = points_frame(self.key, &self.rows).map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
+        self.rows.clear();
+        self.w.push(&df)
+    }
+}
+
+/// `kinematics_samples.parquet` (a shard's summary): every sample, by group.
+fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Result<()> {
+    let empty =
+        points_frame(&Default::default(), &[]).map_err(|e| pe(KINEMATICS_SAMPLES_FILE, e))?;
+    let mut w = TableWriter::create(dir, KINEMATICS_SAMPLES_FILE, &empty)?;
+    for (key, _) in spill.groups() {
+        let mut rows = GroupRows {
+            key,
+            rows: Vec::new(),
+            w: &mut w,
+        };
+        spill.read_group(key, &mut |b| b.iter().try_for_each(|s| rows.add(s)))?;
+        rows.flush()?;
+    }
+    w.finish(kv)
+}
+
+/// The two kinematics tables of the spilled samples with each character's leg length (m),
+/// written into `dir`: per (character, effector) the outlier rules and the polytope
+/// ([`kinematic_polytope`]) on the group's points (held for the group alone: see the
+/// module docs of [`crate::twopac::kinematic`]), then the kept samples streamed from the
+/// spill; a group with fewer than 4 non-coplanar points after the rules has points but no
+/// facets (an error at query time).
 fn kinematics(
-    samples: SampleStore,
+    spill: &SampleSpill,
     legs: &BTreeMap<String, f64>,
-) -> PolarsResult<(DataFrame, DataFrame)> {
-    let groups = samples.into_groups();
-    let mut kept: Vec<(&(String, String), Vec<&Sample>)> = Vec::new();
+    dir: &Path,
+    kv: &[(String, String)],
+) -> Result<()> {
+    let empty =
+        points_frame(&Default::default(), &[]).map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
+    let mut w = TableWriter::create(dir, KINEMATICS_POINTS_FILE, &empty)?;
     let mut facets: Vec<Facet> = Vec::new();
-    for (key, g) in &groups {
-        let pts: Vec<[f64; 3]> = g.iter().map(|s| s.rc).collect();
+    for (key, n) in spill.groups() {
+        let mut pts: Vec<[f64; 3]> = Vec::with_capacity(n as usize);
+        spill.read_group(key, &mut |b| {
+            pts.extend(b.iter().map(|s| s.rc));
+            Ok(())
+        })?;
         let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
-        let (keep, poly) = kinematic_polytope(&pts, leg);
+        let (keep, poly) = kinematic_polytope(pts, leg);
         if let Some(p) = poly {
             facets.extend(
                 p.a.iter()
@@ -381,16 +426,26 @@ fn kinematics(
                     .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d)),
             );
         }
-        kept.push((
+        let mut rows = GroupRows {
             key,
-            g.iter()
-                .zip(keep)
-                .filter(|(_, k)| *k)
-                .map(|(s, _)| s)
-                .collect(),
-        ));
+            rows: Vec::new(),
+            w: &mut w,
+        };
+        let mut at = 0;
+        spill.read_group(key, &mut |b| {
+            for s in b {
+                if keep[at] {
+                    rows.add(s)?;
+                }
+                at += 1;
+            }
+            Ok(())
+        })?;
+        rows.flush()?;
     }
-    kinematics_tables(facets, &kept)
+    w.finish(kv)?;
+    let mut facets = facets_table(facets).map_err(|e| pe(KINEMATICS_FILE, e))?;
+    write_atomic(dir, KINEMATICS_FILE, &mut facets, kv)
 }
 
 /// `parts` stacked and sorted as table `name` (`empty` when there are none).
@@ -404,13 +459,17 @@ fn concat(parts: Vec<DataFrame>, empty: &DataFrame, name: &str) -> Result<DataFr
 }
 
 /// A table sorted by clip, read forward in clip order: the rows of a range of clips at a
-/// time, never the whole file.
+/// time, never the whole file (the last row group read is kept, as the next range of
+/// clips usually starts in it).
 pub(crate) struct ClipCursor {
     path: PathBuf,
     /// Consecutive rows per clip, in file order.
     runs: Vec<(String, usize)>,
     next: usize,
     offset: usize,
+    /// The last row group read (its first row and rows): the next batches of clips
+    /// usually lie in it, and decoding it again per batch dominated a merge of 8 shards.
+    cache: Option<(usize, DataFrame)>,
 }
 
 impl ClipCursor {
@@ -442,7 +501,44 @@ impl ClipCursor {
             runs,
             next: 0,
             offset: 0,
+            cache: None,
         })
+    }
+
+    /// Rows `start .. start + len`, read a row group's worth at a time through the cache.
+    fn rows(&mut self, start: usize, len: usize) -> Result<DataFrame> {
+        let (end, mut at) = (start + len, start);
+        let mut out: Option<DataFrame> = None;
+        while at < end {
+            let group = at / ROW_GROUP_ROWS * ROW_GROUP_ROWS;
+            if self.cache.as_ref().map(|c| c.0) != Some(group) {
+                self.cache = Some((group, read_rows(&self.path, group, ROW_GROUP_ROWS)?));
+            }
+            let Some((_, df)) = self.cache.as_ref() else {
+                break;
+            };
+            let take = end.min(group + df.height()).saturating_sub(at);
+            if take == 0 {
+                break;
+            }
+            let part = df.slice((at - group) as i64, take);
+            out = Some(match out {
+                None => part,
+                Some(mut o) => {
+                    o.vstack_mut(&part)
+                        .map_err(|e| Error::io(&self.path, "cannot stack rows", e))?;
+                    o
+                }
+            });
+            at += take;
+        }
+        match out {
+            Some(mut o) => {
+                o.rechunk_mut();
+                Ok(o)
+            }
+            None => read_rows(&self.path, start, 0),
+        }
     }
 
     /// The rows of every clip not read yet up to and including `last` (by name), keeping
@@ -465,7 +561,7 @@ impl ClipCursor {
         if wanted.iter().all(|w| !w) {
             return Ok(None);
         }
-        let df = read_rows(&self.path, start, self.offset - start)?;
+        let df = self.rows(start, self.offset - start)?;
         if wanted.iter().all(|w| *w) {
             return Ok(Some(df));
         }
@@ -485,5 +581,40 @@ mod erased {
         fn to_json(&self) -> String {
             serde_json::to_string(self).unwrap_or_default()
         }
+    }
+}
+
+#[cfg(test)]
+mod cursor_tests {
+    use super::*;
+
+    // See: issue 16 item 3 — a merge decoded a row group again for every batch of clips
+    // that touched it; the cursor keeps the last one, and must still give the same rows.
+    #[test]
+    fn a_clip_cursor_gives_the_rows_of_the_file_across_row_groups() {
+        let d = tempfile::tempdir().unwrap();
+        let n = 2 * ROW_GROUP_ROWS + 999;
+        // Clips of 1,000 rows each, named in order.
+        let clip: Vec<String> = (0..n).map(|i| format!("c{:04}", i / 1000)).collect();
+        let v: Vec<i64> = (0..n as i64).collect();
+        let df = DataFrame::new_infer_height(vec![
+            Column::new("clip".into(), clip.clone()),
+            Column::new("v".into(), v),
+        ])
+        .unwrap();
+        let mut w = TableWriter::create(d.path(), "t.parquet", &df).unwrap();
+        w.push(&df).unwrap();
+        w.finish(&[]).unwrap();
+        let mut cur = ClipCursor::open(&d.path().join("t.parquet")).unwrap();
+        let mut seen: Vec<i64> = Vec::new();
+        // Batches of 7 clips (7,000 rows: some cross a row group); every third clip kept.
+        for last in (6..=(n / 1000)).step_by(7).chain([n / 1000]) {
+            let keep = |c: &str| c[1..].parse::<usize>().unwrap() % 3 == 0;
+            if let Some(rows) = cur.take_through(&format!("c{last:04}"), &keep).unwrap() {
+                seen.extend(rows.column("v").unwrap().i64().unwrap().into_no_null_iter());
+            }
+        }
+        let want: Vec<i64> = (0..n as i64).filter(|i| (i / 1000) % 3 == 0).collect();
+        assert_eq!(seen, want);
     }
 }

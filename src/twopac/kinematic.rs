@@ -13,12 +13,26 @@
 //! contact at `(p, R)` uses `K_w = K_e Rᵀ`, `k_w = k_e + K_e Rᵀ p`
 //! ([`Polytope::to_world_yaw`]).
 //!
+//! # Memory: why one group's points are held
+//! A library build keeps the samples on disk and reduces one (character, effector) at a
+//! time; that group's points are then in memory (~200 bytes a point with the hull's
+//! copies). The outlier rule alone would need only bounded state (a streamed centroid in
+//! file order, and the P99.5 order statistics by a radix selection over the distances),
+//! but the hull would not: parry's quickhull normalises the points by the covariance of
+//! **all** of them (interior points included), picks its first triangle from that
+//! normalisation, and takes each facet's farthest point from that facet's conflict list,
+//! which can be a point inside the final hull (the point farther out may sit in another
+//! facet's list). So a hull of a bounded subset (the boundary points, say) gives the same
+//! polytope only up to the order of its triangles and their vertices, and the rounding of
+//! the normals and offsets follows that order: the bytes of `kinematics.parquet` would
+//! change. Exact identity with the in-memory build therefore keeps one group's points.
+//!
 //! # References
 //! spec two-pac §3; com-from-bvh §7.5 (contact frames).
 
 use super::hull::{hull_hrep, HullOptions};
 use super::polytope::Polytope;
-use crate::math::stats::percentile;
+use crate::math::stats::percentile_sorted;
 
 /// Distance percentile beyond which points are outliers.
 pub const OUTLIER_PERCENTILE: f64 = 99.5;
@@ -47,13 +61,16 @@ pub fn inliers(points: &[[f64; 3]], leg_m: f64) -> Vec<bool> {
         ((p[0] - centroid[0]).powi(2) + (p[1] - centroid[1]).powi(2) + (p[2] - centroid[2]).powi(2))
             .sqrt()
     };
-    let d: Vec<f64> = points
+    let mut d: Vec<f64> = points
         .iter()
         .zip(&finite)
         .filter(|(_, &f)| f)
         .map(|(p, _)| dist(p))
         .collect();
-    let limit = percentile(&d, OUTLIER_PERCENTILE).unwrap_or(f64::INFINITY);
+    // Sorted in place (no second copy of the distances).
+    d.sort_by(f64::total_cmp);
+    let limit = percentile_sorted(&d, OUTLIER_PERCENTILE).unwrap_or(f64::INFINITY);
+    drop(d);
     let reach = MAX_LEG_LENGTHS * leg_m;
     points
         .iter()
@@ -75,15 +92,17 @@ pub fn polytope(points: &[[f64; 3]]) -> Result<Polytope, crate::twopac::TwopacEr
 
 /// One (character, effector)'s samples after the outlier rules, and their polytope:
 /// `(keep, polytope)`, `keep[i]` for `points[i]`; no polytope from fewer than 4
-/// non-coplanar kept points.
-pub fn kinematic_polytope(points: &[[f64; 3]], leg_m: f64) -> (Vec<bool>, Option<Polytope>) {
-    let keep = inliers(points, leg_m);
+/// non-coplanar kept points. The points are dropped before the hull is built (memory:
+/// the hull's copies of the kept points are the peak of a library build).
+pub fn kinematic_polytope(points: Vec<[f64; 3]>, leg_m: f64) -> (Vec<bool>, Option<Polytope>) {
+    let keep = inliers(&points, leg_m);
     let kept: Vec<[f64; 3]> = points
         .iter()
         .zip(&keep)
         .filter(|(_, k)| **k)
         .map(|(p, _)| *p)
         .collect();
+    drop(points);
     let poly = polytope(&kept).ok();
     (keep, poly)
 }
