@@ -156,7 +156,10 @@ pub fn samples_table(
     rows.sort_by(|x, y| (x.0, x.1, x.2, x.3).cmp(&(y.0, y.1, y.2, y.3)));
     let p = |a: usize| -> Vec<f64> { rows.iter().map(|r| r.4[a]).collect() };
     DataFrame::new_infer_height(vec![
-        col(K::CHARACTER_ID, rows.iter().map(|r| r.0).collect::<Vec<_>>()),
+        col(
+            K::CHARACTER_ID,
+            rows.iter().map(|r| r.0).collect::<Vec<_>>(),
+        ),
         col(K::EFFECTOR, rows.iter().map(|r| r.1).collect::<Vec<_>>()),
         col(K::CLIP, rows.iter().map(|r| r.2).collect::<Vec<_>>()),
         col(K::FRAME, rows.iter().map(|r| r.3).collect::<Vec<_>>()),
@@ -208,7 +211,12 @@ pub fn facets_table(mut facets: Vec<Facet>) -> PolarsResult<DataFrame> {
 pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRows>> {
     let t = Table::open(&lib_dir.join(KINEMATICS_FILE))?;
     let (ch, eff) = (t.strings(K::CHARACTER_ID)?, t.strings(K::EFFECTOR)?);
-    let (nx, ny, nz, d) = (t.f64s(K::NORMAL[0])?, t.f64s(K::NORMAL[1])?, t.f64s(K::NORMAL[2])?, t.f64s(K::OFFSET)?);
+    let (nx, ny, nz, d) = (
+        t.f64s(K::NORMAL[0])?,
+        t.f64s(K::NORMAL[1])?,
+        t.f64s(K::NORMAL[2])?,
+        t.f64s(K::OFFSET)?,
+    );
     let mut rows: BTreeMap<(String, String), FacetRows> = BTreeMap::new();
     for i in 0..t.height() {
         let n = [nx[i], ny[i], nz[i]];
@@ -239,7 +247,10 @@ pub fn points_frame(key: &(String, String), rows: &[Sample]) -> PolarsResult<Dat
     DataFrame::new_infer_height(vec![
         col(K::CHARACTER_ID, vec![key.0.as_str(); rows.len()]),
         col(K::EFFECTOR, vec![key.1.as_str(); rows.len()]),
-        col(K::CLIP, rows.iter().map(|s| &*s.clip).collect::<Vec<&str>>()),
+        col(
+            K::CLIP,
+            rows.iter().map(|s| &*s.clip).collect::<Vec<&str>>(),
+        ),
         col(K::FRAME, rows.iter().map(|s| s.frame).collect::<Vec<_>>()),
         col(K::POINT[0], p(0)),
         col(K::POINT[1], p(1)),

@@ -25,6 +25,7 @@ use std::sync::Arc;
 use polars::prelude::*;
 
 use super::kinematics::Sample;
+use super::schema::kinematics as K;
 use crate::error::{Error, Result};
 
 /// Bytes of one spilled sample: the frame and the three coordinates.
@@ -97,17 +98,18 @@ impl SampleSpill {
             Ok(samples.column(n).map_err(bad)?.f64().map_err(bad)?.clone())
         };
         let (ch, eff, clip) = (
-            str_col("character_id")?,
-            str_col("effector")?,
-            str_col("clip")?,
+            str_col(K::CHARACTER_ID)?,
+            str_col(K::EFFECTOR)?,
+            str_col(K::CLIP)?,
         );
         let frame = samples
-            .column("frame")
+            .column(K::FRAME)
             .map_err(bad)?
             .i64()
             .map_err(bad)?
             .clone();
-        let (x, y, z) = (f64_col("x")?, f64_col("y")?, f64_col("z")?);
+        let [nx, ny, nz] = K::POINT;
+        let (x, y, z) = (f64_col(nx)?, f64_col(ny)?, f64_col(nz)?);
         let Some(out) = self.out.as_mut() else {
             return Err(io(
                 &self.path,
