@@ -31,10 +31,11 @@ test:
 golden:
 	UPDATE_GOLDEN=1 $(CARGO) test --test integration golden
 
-## Formatting and clippy, warnings as errors.
+## Formatting, clippy and the API docs' links, warnings as errors.
 lint:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps --lib
 
 ## Mutation fuzzer of the reader and ingest for STANCELIB_FUZZ_SECS seconds (default 300);
 ## failing inputs are saved under fixtures/regressions/ (replayed by `make test`).

@@ -71,20 +71,13 @@ pub enum ErrorKind {
         msg: String,
     },
     /// A numerical step failed (a solver, a fit); `msg` names the step and the cause.
+    /// (An iteration that stops at its cap is typed where one exists: the static-region
+    /// LPs' [`crate::twopac::TwopacError::NotConverged`]; the editor's pose iteration
+    /// reports its unconverged frames in the plan's `converged` column instead of failing.)
     #[error("numeric: {msg}")]
     Numeric {
         /// The step and what failed.
         msg: String,
-    },
-    /// An iterative numerical step stopped at its iteration cap before it converged.
-    #[error("{step}: not converged after {iterations} iterations (residual {residual:e})")]
-    NotConverged {
-        /// The step (`static region`, `COM placement`, …).
-        step: String,
-        /// Iterations done.
-        iterations: usize,
-        /// The residual left (in the step's own unit; NaN when it has none).
-        residual: f64,
     },
     /// The Savitzky–Golay smoothing filter of a clip cannot be built (for example a frame
     /// time so short that the window exceeds `math::savgol::MAX_SAVGOL_WINDOW`).
@@ -150,16 +143,6 @@ impl Error {
         Error {
             kind: ErrorKind::Numeric { msg: msg.into() },
         }
-    }
-
-    /// An iterative step that did not converge (see [`ErrorKind::NotConverged`]).
-    pub fn not_converged(step: impl Into<String>, iterations: usize, residual: f64) -> Self {
-        ErrorKind::NotConverged {
-            step: step.into(),
-            iterations,
-            residual,
-        }
-        .into()
     }
 
     /// A BVH error at a line, without a path yet (see [`Error::with_path`]).

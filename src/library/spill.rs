@@ -185,7 +185,7 @@ impl SampleSpill {
             .collect()
     }
 
-    /// Call `f` on the samples of `key` in (clip, frame) order, up to [`READ_RECORDS`]
+    /// Call `f` on the samples of `key` in (clip, frame) order, up to `READ_RECORDS`
     /// at a time (after [`SampleSpill::seal`]).
     ///
     /// # Errors

@@ -4,7 +4,7 @@
 //!
 //! The build streams: clips are taken in name order in batches of
 //! [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads, and each batch's rows are
-//! appended to the tables ([`super::sink`]) before the next batch is read, so memory
+//! appended to the tables (`pipeline::sink`) before the next batch is read, so memory
 //! depends on the largest clips and the thread count, not on the number of clips. The
 //! files are the same, byte for byte, whatever the batch size and thread count.
 //!

@@ -11,7 +11,7 @@
 //! k = v / v_orig;  (vs, ve, x) := k·(vs, ve, x)_orig, zs, ze, vp, vps unchanged
 //! ⇒ β_h = k, β_v = β_p = 1, times unchanged (A1–A5)
 //! ```
-//! Each scaled stance is solved by [`solve`](super::solve::solve) (no shortcut: the
+//! Each scaled stance is solved by [`super::solve::solve`] (no shortcut: the
 //! policy's outcome is checked, not assumed), its contact point re-solved (§8.3, `H_des`
 //! = the stance's own `H`), then filtered (eq 10, 12) and checked exactly (§7.4) against
 //! the character's absolute limits (§7.5), scaled by `M` (force) and `L` (lengths).

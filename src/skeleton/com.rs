@@ -21,7 +21,7 @@
 //! Positions in metres, internal Z-up frame; mass does not change the COM.
 //!
 //! # References
-//! de Leva, P. (1996) J Biomech 29(9), Table 4; spec com-from-bvh §5 [verified].
+//! de Leva, P. (1996) J Biomech 29(9), Table 4; spec com-from-bvh §5 (verified).
 //!
 //! # Examples
 //! ```

@@ -14,7 +14,7 @@
 //! Output: metres, right-handed, Z up.
 //!
 //! # References
-//! spec com-from-bvh §3.1, §3.2 [verified].
+//! spec com-from-bvh §3.1, §3.2 (verified).
 
 /// Nominal leg length (hip–knee–ankle) of a 1.75 m adult, metres.
 pub const NOMINAL_LEG_M: f64 = 0.84;

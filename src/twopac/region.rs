@@ -13,7 +13,7 @@
 //! ```
 //!
 //! The support function `h_Q` is one LP per direction, all on the same constraints, so a
-//! phase-1 basis is found once and every further LP is warm-started ([`super::simplex`]).
+//! phase-1 basis is found once and every further LP is warm-started (`twopac::simplex`).
 //! The polygon is found by Bretl–Lall refinement: supports in 8 directions, then for each
 //! pair of consecutive support points the outward normal of their chord is queried; if
 //! `h_Q(n)` exceeds the chord by more than `tol_m` the new point splits the chord, else

@@ -18,7 +18,7 @@
 //! and its accuracy are in module `simd`. Every path gives the same bits.
 //!
 //! # References
-//! spec com-from-bvh §2 [verified]; pinocchio `kinematics.hxx` (parents before children).
+//! spec com-from-bvh §2 (verified); pinocchio `kinematics.hxx` (parents before children).
 //!
 //! # Examples
 //! ```
