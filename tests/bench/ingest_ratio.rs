@@ -25,6 +25,22 @@
 //! to time it as a whole process beside the `stancelib` binary.
 //!
 //! # Results
+//! 2026-12-02, after issue 15's merge, the same 2-core sandbox with nothing else running,
+//! profiling profile, bulk CMU set, 5 rounds (medians):
+//!
+//! ```text
+//! threads  stage   wall s   frames/s  × limit
+//! 2        limit   0.106   1122594    1.00
+//! 2        frames  0.384    310986    3.55
+//! 2        build   0.647    184378    5.99
+//! 1        limit   0.186    641575    1.00
+//! 1        frames  0.634    188428    3.40
+//! 1        build   0.987    120894    5.29
+//! 2-thread speed-up: limit 1.75×, frames 1.65×, build 1.53×
+//! ```
+//! Targets not met: frames ≤ 2.0×, build ≤ 2.5×, speed-up ≥ 1.8×.
+//!
+//! Earlier, on the loaded machine:
 //! 2026-12-02, 2-core x86_64 sandbox shared with three other engineers (load 2.4–3.0),
 //! profiling profile, bulk CMU set, 3 rounds, this bench built from the commit before
 //! issue 15 (base) and from the issue 15 branch (head), run base, head, base, head:
