@@ -15,16 +15,18 @@
 //!                 │                   → force_model (fit per stance) → constraints (coefficients)
 //!                 │                   → library (stances.parquet, frames, contacts, clips, errors)
 //!                 │                   → query (solve, feasibility, run, jump, map)
-//!                 │                   → edit (plan, COM path, pose) → bvh::write   (edited clip)
+//!                 │                   → edit (select, plan, COM path, pose) → bvh::write (edited clip)
 //!                 │
 //!                 └─ twopac path:   kinematics (polytopes from contact samples) → library
 //!                                     (kinematics.parquet); twopac::clip (phases from a clip's
 //!                                     contact runs) or a phases JSON → twopac (contacts,
 //!                                     static region, transitions, trajectory, validation)
 //!
-//! pipeline (batch ingest in parallel, streaming build, shards, merge) and cli (commands)
-//! drive the stages and write the tables; plot draws PNGs of their results; synth makes
-//! clips with known truth for the tests.
+//! pipeline drives the stages and writes their outputs: batch ingest in parallel, the
+//! streaming build, shards and merge, pipeline files (job), and one stage per command
+//! (queries, edit, equilibrium, twopac, plots) from typed options; cli only parses
+//! arguments into those options, delegates and prints. plot draws PNGs of the results;
+//! synth makes clips with known truth for the tests.
 //! ```
 //!
 //! The method of each stage (equations, units, the papers' numbering and where the tool

@@ -150,3 +150,30 @@ pub struct Bvh {
     /// Advisory problems (for example a `Frames:` count that disagrees with the data).
     pub warnings: Vec<String>,
 }
+
+impl Bvh {
+    /// The clip of a character `length` times as long: joint offsets, End Sites and every
+    /// position channel × `length` (rotations kept), so FK positions scale by `length`.
+    pub fn scaled(mut self, length: f64) -> Bvh {
+        if length == 1.0 {
+            return self;
+        }
+        let mut position = vec![false; self.motion.n_channels];
+        for j in &mut self.hierarchy.joints {
+            j.offset = j.offset.map(|v| v * length);
+            j.end_site = j.end_site.map(|e| e.map(|v| v * length));
+            for (k, c) in j.channels.iter().enumerate() {
+                if let Some(p) = position.get_mut(j.first_channel + k) {
+                    *p = !c.is_rotation();
+                }
+            }
+        }
+        let nc = self.motion.n_channels.max(1);
+        for (i, v) in self.motion.values.iter_mut().enumerate() {
+            if position[i % nc] {
+                *v *= length;
+            }
+        }
+        self
+    }
+}

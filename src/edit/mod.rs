@@ -50,6 +50,7 @@ pub mod path;
 pub mod plan;
 pub mod pose;
 pub mod rotation;
+pub mod select;
 
 /// COM tolerance of a written frame, m (the 1 mm): a frame whose pose COM is
 /// farther from the plan is reported as not converged.

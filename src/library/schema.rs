@@ -638,3 +638,52 @@ pub mod flight_ref {
     /// Every column, in file order.
     pub const COLUMNS: [&str; 6] = [FIRST_FRAME, LAST_FRAME, N_INT, FREE, A_Z, VEL];
 }
+
+/// Column names of an edit's `FILE.plan.parquet` (`stancelib edit`): one row per output
+/// frame. The 3-vectors are `<prefix>_x_m`, `<prefix>_y_m`, `<prefix>_z_m` ([`edit_plan::axis_column`]).
+pub mod edit_plan {
+    /// The plan table beside `FILE.bvh`: `FILE` + this extension.
+    pub const EXTENSION: &str = "plan.parquet";
+    /// The plot beside `FILE.bvh`: `FILE` + this extension.
+    pub const PLOT_EXTENSION: &str = "png";
+    /// `time_clip_s`: Time of the frame in the written clip, s.
+    pub const TIME: &str = "time_clip_s";
+    /// `phase`: `stance` or `flight`.
+    pub const PHASE: &str = "phase";
+    /// `stance_id`: The source stance of a stance frame (null in flight).
+    pub const STANCE_ID: &str = "stance_id";
+    /// Prefix of the planned COM, m.
+    pub const COM: &str = "com";
+    /// Prefix of the COM of the written pose, m.
+    pub const POSE_COM: &str = "pose_com";
+    /// Prefix of the planned contact point, m (null in flight).
+    pub const CONTACT: &str = "contact";
+    /// Prefix of the support foot's contact point in the written pose, m (null in flight).
+    pub const FOOT: &str = "foot";
+    /// `stance_td_clip_s`: Touchdown of the frame's stance in the written clip, s.
+    pub const STANCE_TD: &str = "stance_td_clip_s";
+    /// `stance_lo_clip_s`: Liftoff of the frame's stance in the written clip, s.
+    pub const STANCE_LO: &str = "stance_lo_clip_s";
+    /// `converged`: COM and foot within tolerance.
+    pub const CONVERGED: &str = "converged";
+    /// `iterations`: Root-correction and IK iterations used.
+    pub const ITERATIONS: &str = "iterations";
+    /// `violated`: `<stance_id>: <constraint>` when the frame's stance breaks one.
+    pub const VIOLATED: &str = "violated";
+
+    /// The column of axis `a` (0 = x, 1 = y, 2 = z) of the 3-vector `prefix`, in m.
+    pub fn axis_column(prefix: &str, a: usize) -> String {
+        format!("{prefix}_{}_m", ["x", "y", "z"][a])
+    }
+}
+
+/// COM-state columns shared by `twopac`'s `trajectory.parquet` / `quasi_static.parquet`
+/// (written) and `equilibrium --points` (read): position, velocity, acceleration per axis.
+pub mod com_state {
+    /// `x_m, y_m, z_m`: COM position, m.
+    pub const POSITION: [&str; 3] = ["x_m", "y_m", "z_m"];
+    /// `vx_mps, vy_mps, vz_mps`: COM velocity, m/s.
+    pub const VELOCITY: [&str; 3] = ["vx_mps", "vy_mps", "vz_mps"];
+    /// `ax_mps2, ay_mps2, az_mps2`: COM acceleration, m/s² (optional on input: 0).
+    pub const ACCELERATION: [&str; 3] = ["ax_mps2", "ay_mps2", "az_mps2"];
+}

@@ -199,3 +199,43 @@ pub fn check_threads(field: &str, threads: usize) -> Result<()> {
     }
     Ok(())
 }
+
+/// Checks there is work, then starts the rayon pool with `threads` workers (0 = all cores).
+///
+/// # Errors
+/// No input files, none that can be read (nothing is written then), or a pool that cannot
+/// start.
+pub fn worker_pool(files: &[PathBuf], threads: usize) -> anyhow::Result<rayon::ThreadPool> {
+    use anyhow::Context;
+    if files.is_empty() {
+        anyhow::bail!("no .bvh files found in the inputs");
+    }
+    if let Some(why) = none_readable(files) {
+        anyhow::bail!("no input can be read (nothing was written):\n{why}");
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the worker threads")
+}
+
+/// `frames`: ingests `files` on `threads` workers and writes the frame, clip and contact
+/// tables (and joints, with `opts.joints`) to `out`; one record per file, failures
+/// included.
+///
+/// # Errors
+/// No readable input, a pool that cannot start, an unwritable output folder.
+pub fn frames_into(
+    files: &[PathBuf],
+    out: &Path,
+    opts: &IngestOptions,
+    threads: usize,
+) -> anyhow::Result<Vec<ClipRecord>> {
+    use anyhow::Context;
+    let pool = worker_pool(files, threads)?;
+    let records = pool.install(|| ingest_all(files, opts));
+    // On the same workers: the tables and their columns are encoded in parallel.
+    pool.install(|| crate::library::write::write_all(out, &records, opts.joints))
+        .with_context(|| format!("writing tables to {}", out.display()))?;
+    Ok(records)
+}

@@ -443,3 +443,22 @@ pub(crate) fn replace_library(out: &Path, write: impl FnOnce(&Path) -> Result<()
     }
     result
 }
+
+/// `build`: builds `files` into `out` on `threads` workers (0 = all cores), as
+/// [`build_into`] does.
+///
+/// # Errors
+/// No readable inputs, a pool that cannot start, or what [`build_into`] reports.
+pub fn build_library(
+    files: &[PathBuf],
+    out: &Path,
+    opts: &BuildOptions,
+    threads: usize,
+    plan: &BuildPlan,
+    rules: &OutputRules,
+) -> anyhow::Result<BuildSummary> {
+    use anyhow::Context;
+    super::batch::worker_pool(files, threads)?
+        .install(|| build_into(files, out, opts, plan, rules))
+        .with_context(|| format!("writing the library to {}", out.display()))
+}

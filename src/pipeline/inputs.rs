@@ -274,3 +274,30 @@ pub fn none_readable(files: &[PathBuf]) -> Option<String> {
     }
     Some(text)
 }
+
+/// Reads a UTF-8 text file (a phases or contacts file), naming it on failure.
+///
+/// # Errors
+/// A missing or unreadable file, or one that is not UTF-8.
+pub fn read_text(path: &Path) -> anyhow::Result<String> {
+    use anyhow::Context;
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// `(folder, file name)` of an output file path given as `--out`.
+///
+/// # Errors
+/// A path that does not end in a UTF-8 file name.
+pub fn split_out(out: &Path) -> anyhow::Result<(&Path, String)> {
+    use anyhow::Context;
+    let name = out
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("--out {}: not a file name", out.display()))?
+        .to_string();
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    Ok((dir, name))
+}

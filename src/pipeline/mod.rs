@@ -5,13 +5,19 @@
 
 pub mod batch;
 pub mod build;
+pub mod edit;
+pub mod edit_outputs;
+pub mod equilibrium;
 pub mod inputs;
+pub mod job;
 pub mod merge;
 pub mod names;
 pub mod output;
+pub mod plots;
 pub mod queries;
 pub mod shard;
 pub(crate) mod sink;
 pub mod spec;
 pub mod twopac;
+pub mod twopac_outputs;
 pub mod twopac_tables;

@@ -21,12 +21,13 @@ use crate::plot::{jump_map_png, write_png};
 use crate::query::feasibility::{check_mu, LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
 use crate::query::map::{check_grid, jump_map, Axis, JumpMap, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};
+use crate::query::pairs::ranked_jump_pairs;
 use crate::query::pool::Prepared;
 use crate::query::run::{
     check_scale, check_speed, check_sweep, run_at_speed, run_cycles, scale_limits, RunCycle,
     ScaledStance,
 };
-use crate::query::tables::{jump_map_table, jump_pairs_table, run_table, RunRow};
+use crate::query::tables::{jump_map_table, jump_pairs_table, jump_table, run_table, RunRow};
 use crate::stances::limits::S_EFF_RANGE;
 
 /// The limit options of a query (§7.5), as given: each `None` takes the query's default.
@@ -551,4 +552,76 @@ fn axis_or(flag: &str, given: Option<&str>, default: Axis) -> anyhow::Result<Vec
         None => default,
     }
     .values())
+}
+
+/// `query jump`: every liftoff × landing pair of a library at one apex height and distance.
+#[derive(Debug, Clone)]
+pub struct JumpQuery {
+    /// Library folder.
+    pub lib: PathBuf,
+    /// Apex height above the liftoff contact, m.
+    pub height_m: f64,
+    /// Jump distance, m.
+    pub distance_m: f64,
+    /// Limit options (default form: relative).
+    pub limits: LimitOptions,
+    /// Output Parquet file.
+    pub out: PathBuf,
+}
+
+/// One ranked pair of `query jump`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JumpLine {
+    /// Liftoff stance id.
+    pub liftoff: String,
+    /// Landing stance id.
+    pub landing: String,
+    /// Apex speed, m/s (a solved pair).
+    pub u_apex_mps: Option<f64>,
+    /// `[β_h, β_v]` of the liftoff and of the landing (a solved pair).
+    pub beta: Option<[[f64; 2]; 2]>,
+    /// Feasible by the exact check.
+    pub feasible: bool,
+}
+
+/// Runs `query jump`: ranks every pair (feasible first, then the least force change),
+/// writes the table and returns the pairs in rank order.
+///
+/// # Errors
+/// A height or distance that is not a number, bad limit options, an unreadable library,
+/// an unwritable output.
+pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
+    for (n, v) in [("--height", q.height_m), ("--distance", q.distance_m)] {
+        anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
+    }
+    let (form, mu) = q.limits.form(LimitForm::Relative)?;
+    let active = q.limits.active_fraction()?;
+    let (lib, pool) = load_pool(&q.lib, active)?;
+    let absolute = absolute_limits(&lib);
+    let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);
+    let rows = ranked_jump_pairs(&pool, q.height_m, q.distance_m, lim);
+    let mut df = jump_table(&rows)?;
+    let kv = query_kv(
+        &q.lib,
+        serde_json::json!({
+            "query": "jump", "lib": q.lib, "height_m": q.height_m, "distance_m": q.distance_m,
+            "limits": form.name(), "mu": mu, "active_set": active,
+        }),
+    )?;
+    write_table(&q.out, &mut df, &kv)?;
+    Ok(rows
+        .iter()
+        .map(|r| JumpLine {
+            liftoff: r.liftoff.stance.stance_id.clone(),
+            landing: r.landing.stance.stance_id.clone(),
+            u_apex_mps: r.jump.as_ref().ok().map(|j| j.u_apex),
+            beta: r.jump.as_ref().ok().map(|j| {
+                [0, 1].map(|k| {
+                    let b = j.sides[k].1.solution.beta;
+                    [b[0], b[2]]
+                })
+            }),
+            feasible: r.jump.as_ref().is_ok_and(|j| j.feasible()),
+        })
+        .collect())
 }

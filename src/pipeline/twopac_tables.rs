@@ -6,6 +6,7 @@
 use polars::prelude::*;
 
 use crate::library::columns::{col, list_col};
+use crate::library::schema::com_state::{ACCELERATION, POSITION, VELOCITY};
 use crate::twopac::bezier::ComState;
 use crate::twopac::equilibrium::Verdict;
 use crate::twopac::trajectory::{Phase, PhaseDiagnostic, Plan};
@@ -28,9 +29,9 @@ pub fn form_name(f: QpForm) -> &'static str {
 pub fn equilibrium_table(com: &[[f64; 3]], verdicts: &[Verdict]) -> PolarsResult<DataFrame> {
     let c = |k: usize| com.iter().map(|p| p[k]).collect::<Vec<f64>>();
     DataFrame::new_infer_height(vec![
-        col("x_m", c(0)),
-        col("y_m", c(1)),
-        col("z_m", c(2)),
+        col(POSITION[0], c(0)),
+        col(POSITION[1], c(1)),
+        col(POSITION[2], c(2)),
         col(
             "in_equilibrium",
             verdicts
@@ -75,21 +76,26 @@ pub struct TrajectoryRow {
 /// A column cannot be built.
 pub fn trajectory_table(rows: &[TrajectoryRow]) -> PolarsResult<DataFrame> {
     let v = |g: &dyn Fn(&TrajectoryRow) -> f64| rows.iter().map(g).collect::<Vec<f64>>();
-    DataFrame::new_infer_height(vec![
+    let mut cols = vec![
         col("time_s", v(&|r| r.t_s)),
         col(
             "phase",
             rows.iter().map(|r| r.phase as i64).collect::<Vec<_>>(),
         ),
-        col("x_m", v(&|r| r.state.pos[0])),
-        col("y_m", v(&|r| r.state.pos[1])),
-        col("z_m", v(&|r| r.state.pos[2])),
-        col("vx_mps", v(&|r| r.state.vel[0])),
-        col("vy_mps", v(&|r| r.state.vel[1])),
-        col("vz_mps", v(&|r| r.state.vel[2])),
-        col("ax_mps2", v(&|r| r.state.acc[0])),
-        col("ay_mps2", v(&|r| r.state.acc[1])),
-        col("az_mps2", v(&|r| r.state.acc[2])),
+    ];
+    for (names, g) in [
+        (
+            POSITION,
+            &(|r: &TrajectoryRow| r.state.pos) as &dyn Fn(&TrajectoryRow) -> [f64; 3],
+        ),
+        (VELOCITY, &|r: &TrajectoryRow| r.state.vel),
+        (ACCELERATION, &|r: &TrajectoryRow| r.state.acc),
+    ] {
+        for (a, name) in names.iter().enumerate() {
+            cols.push(col(name, v(&|r| g(r)[a])));
+        }
+    }
+    cols.extend([
         col("valid", rows.iter().map(|r| r.valid).collect::<Vec<_>>()),
         col(
             "slack_n",
@@ -113,7 +119,8 @@ pub fn trajectory_table(rows: &[TrajectoryRow]) -> PolarsResult<DataFrame> {
                 .map(|r| r.verdict.status.as_str())
                 .collect::<Vec<_>>(),
         ),
-    ])
+    ]);
+    DataFrame::new_infer_height(cols)
 }
 
 /// `(slack_m, slack_bw)`: the slack in the unit of its form, the other `None`.
@@ -127,9 +134,9 @@ fn slacks(p: &TransitionPoint) -> (Option<f64>, Option<f64>) {
 fn point_cols(points: &[TransitionPoint]) -> Vec<Column> {
     let c = |k: usize| points.iter().map(|p| p.com[k]).collect::<Vec<f64>>();
     vec![
-        col("x_m", c(0)),
-        col("y_m", c(1)),
-        col("z_m", c(2)),
+        col(POSITION[0], c(0)),
+        col(POSITION[1], c(1)),
+        col(POSITION[2], c(2)),
         col(
             "slack_m",
             points.iter().map(|p| slacks(p).0).collect::<Vec<_>>(),

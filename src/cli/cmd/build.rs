@@ -7,7 +7,7 @@ use anyhow::Context;
 use super::super::args::{BuildArgs, MergeArgs};
 use super::super::Outcome;
 use crate::pipeline::batch::discover;
-use crate::pipeline::build::{build_into, BuildOptions, BuildPlan};
+use crate::pipeline::build::{build_library, BuildOptions, BuildPlan};
 use crate::pipeline::merge::merge_into;
 use crate::pipeline::output::OutputRules;
 use crate::pipeline::spec::{load_body, resolve, resolve_fit};
@@ -81,9 +81,7 @@ pub fn execute(
     plan: &BuildPlan,
     rules: &OutputRules,
 ) -> anyhow::Result<Outcome> {
-    let report = super::frames::worker_pool(files, threads)?
-        .install(|| build_into(files, out, opts, plan, rules))
-        .with_context(|| format!("writing the library to {}", out.display()))?;
+    let report = build_library(files, out, opts, threads, plan, rules)?;
     let reused = report.reused;
     let outcome = super::frames::report(&report.records, out);
     crate::say!("{} stances rebuilt, {reused} clips reused", report.stances);

@@ -2,13 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
-
 use super::super::args::FramesArgs;
 use super::super::Outcome;
 use crate::ingest::IngestOptions;
-use crate::library::{write::write_all, ClipRecord, Status};
-use crate::pipeline::batch::{discover, ingest_all, none_readable};
+use crate::library::{ClipRecord, Status};
+use crate::pipeline::batch::{discover, frames_into};
 use crate::pipeline::spec::{load_body, resolve};
 
 /// Run `frames`.
@@ -23,21 +21,17 @@ pub fn run(a: FramesArgs) -> anyhow::Result<Outcome> {
     execute(&files, &a.out, &opts, a.body.threads)
 }
 
-/// Ingest `files` with `threads` workers and write the tables to `out`.
+/// Ingest `files` with `threads` workers, write the tables to `out`, report.
 ///
 /// # Errors
-/// A thread pool that cannot start, or an unwritable output folder.
+/// No readable input, a thread pool that cannot start, or an unwritable output folder.
 pub fn execute(
     files: &[PathBuf],
     out: &Path,
     opts: &IngestOptions,
     threads: usize,
 ) -> anyhow::Result<Outcome> {
-    let pool = worker_pool(files, threads)?;
-    let records = pool.install(|| ingest_all(files, opts));
-    // On the same workers: the tables and their columns are encoded in parallel.
-    pool.install(|| write_all(out, &records, opts.joints))
-        .with_context(|| format!("writing tables to {}", out.display()))?;
+    let records = frames_into(files, out, opts, threads)?;
     let outcome = report(&records, out);
     crate::cli::summary_json(&summary(&records, out, "frames"));
     Ok(outcome)
@@ -54,24 +48,6 @@ pub fn summary(records: &[ClipRecord], out: &Path, command: &str) -> serde_json:
         "failed": count(Status::Error),
         "out": out,
     })
-}
-
-/// Check there is work, then start the rayon pool with `threads` workers (0 = all cores).
-///
-/// # Errors
-/// No input files, none that can be read (nothing is written then), or a pool that cannot
-/// start.
-pub fn worker_pool(files: &[PathBuf], threads: usize) -> anyhow::Result<rayon::ThreadPool> {
-    if files.is_empty() {
-        anyhow::bail!("no .bvh files found in the inputs");
-    }
-    if let Some(why) = none_readable(files) {
-        anyhow::bail!("no input can be read (nothing was written):\n{why}");
-    }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("starting the worker threads")
 }
 
 /// Print the per-clip failures and a one-line summary; the outcome for the exit code.

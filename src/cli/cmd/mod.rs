@@ -13,4 +13,3 @@ pub mod run;
 pub mod synth;
 pub mod twopac;
 
-pub use crate::plot::write_png;

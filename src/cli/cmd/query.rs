@@ -5,13 +5,7 @@ use std::path::Path;
 
 use super::super::args::{JumpArgs, RunQueryArgs};
 use super::super::Outcome;
-use crate::pipeline::queries::{load_pool, query_kv, write_table};
-use crate::pipeline::queries::{run_query, RunQuery, RunReport};
-use crate::query::feasibility::LimitForm;
-use crate::query::limits::{absolute_limits, stance_limits};
-use crate::query::pairs::ranked_jump_pairs;
-use crate::query::pool::Prepared;
-use crate::query::tables::jump_table;
+use crate::pipeline::queries::{jump_query, run_query, JumpQuery, RunQuery, RunReport};
 
 /// Run `query run`.
 ///
@@ -73,25 +67,14 @@ pub fn print_run(report: &RunReport, out: &Path) {
 /// # Errors
 /// Bad options, an unreadable library, an unwritable output.
 pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
-    for (n, v) in [("--height", a.height), ("--distance", a.distance)] {
-        anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
-    }
-    let lim_opts = a.lim.options();
-    let (form, mu) = lim_opts.form(LimitForm::Relative)?;
-    let active = lim_opts.active_fraction()?;
-    let (lib, pool) = load_pool(&a.lib, active)?;
-    let absolute = absolute_limits(&lib);
-    let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);
-    let rows = ranked_jump_pairs(&pool, a.height, a.distance, lim);
-    let mut df = jump_table(&rows)?;
-    let kv = query_kv(
-        &a.lib,
-        serde_json::json!({
-            "query": "jump", "lib": a.lib, "height_m": a.height, "distance_m": a.distance,
-            "limits": form.name(), "mu": mu, "active_set": active,
-        }),
-    )?;
-    write_table(&a.out, &mut df, &kv)?;
+    let q = JumpQuery {
+        lib: a.lib,
+        height_m: a.height,
+        distance_m: a.distance,
+        limits: a.lim.options(),
+        out: a.out,
+    };
+    let lines = jump_query(&q)?;
     crate::say!(
         "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8}",
         "rank",
@@ -104,38 +87,28 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         "β_v2",
         "feasible"
     );
-    for (i, r) in rows.iter().take(a.top).enumerate() {
-        let b = |k: usize, ax: usize| {
-            r.jump.as_ref().map_or("-".into(), |j| {
-                format!("{:.3}", j.sides[k].1.solution.beta[ax])
-            })
-        };
-        let u = r
-            .jump
-            .as_ref()
-            .map_or("-".into(), |j| format!("{:.3}", j.u_apex));
+    let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
+    for (i, r) in lines.iter().take(a.top).enumerate() {
+        let b = |k: usize, ax: usize| f(r.beta.map(|b| b[k][ax]));
         crate::say!(
             "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8}",
             i + 1,
-            r.liftoff.stance.stance_id,
-            r.landing.stance.stance_id,
-            u,
+            r.liftoff,
+            r.landing,
+            f(r.u_apex_mps),
             b(0, 0),
-            b(0, 2),
+            b(0, 1),
             b(1, 0),
-            b(1, 2),
-            r.jump.as_ref().is_ok_and(|j| j.feasible())
+            b(1, 1),
+            r.feasible
         );
     }
-    let n_ok = rows
-        .iter()
-        .filter(|r| r.jump.as_ref().is_ok_and(|j| j.feasible()))
-        .count();
+    let n_ok = lines.iter().filter(|r| r.feasible).count();
     crate::say!(
         "query jump: {} pair(s), {} feasible → {}",
-        rows.len(),
+        lines.len(),
         n_ok,
-        a.out.display()
+        q.out.display()
     );
     Ok(Outcome::Clean)
 }

@@ -1,0 +1,332 @@
+//! Choosing what an edit plays, from a prepared library: the run cycle solved at a speed
+//! and the liftoff → landing pair of a jump.
+//!
+//! # Policy
+//! ```text
+//! run:  every run cycle of a clip that is not time-scaled (or the one named), each solved
+//!       at k = v / (v_orig·√L) refined until the cycle's speed is v (`refine_run_k`);
+//!       best = feasible first, then the least |k − 1| (the least change of the recorded
+//!       speed), ties by the order of the cycles (stance id order)
+//! jump: the named pair; else, without both a height and a distance, the library's first
+//!       recorded jump; else every liftoff × landing of one clip, each solved by
+//!       `query::jump`; best = `query::pairs::jump_rank` (feasible first, then the least
+//!       change of the recorded forces)
+//! ```
+//! Pure: the library and the pool are in memory; the I/O is in `pipeline::edit`.
+
+use std::collections::BTreeMap;
+
+use super::plan::{refine_run_k, run_requests, solve_stance, EditStance, StanceTiming};
+use crate::error::{Error, Result};
+use crate::library::read::StanceLibrary;
+use crate::query::feasibility::{LimitForm, Limits};
+use crate::query::jump::{is_landing, is_liftoff, jump, recorded_jump, Jump};
+use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
+use crate::query::pairs::jump_rank;
+use crate::query::pool::Prepared;
+use crate::query::run::{run_cycles, scale_limits};
+
+/// The limits an edit's stances are checked against (§7.5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EditLimits {
+    /// Absolute or relative limits.
+    pub form: LimitForm,
+    /// Friction limit μ (`None`: the form's default).
+    pub mu: Option<f64>,
+    /// Active fraction of the friction check.
+    pub active: f64,
+}
+
+/// A run edit's request: speed and character.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunTarget {
+    /// Target speed, m/s.
+    pub speed_mps: f64,
+    /// Leg-length ratio target/recorded (dynamic similarity, §9).
+    pub length_scale: f64,
+    /// Body-mass ratio target/recorded.
+    pub mass_scale: f64,
+    /// The cycle's first stance id; `None`: the best cycle.
+    pub stance: Option<String>,
+}
+
+/// The chosen run cycle: its speed factor `k` and its two solved stances.
+#[derive(Debug, Clone)]
+pub struct ChosenRun {
+    /// Speed factor of the stances' recorded speeds.
+    pub k: f64,
+    /// The two stances, in time order.
+    pub stances: Vec<EditStance>,
+}
+
+/// A solved candidate: its speed factor and its stances or why it has none.
+type RunCandidate = (f64, std::result::Result<Vec<EditStance>, String>);
+
+/// Solves every candidate run cycle of `lib` for `target` and returns the best
+/// (see the module docs).
+///
+/// # Errors
+/// No run cycle (or `target.stance` is not the first stance of one), or no candidate has
+/// a solution at the speed.
+pub fn choose_run(
+    lib: &StanceLibrary,
+    pool: &[Prepared],
+    times: &[StanceTiming],
+    target: &RunTarget,
+    limits: EditLimits,
+) -> Result<ChosenRun> {
+    let (length, mass) = (target.length_scale, target.mass_scale);
+    let absolute: BTreeMap<String, Limits> = absolute_limits(lib)
+        .into_iter()
+        .map(|(k, l)| (k, scale_limits(&l, length, mass)))
+        .collect();
+    let cycles: Vec<_> = run_cycles(&lib.stances)
+        .into_iter()
+        .filter(|cy| !time_scaled(lib, &lib.stances[cy.stances[0]].clip))
+        .filter(|cy| {
+            target
+                .stance
+                .as_ref()
+                .is_none_or(|id| &lib.stances[cy.stances[0]].stance_id == id)
+        })
+        .collect();
+    if cycles.is_empty() {
+        return Err(match &target.stance {
+            Some(id) => Error::invalid(
+                "--stance",
+                format!("{id}: not the first stance of a run cycle in the library"),
+            ),
+            None => no_run_cycle(),
+        });
+    }
+    let solved: Vec<RunCandidate> = cycles
+        .iter()
+        .map(|cy| {
+            let prep = cy.stances.map(|i| {
+                Prepared::with_active_fraction(pool[i].stance.scaled(length, mass), limits.active)
+            });
+            let k0 = target.speed_mps / (cy.v_orig * length.sqrt());
+            refine_run_k(target.speed_mps, k0, |k| {
+                let req = run_requests([&prep[0].stance, &prep[1].stance], k);
+                (0..2)
+                    .map(|n| {
+                        let lim = stance_limits(&prep[n], limits.form, &absolute, limits.mu);
+                        let i = cy.stances[n];
+                        solve_stance(&lib.stances[i], times[i], &prep[n], req[n], &lim)
+                    })
+                    .collect()
+            })
+        })
+        .collect();
+    let best = solved.into_iter().min_by(|x, y| {
+        let (a, b) = (run_rank(x), run_rank(y));
+        a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+    });
+    match best {
+        Some((k, Ok(stances))) => Ok(ChosenRun { k, stances }),
+        Some((_, Err(e))) => Err(Error::invalid(
+            "--speed",
+            format!("no solution at {} m/s: {e}", target.speed_mps),
+        )),
+        None => Err(no_run_cycle()),
+    }
+}
+
+/// Rank of a run candidate: (infeasible or unsolved, |k − 1|); smaller is better.
+fn run_rank((k, r): &RunCandidate) -> (bool, f64) {
+    match r {
+        Ok(v) => (v.iter().any(|e| e.violated().is_some()), (k - 1.0).abs()),
+        Err(_) => (true, f64::INFINITY),
+    }
+}
+
+fn no_run_cycle() -> Error {
+    Error::invalid(
+        "run cycles",
+        "none in the library (two chained single-foot stances between flights)",
+    )
+}
+
+/// A jump edit's request: apex height and distance, or a scale of the recorded height.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JumpTarget {
+    /// Apex height above the liftoff contact, m (`None`: the recorded pair's, × the scale).
+    pub height_m: Option<f64>,
+    /// The recorded apex height times this (when no height is given).
+    pub height_scale: Option<f64>,
+    /// Jump distance, m (`None`: the recorded pair's).
+    pub distance_m: Option<f64>,
+    /// `LIFTOFF_ID:LANDING_ID`; `None`: chosen (see the module docs).
+    pub pair: Option<String>,
+}
+
+/// The chosen jump: the pair's pool indices, the request and the solution.
+#[derive(Debug, Clone)]
+pub struct ChosenJump {
+    /// (liftoff, landing) indices in the library.
+    pub pair: [usize; 2],
+    /// Apex height requested, m.
+    pub height_m: f64,
+    /// Distance requested, m.
+    pub distance_m: f64,
+    /// The two sides' solution.
+    pub jump: Jump,
+}
+
+/// Solves every candidate pair of `lib` for `target` and returns the best.
+///
+/// # Errors
+/// A bad or missing pair, no liftoff and landing of one clip, or no solution for the best
+/// pair.
+pub fn choose_jump(
+    lib: &StanceLibrary,
+    pool: &[Prepared],
+    target: &JumpTarget,
+    limits: EditLimits,
+) -> Result<ChosenJump> {
+    let absolute = absolute_limits(lib);
+    let both = target.height_m.is_some() && target.distance_m.is_some();
+    let candidates = jump_candidates(lib, target.pair.as_deref(), both)?;
+    let solved: Vec<_> = candidates
+        .iter()
+        .map(|&(i, j)| {
+            let (h0, d0) = recorded_jump(&lib.stances[i], &lib.stances[j]);
+            let h = target
+                .height_m
+                .unwrap_or(h0 * target.height_scale.unwrap_or(1.0));
+            let d = target.distance_m.unwrap_or(d0);
+            let lim = [i, j].map(|s| stance_limits(&pool[s], limits.form, &absolute, limits.mu));
+            let r = jump(&pool[i], &pool[j], h, d, Some(lim)).map_err(|e| e.to_string());
+            ([i, j], h, d, r)
+        })
+        .collect();
+    let best = solved.into_iter().min_by(|x, y| {
+        let (a, b) = (jump_rank(&x.3), jump_rank(&y.3));
+        a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+    });
+    let Some((pair, h, d, result)) = best else {
+        return Err(Error::invalid(
+            "jump pairs",
+            "no liftoff and landing stance of one clip in the library",
+        ));
+    };
+    match result {
+        Ok(jump) => Ok(ChosenJump {
+            pair,
+            height_m: h,
+            distance_m: d,
+            jump,
+        }),
+        Err(e) => Err(Error::invalid(
+            "--height",
+            format!(
+                "no solution for height {h} m, distance {d} m ({} → {}): {e}",
+                lib.stances[pair[0]].stance_id, lib.stances[pair[1]].stance_id
+            ),
+        )),
+    }
+}
+
+/// The first recorded jump of a library: a liftoff followed by a landing in its clip.
+pub fn recorded_pair(lib: &StanceLibrary) -> Option<(usize, usize)> {
+    let s = &lib.stances;
+    (1..s.len()).find_map(|i| {
+        (s[i - 1].clip == s[i].clip && is_liftoff(&s[i - 1]) && is_landing(&s[i]))
+            .then_some((i - 1, i))
+    })
+}
+
+/// The (liftoff, landing) stance indices of `LIFTOFF_ID:LANDING_ID`.
+///
+/// # Errors
+/// Not two stance ids, an unknown id, or a stance of the wrong kind.
+pub fn given_pair(lib: &StanceLibrary, p: &str) -> Result<(usize, usize)> {
+    let bad = |msg: String| Error::invalid("--pair", msg);
+    let index = |id: &str| {
+        lib.stances
+            .iter()
+            .position(|s| s.stance_id == id)
+            .ok_or_else(|| bad(format!("unknown stance {id}")))
+    };
+    // Stance ids hold ':' themselves (<clip>:<label>:<frame>): split at the middle ':'.
+    let parts: Vec<&str> = p.split(':').collect();
+    if parts.len() != 6 {
+        return Err(bad(format!(
+            "expected LIFTOFF_ID:LANDING_ID (each <clip>:<label>:<frame>), found {p}"
+        )));
+    }
+    let (i, j) = (index(&parts[..3].join(":"))?, index(&parts[3..].join(":"))?);
+    if !is_liftoff(&lib.stances[i]) {
+        return Err(bad(format!(
+            "{} is not a liftoff stance (rest or clip edge, then flight)",
+            lib.stances[i].stance_id
+        )));
+    }
+    if !is_landing(&lib.stances[j]) {
+        return Err(bad(format!(
+            "{} is not a landing stance (flight, then rest or clip edge)",
+            lib.stances[j].stance_id
+        )));
+    }
+    Ok((i, j))
+}
+
+/// The (liftoff, landing) pairs a jump edit may use: the given pair; else, without both a
+/// height and a distance, the library's first recorded jump; else every liftoff and
+/// landing of one clip.
+///
+/// # Errors
+/// A bad `pair`, or no recorded jump when one is needed.
+pub fn jump_candidates(
+    lib: &StanceLibrary,
+    pair: Option<&str>,
+    height_and_distance: bool,
+) -> Result<Vec<(usize, usize)>> {
+    let given = match pair {
+        Some(p) => Some(given_pair(lib, p)?),
+        None if !height_and_distance => Some(recorded_pair(lib).ok_or_else(|| {
+            Error::invalid(
+                "--pair",
+                "no recorded jump (liftoff then landing in one clip) in the library: give --pair",
+            )
+        })?),
+        None => None,
+    };
+    if let Some(p) = given {
+        return Ok(vec![p]);
+    }
+    let s = &lib.stances;
+    let ups = (0..s.len()).filter(|&i| is_liftoff(&s[i]));
+    Ok(ups
+        .flat_map(|i| {
+            (0..s.len())
+                .filter(|&j| is_landing(&s[j]))
+                .map(move |j| (i, j))
+        })
+        .filter(|&(i, j)| s[i].clip == s[j].clip)
+        .collect())
+}
+
+/// The two stances of a solved jump, as the editor places them.
+pub fn jump_stances(
+    lib: &StanceLibrary,
+    pool: &[Prepared],
+    times: &[StanceTiming],
+    chosen: &ChosenJump,
+) -> Vec<EditStance> {
+    chosen
+        .pair
+        .iter()
+        .enumerate()
+        .map(|(n, &s)| {
+            let (request, scaled) = chosen.jump.sides[n];
+            EditStance {
+                source: lib.stances[s].clone(),
+                timing: times[s],
+                prepared: pool[s].clone(),
+                request,
+                scaled,
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,143 @@
+//! What an edit writes besides the BVH: the plan table `FILE.plan.parquet` (one row per
+//! output frame, columns in [`crate::library::schema::edit_plan`]) and the plot data of
+//! `FILE.png` (planned COM path, footprints, a stick figure every
+//! [`PLOT_STICK_EVERY_S`]).
+
+use std::path::{Path, PathBuf};
+
+use polars::prelude::{Column, DataFrame, PolarsResult};
+
+use crate::bvh::Bvh;
+use crate::edit::path::Phase;
+use crate::edit::plan::EditStance;
+use crate::edit::pose::{EditedMotion, Reference};
+use crate::library::schema::edit_plan as col;
+use crate::plot::edit::EditPlot;
+use crate::skeleton::fk::FkWorkspace;
+
+/// Stick figures in the plot, s apart.
+pub const PLOT_STICK_EVERY_S: f64 = 0.1;
+
+/// Everything an edit computes before anything is written.
+pub struct EditOutputs {
+    /// The source clip (scaled to the character), whose hierarchy is written.
+    pub bvh: Bvh,
+    /// The posed frames.
+    pub edited: EditedMotion,
+    /// The reference the poses came from.
+    pub reference: Reference,
+    /// The solved stances.
+    pub stances: Vec<EditStance>,
+    /// The stances in play order (indices into `stances`).
+    pub order: Vec<usize>,
+    /// Planned contact point of every placed stance, m.
+    pub footprints: Vec<[f64; 3]>,
+    /// `<stance_id>: <constraint>` of every stance that breaks one.
+    pub violated: Vec<String>,
+}
+
+/// The sidecar paths of `FILE.bvh`: `FILE.plan.parquet`, `FILE.png`.
+pub fn sidecars(out: &Path) -> (PathBuf, PathBuf) {
+    (
+        out.with_extension(col::EXTENSION),
+        out.with_extension(col::PLOT_EXTENSION),
+    )
+}
+
+/// The three columns of the 3-vector `prefix`, each frame's value from `g` (null: `None`).
+fn v3_columns(prefix: &str, n: usize, g: impl Fn(usize) -> Option<[f64; 3]>) -> Vec<Column> {
+    (0..3)
+        .map(|a| {
+            let v: Vec<Option<f64>> = (0..n).map(|i| g(i).map(|p| p[a])).collect();
+            Column::new(col::axis_column(prefix, a).into(), v)
+        })
+        .collect()
+}
+
+/// The plan table: one row per output frame (see the module docs).
+///
+/// # Errors
+/// A column cannot be built.
+pub fn plan_table(e: &EditOutputs) -> PolarsResult<DataFrame> {
+    let f = &e.edited.frames;
+    let stance = |p: &Phase| match p {
+        Phase::Stance(k) => Some(&e.stances[e.order[*k]]),
+        Phase::Flight { .. } => None,
+    };
+    let dt = e.edited.motion.frame_time_s;
+    let phase = |p: &Phase| match p {
+        Phase::Stance(_) => "stance",
+        Phase::Flight { .. } => "flight",
+    };
+    let mut cols = vec![
+        Column::new(
+            col::TIME.into(),
+            (0..f.len()).map(|i| i as f64 * dt).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            col::PHASE.into(),
+            f.iter().map(|x| phase(&x.phase)).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            col::STANCE_ID.into(),
+            f.iter()
+                .map(|x| stance(&x.phase).map(|s| s.source.stance_id.clone()))
+                .collect::<Vec<_>>(),
+        ),
+    ];
+    cols.extend(v3_columns(col::COM, f.len(), |i| Some(f[i].com_plan)));
+    cols.extend(v3_columns(col::POSE_COM, f.len(), |i| Some(f[i].com_pose)));
+    cols.extend(v3_columns(col::CONTACT, f.len(), |i| f[i].contact));
+    cols.extend(v3_columns(col::FOOT, f.len(), |i| f[i].foot));
+    for (name, end) in [(col::STANCE_TD, 0), (col::STANCE_LO, 1)] {
+        let v: Vec<Option<f64>> = f
+            .iter()
+            .map(|x| x.window.map(|w| if end == 0 { w.0 } else { w.1 }))
+            .collect();
+        cols.push(Column::new(name.into(), v));
+    }
+    cols.push(Column::new(
+        col::CONVERGED.into(),
+        f.iter().map(|x| x.converged).collect::<Vec<_>>(),
+    ));
+    cols.push(Column::new(
+        col::ITERATIONS.into(),
+        f.iter().map(|x| x.iterations as i64).collect::<Vec<_>>(),
+    ));
+    cols.push(Column::new(
+        col::VIOLATED.into(),
+        f.iter()
+            .map(|x| stance(&x.phase).and_then(EditStance::violated))
+            .collect::<Vec<_>>(),
+    ));
+    DataFrame::new_infer_height(cols)
+}
+
+/// The plot of an edit: the planned COM, the footprints and the bones of a stick figure
+/// every [`PLOT_STICK_EVERY_S`].
+pub fn plot_of(e: &EditOutputs, title: String) -> EditPlot {
+    let body = &e.reference.body;
+    let sk = &body.skeleton;
+    let m = &e.edited.motion;
+    let every = ((PLOT_STICK_EVERY_S / m.frame_time_s).round() as usize).max(1);
+    let mut ws = FkWorkspace::new(sk);
+    let (mut file, mut pts) = (vec![[0.0; 3]; sk.n_points()], vec![[0.0; 3]; sk.n_points()]);
+    let mut bones = Vec::new();
+    for fr in (0..m.n_frames()).step_by(every) {
+        body.points(&mut ws, m.row(fr), &mut file, &mut pts);
+        for j in 0..sk.n_joints() {
+            if let Some(p) = sk.parents[j] {
+                bones.push([pts[p], pts[j]]);
+            }
+        }
+        for (e_i, (j, _)) in sk.end_sites.iter().enumerate() {
+            bones.push([pts[*j], pts[sk.n_joints() + e_i]]);
+        }
+    }
+    EditPlot {
+        title,
+        com: e.edited.frames.iter().map(|f| f.com_plan).collect(),
+        footprints: e.footprints.clone(),
+        bones,
+    }
+}
