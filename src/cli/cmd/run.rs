@@ -44,6 +44,11 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
     };
     let plan = crate::pipeline::build::BuildPlan {
         incremental: a.incremental,
+        layout: pipe
+            .layout
+            .as_deref()
+            .and_then(crate::library::layout::Layout::parse)
+            .unwrap_or_default(),
         ..Default::default()
     };
     let outcome = super::build::execute(&files, &lib, &opts, threads, &plan, &rules)?;
