@@ -29,15 +29,37 @@ fn build(out: &Path, layout: &str) {
 fn queries(lib: &Path, out: &Path) {
     let (l, o) = (s(lib), |n: &str| s(&out.join(n)));
     ok(&[
-        "query", "run", "--lib", &l, "--speeds", "0:6:0.5", "--out", &o("runs.parquet"),
+        "query",
+        "run",
+        "--lib",
+        &l,
+        "--speeds",
+        "0:6:0.5",
+        "--out",
+        &o("runs.parquet"),
     ]);
     ok(&[
-        "query", "jump", "--lib", &l, "--height", "0.3", "--distance=1.0", "--out",
+        "query",
+        "jump",
+        "--lib",
+        &l,
+        "--height",
+        "0.3",
+        "--distance=1.0",
+        "--out",
         &o("jump.parquet"),
     ]);
     ok(&["map", "jumps", "--lib", &l, "--out", &o("map")]);
     let clip = s(&crate::util::root().join("fixtures/bvh/run_120hz_m_yup.bvh"));
-    ok(&["twopac", "--clip", &clip, "--lib", &l, "--out", &o("twopac")]);
+    ok(&[
+        "twopac",
+        "--clip",
+        &clip,
+        "--lib",
+        &l,
+        "--out",
+        &o("twopac"),
+    ]);
 }
 
 /// The key-value metadata of a Parquet file (its footer), `ARROW:schema` left out (it
@@ -105,8 +127,7 @@ fn both_layouts_give_the_same_tables_and_query_outputs() {
     let ds = d.path().join("ds");
     build(&ds, "dataset");
     let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(ds.join("manifest.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(ds.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(m["layout"], "dataset");
     // The layout on disk: partitioned tables by character, the others one file each.
     let chars = read_table(file_lib, STANCES_FILE).unwrap();
@@ -120,7 +141,10 @@ fn both_layouts_give_the_same_tables_and_query_outputs() {
     for f in TABLE_FILES {
         assert!(!ds.join(f).exists(), "{f} left in the dataset library");
         if file_lib.join(f).is_file() {
-            let (a, b) = (read_table(file_lib, f).unwrap(), read_table(&ds, f).unwrap());
+            let (a, b) = (
+                read_table(file_lib, f).unwrap(),
+                read_table(&ds, f).unwrap(),
+            );
             assert!(a.equals_missing(&b), "{f}: rows differ between layouts");
         }
     }
@@ -179,8 +203,7 @@ fn a_merge_and_an_incremental_build_read_dataset_libraries() {
     args.extend(["--out", &o, "--layout", "dataset", "--incremental"]);
     let printed = ok(&args);
     let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(ds.join("manifest.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(ds.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(m["layout"], "dataset", "{printed}");
     for f in [FRAMES_FILE, STANCES_FILE, CLIPS_FILE] {
         let (a, b) = (read_table(single, f).unwrap(), read_table(&ds, f).unwrap());
@@ -270,7 +293,10 @@ fn foreign_readers_read_one_character() {
     for v in ids.iter().flatten() {
         *counts.entry(v.to_string()).or_default() += 1;
     }
-    let (cid, _) = counts.iter().max_by_key(|(k, n)| (**n, std::cmp::Reverse(*k))).unwrap();
+    let (cid, _) = counts
+        .iter()
+        .max_by_key(|(k, n)| (**n, std::cmp::Reverse(*k)))
+        .unwrap();
     let spark = python_has("pyspark")
         && Command::new("java")
             .arg("-version")

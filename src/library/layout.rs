@@ -103,8 +103,7 @@ pub fn table_name(file: &str) -> &str {
 
 /// Whether Hive escapes `c` in a partition value (`escapePathName`).
 fn hive_escaped(c: char) -> bool {
-    matches!(c, '\u{1}'..='\u{1f}' | '\u{7f}')
-        || "\"#%'*/:=?\\{[]^".contains(c)
+    matches!(c, '\u{1}'..='\u{1f}' | '\u{7f}') || "\"#%'*/:=?\\{[]^".contains(c)
 }
 
 /// A partition value as a path segment: the characters Hive escapes as `%XX` (upper-case
@@ -468,7 +467,10 @@ mod tests {
         let file_rows = read_table(d.path(), CLIPS_FILE).unwrap();
         convert_to_dataset(d.path()).unwrap();
         std::fs::write(d.path().join(MANIFEST_FILE), r#"{"layout":"dataset"}"#).unwrap();
-        assert!(d.path().join("clips/character_id=x%2Fy/part-0.parquet").is_file());
+        assert!(d
+            .path()
+            .join("clips/character_id=x%2Fy/part-0.parquet")
+            .is_file());
         assert!(!d.path().join(CLIPS_FILE).exists());
         let back = read_table(d.path(), CLIPS_FILE).unwrap();
         assert!(back.equals_missing(&file_rows), "{back}\n{file_rows}");
@@ -476,6 +478,9 @@ mod tests {
         assert_eq!(file_kv(&part).unwrap(), vec![("k".into(), "v".into())]);
         let some = read_source(&locate(d.path(), CLIPS_FILE).unwrap(), Some(&["v"])).unwrap();
         assert_eq!(some.get_column_names(), vec!["v"]);
-        assert!(some.column("v").unwrap().equals(file_rows.column("v").unwrap()));
+        assert!(some
+            .column("v")
+            .unwrap()
+            .equals(file_rows.column("v").unwrap()));
     }
 }

@@ -30,12 +30,13 @@ use crate::library::kinematics::{
 use crate::library::layout::{convert_to_dataset, locate_path, read_source, Layout, TableSource};
 use crate::library::read::parquet_rows;
 use crate::library::schema::{
-    clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE,
-    FRAMES_FILE, JOINTS_FILE, KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE,
-    MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
+    clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
+    KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE,
+    MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::schema::{
-    INPUTS_KEY, LAYOUT_MANIFEST_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION, TOOL_VERSION_KEY,
+    INPUTS_KEY, LAYOUT_MANIFEST_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION,
+    TOOL_VERSION_KEY,
 };
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::spill::SampleSpill;

@@ -650,7 +650,11 @@ mod tests {
                 "no [queries] stage",
             ),
             ("threads = 1000000\n".to_string(), 3, "MAX_THREADS_PER_CORE"),
-            ("layout = \"hive\"\n".to_string(), 3, "layout must be file or dataset"),
+            (
+                "layout = \"hive\"\n".to_string(),
+                3,
+                "layout must be file or dataset",
+            ),
             (
                 "[contacts]\nfloor_window_s = 0\n".to_string(),
                 4,
