@@ -23,6 +23,8 @@
 //!   for the control characters, `"#%'*/:=?\^{[]` and DEL); a null or empty value is
 //!   the partition [`HIVE_NULL_PARTITION`], which the readers give as null (stancelib
 //!   reads the value stored in the file).
+//! - A partition file has its table's key-value metadata but the library-wide input
+//!   hashes and limits (in `manifest.json`), which would be repeated in every partition.
 //! - A partition holds the rows of one character in the order of the file layout; the
 //!   rows of a table are those of its partitions in value order (byte order, null first),
 //!   re-sorted by the table's keys where they are sorted by clip (`clips`, `stances`), so
@@ -34,8 +36,8 @@ use std::path::{Path, PathBuf};
 use polars::prelude::*;
 
 use super::schema::{
-    sort_keys, CLIPS_FILE, DATASET_PART_FILE, HIVE_NULL_PARTITION, LAYOUT_MANIFEST_KEY,
-    MANIFEST_FILE, PARTITIONED_FILES, PARTITION_COLUMN, STANCES_FILE, TABLE_FILES,
+    sort_keys, CLIPS_FILE, DATASET_PART_FILE, HIVE_NULL_PARTITION, INPUTS_KEY, LAYOUT_MANIFEST_KEY,
+    LIMITS_KEY, MANIFEST_FILE, PARTITIONED_FILES, PARTITION_COLUMN, STANCES_FILE, TABLE_FILES,
 };
 use super::stream::TableWriter;
 use crate::error::{Error, Result};
@@ -360,6 +362,11 @@ pub fn file_kv(path: &Path) -> Result<Vec<(String, String)>> {
         .collect())
 }
 
+/// Key-value entries about the whole library, left out of partition files: they grow
+/// with the clips and the characters and would be repeated in every partition (they stay
+/// in `manifest.json` and in the unpartitioned tables' files).
+const LIBRARY_WIDE_KEYS: [&str; 2] = [INPUTS_KEY, LIMITS_KEY];
+
 /// The row numbers of each partition of `df`, by partition folder, in row order.
 fn partition_rows(df: &DataFrame, path: &Path) -> Result<BTreeMap<String, Vec<IdxSize>>> {
     let ids = df
@@ -373,8 +380,9 @@ fn partition_rows(df: &DataFrame, path: &Path) -> Result<BTreeMap<String, Vec<Id
     Ok(rows)
 }
 
-/// Split the table file `src` into partition files under `table_dir` (same columns,
-/// rows and key-value metadata; each partition's rows in file order), then remove `src`.
+/// Split the table file `src` into partition files under `table_dir` (same columns, rows
+/// and key-value metadata but [`LIBRARY_WIDE_KEYS`]; each partition's rows in file
+/// order), then remove `src`.
 fn partition_file(src: &Path, table_dir: &Path) -> Result<()> {
     let df = read_file(src, None)?;
     let single = table_dir.join(DATASET_PART_FILE);
@@ -382,7 +390,8 @@ fn partition_file(src: &Path, table_dir: &Path) -> Result<()> {
         // No partition to name: the empty table is one file (readers keep its schema).
         return std::fs::rename(src, &single).map_err(|e| Error::io(&single, "cannot move", e));
     }
-    let kv = file_kv(src)?;
+    let mut kv = file_kv(src)?;
+    kv.retain(|(k, _)| !LIBRARY_WIDE_KEYS.contains(&k.as_str()));
     for (dir_name, idx) in partition_rows(&df, src)? {
         let dir = table_dir.join(dir_name);
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, "cannot create folder", e))?;
