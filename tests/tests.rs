@@ -34,6 +34,9 @@
 //!   plates of the treadmill run); unknown stances exit 2 and write nothing.
 //! - `scale`: issue 16 — streaming build (any batch size and thread count), `--shard I/N`
 //!   and `merge` equal to one build byte for byte, merge refusals, the Spark driver.
+//! - `dataset`: issue 16 item 3 — `--layout dataset`: the same tables and query outputs as
+//!   the file layout, merges and incremental builds of it, and DuckDB, pyarrow, polars and
+//!   Spark reading one character's partition (pruned).
 //! - `scale_memory`: issue 16 items 1–2 — kinematic samples spilled to disk, not held:
 //!   no scratch left behind, shards whose samples span several row groups merge exactly.
 //!
@@ -102,6 +105,7 @@ mod forceplate_stances;
 mod stances;
 mod stances_truth;
 // Library
+mod dataset;
 mod force_export;
 mod golden;
 mod readers;

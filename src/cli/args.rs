@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use crate::library::layout::Layout;
 use crate::pipeline::queries::{speed_range, LimitOptions};
 use crate::pipeline::shard::Shard;
 use crate::pipeline::spec::Overrides;
@@ -29,6 +30,26 @@ impl From<LimitFormArg> for LimitForm {
         match f {
             LimitFormArg::Absolute => LimitForm::Absolute,
             LimitFormArg::Relative => LimitForm::Relative,
+        }
+    }
+}
+
+/// `--layout`: how the library's tables are laid out on disk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum LayoutArg {
+    /// One Parquet file per table (`LIB/stances.parquet`).
+    #[default]
+    File,
+    /// A hive-partitioned Parquet dataset per table
+    /// (`LIB/stances/character_id=…/part-0.parquet`), for DuckDB, polars, pyarrow, Spark.
+    Dataset,
+}
+
+impl From<LayoutArg> for Layout {
+    fn from(l: LayoutArg) -> Self {
+        match l {
+            LayoutArg::File => Layout::File,
+            LayoutArg::Dataset => Layout::Dataset,
         }
     }
 }
@@ -640,6 +661,10 @@ pub struct BuildArgs {
     /// Build only the I-th of N shards of the inputs (by content hash), for `merge`.
     #[arg(long, value_parser = parse_shard)]
     pub shard: Option<Shard>,
+    /// Table layout: `file` (one Parquet file per table) or `dataset` (hive-partitioned
+    /// by `character_id`); the rows are the same.
+    #[arg(long, value_enum, default_value_t = LayoutArg::File)]
+    pub layout: LayoutArg,
     /// Body and contact options.
     #[command(flatten)]
     pub body: BodyArgs,
@@ -665,6 +690,9 @@ pub struct MergeArgs {
     /// Replace an existing `--out` folder that is not a stancelib library (as `build`).
     #[arg(long)]
     pub force: bool,
+    /// Table layout of the merged library (as `build --layout`; shards of either layout).
+    #[arg(long, value_enum, default_value_t = LayoutArg::File)]
+    pub layout: LayoutArg,
 }
 
 /// `stancelib run`.

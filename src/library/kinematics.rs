@@ -170,7 +170,7 @@ pub fn samples_table(
 }
 
 /// Sort keys of a samples table (see [`samples_table`]).
-pub const SAMPLES_SORT_KEYS: [&str; 4] = [K::CHARACTER_ID, K::EFFECTOR, K::CLIP, K::FRAME];
+pub use super::schema::SAMPLES_SORT_KEYS;
 
 /// The facets table (`kinematics.parquet`) of every polytope's facets, sorted by
 /// character, effector, normal and offset.

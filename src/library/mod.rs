@@ -11,6 +11,7 @@ pub(crate) mod columns;
 pub mod forces;
 pub mod info;
 pub mod kinematics;
+pub mod layout;
 pub mod plates;
 pub mod provenance;
 #[doc(hidden)]

@@ -8,31 +8,36 @@ use polars::prelude::*;
 
 use crate::error::{Error, Result};
 
+use super::layout::{locate_path, read_source};
 use super::stances::PoolStance;
 pub use super::stances::{read_stance_timing, read_stances};
 
 use super::schema::{clips, CLIPS_FILE, STANCES_FILE};
 
-/// Read a Parquet file into a DataFrame.
+/// Read a Parquet file into a DataFrame; a library table's `file`-layout path
+/// (`LIB/stances.parquet`) reads the table in the library's layout
+/// ([`super::layout::locate_path`]).
 ///
 /// # Errors
 /// The file cannot be opened or is not valid Parquet.
 pub fn read_parquet(path: &Path) -> Result<DataFrame> {
-    let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
-    ParquetReader::new(f)
-        .finish()
-        .map_err(|e| Error::io(path, "cannot read parquet", e))
+    read_source(&locate_path(path)?, None)
 }
 
-/// The number of rows of a Parquet file, from its footer (nothing else is read).
+/// The number of rows of a Parquet file (or of a library table, as [`read_parquet`]), from
+/// the footers (nothing else is read).
 ///
 /// # Errors
 /// The file cannot be opened or is not valid Parquet.
 pub fn parquet_rows(path: &Path) -> Result<usize> {
-    let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
-    ParquetReader::new(f)
-        .num_rows()
-        .map_err(|e| Error::io(path, "cannot read parquet", e))
+    let mut n = 0;
+    for p in locate_path(path)?.files() {
+        let f = std::fs::File::open(&p).map_err(|e| Error::io(&p, "cannot open", e))?;
+        n += ParquetReader::new(f)
+            .num_rows()
+            .map_err(|e| Error::io(&p, "cannot read parquet", e))?;
+    }
+    Ok(n)
 }
 
 /// A table read from a file: typed column access whose errors name the file and column.
@@ -44,14 +49,15 @@ pub struct Table {
 }
 
 impl Table {
-    /// Reads `path`.
+    /// Reads `path` (a library table in its library's layout, as [`read_parquet`]).
     ///
     /// # Errors
     /// The file cannot be opened or is not valid Parquet.
     pub fn open(path: &Path) -> Result<Self> {
+        let src = locate_path(path)?;
         Ok(Table {
-            path: path.to_path_buf(),
-            df: read_parquet(path)?,
+            path: src.path().to_path_buf(),
+            df: read_source(&src, None)?,
         })
     }
 
@@ -60,14 +66,10 @@ impl Table {
     /// # Errors
     /// The file cannot be opened, is not valid Parquet, or lacks one of `names`.
     pub fn open_columns(path: &Path, names: &[&str]) -> Result<Self> {
-        let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
-        let df = ParquetReader::new(f)
-            .with_columns(Some(names.iter().map(|n| n.to_string()).collect()))
-            .finish()
-            .map_err(|e| Error::io(path, "cannot read parquet", e))?;
+        let src = locate_path(path)?;
         Ok(Table {
-            path: path.to_path_buf(),
-            df,
+            path: src.path().to_path_buf(),
+            df: read_source(&src, Some(names))?,
         })
     }
 

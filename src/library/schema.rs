@@ -41,6 +41,61 @@ pub const MANIFEST_FILE: &str = "manifest.json";
 /// a folder a stancelib library, which `build` may replace.
 pub const MANIFEST_SCHEMA_PREFIX: &str = "stancelib.library/";
 
+/// Key of `manifest.json` naming the library's layout (`file` or `dataset`,
+/// [`super::layout::Layout`]); a manifest without it is a `file` library.
+pub const LAYOUT_MANIFEST_KEY: &str = "layout";
+/// The hive partition column of a `dataset` library's tables that have it.
+pub const PARTITION_COLUMN: &str = "character_id";
+/// The one data file of a partition (or of an unpartitioned table) of a `dataset` library.
+pub const DATASET_PART_FILE: &str = "part-0.parquet";
+/// The hive name of the partition of a null (or empty) value, as Hive and Spark write it
+/// and DuckDB, polars, pyarrow and Spark read it (as null).
+pub const HIVE_NULL_PARTITION: &str = "__HIVE_DEFAULT_PARTITION__";
+/// Every table a library may hold, in the order `build` writes them.
+pub const TABLE_FILES: [&str; 9] = [
+    FRAMES_FILE,
+    CONTACTS_FILE,
+    CLIPS_FILE,
+    STANCES_FILE,
+    JOINTS_FILE,
+    ERRORS_FILE,
+    KINEMATICS_FILE,
+    KINEMATICS_POINTS_FILE,
+    KINEMATICS_SAMPLES_FILE,
+];
+/// The tables with a [`PARTITION_COLUMN`] (partitioned in a `dataset` library); the others
+/// (`frames`, `contacts`, `joints`, `errors`) have no character column.
+pub const PARTITIONED_FILES: [&str; 5] = [
+    CLIPS_FILE,
+    STANCES_FILE,
+    KINEMATICS_FILE,
+    KINEMATICS_POINTS_FILE,
+    KINEMATICS_SAMPLES_FILE,
+];
+
+/// Sort keys of a table (the order a full build writes it, module docs); `errors.parquet`
+/// and tables without keys of their own (`kinematics*.parquet` are written in
+/// (`character_id`, `effector`) group order) get the errors keys.
+pub fn sort_keys(file: &str) -> &'static [&'static str] {
+    match file {
+        // Joint rows keep the skeleton's order within a frame (the sort is stable).
+        FRAMES_FILE | JOINTS_FILE => &[frames::CLIP, frames::FRAME],
+        CONTACTS_FILE => &[contacts::CLIP, contacts::EFFECTOR, contacts::FIRST_FRAME],
+        CLIPS_FILE => &[clips::CLIP],
+        STANCES_FILE => &[stances::CLIP, stances::FIRST_FRAME, stances::LABEL],
+        KINEMATICS_SAMPLES_FILE => &SAMPLES_SORT_KEYS,
+        _ => &[errors::PATH, errors::STAGE, errors::MESSAGE],
+    }
+}
+
+/// Sort keys of `kinematics_samples.parquet` (and the order of `kinematics_points.parquet`).
+pub const SAMPLES_SORT_KEYS: [&str; 4] = [
+    kinematics::CHARACTER_ID,
+    kinematics::EFFECTOR,
+    kinematics::CLIP,
+    kinematics::FRAME,
+];
+
 /// Key-value metadata key of every library table: [`SCHEMA_VERSION`].
 pub const SCHEMA_VERSION_KEY: &str = "stancelib.schema_version";
 /// Key-value metadata key of every output: the tool version ([`TOOL_VERSION`]).

@@ -46,6 +46,9 @@ pub struct TableWriter {
     columns: Vec<(ParquetType, Vec<Encoding>)>,
     pending: DataFrame,
     rows: usize,
+    /// A string column whose Arrow type hint is `string`, not `large_string`
+    /// ([`TableWriter::with_string_hint`]).
+    string_hint: Option<PlSmallStr>,
 }
 
 /// Page compression of every table: zstd at its default level.
@@ -157,7 +160,17 @@ impl TableWriter {
             writer: Some(writer),
             columns,
             rows: 0,
+            string_hint: None,
         })
+    }
+
+    /// Give `column` (a string column) the Arrow type hint `string` instead of
+    /// `large_string` (the data pages are the same). A hive reader types a partition
+    /// value from its path as `string`; pyarrow refuses to merge it with a file column of
+    /// `large_string`, so the partition column of a dataset's files carries this hint.
+    pub fn with_string_hint(mut self, column: &str) -> TableWriter {
+        self.string_hint = Some(column.into());
+        self
     }
 
     /// Rows appended so far.
@@ -218,8 +231,13 @@ impl TableWriter {
         if rest.height() > 0 {
             self.write_group(rest)?;
         }
-        let arrow = Schema::from_iter(self.schema.iter().map(|(n, d)| (n.clone(), d.clone())))
+        let mut arrow = Schema::from_iter(self.schema.iter().map(|(n, d)| (n.clone(), d.clone())))
             .to_arrow(CompatLevel::oldest());
+        if let Some(f) = self.string_hint.as_ref().and_then(|c| arrow.get_mut(c)) {
+            if f.dtype == ArrowDataType::LargeUtf8 {
+                f.dtype = ArrowDataType::Utf8;
+            }
+        }
         let (key, value) = super::write::arrow_schema_entry(&arrow, kv);
         let mut meta: Vec<KeyValue> = Vec::with_capacity(kv.len() + 1);
         meta.push(KeyValue {

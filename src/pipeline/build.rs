@@ -17,7 +17,9 @@
 //! its kinematic samples and a `shard` entry in its manifest for [`super::merge`].
 //!
 //! Layout of a library folder: `frames.parquet`, `contacts.parquet`, `clips.parquet`,
-//! `stances.parquet`, `errors.parquet`, `manifest.json` (spec stance-model §11).
+//! `stances.parquet`, `errors.parquet`, `manifest.json` (spec stance-model §11); with
+//! [`Layout::Dataset`] each table is a hive-partitioned dataset instead
+//! ([`crate::library::layout`]). `incremental` reads the previous library in its layout.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -35,6 +37,7 @@ use super::shard::{inputs_fingerprint, shard_of, Shard};
 use super::sink::{combine, pe, strings, ClipCursor, LibrarySink, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
+use crate::library::layout::Layout;
 use crate::library::provenance::library_layout;
 use crate::library::read::read_parquet;
 use crate::library::schema::{
@@ -61,6 +64,8 @@ pub struct BuildPlan {
     pub shard: Option<Shard>,
     /// Clips per batch; 0 = [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads.
     pub batch_clips: usize,
+    /// How the tables are laid out (`--layout`; the rows are the same).
+    pub layout: Layout,
 }
 
 /// Options of a library build.
@@ -405,7 +410,7 @@ pub fn build_into(
                 }));
         }
         bar.bar.finish_and_clear();
-        sink.finish(&fingerprint, t0, shard_entry.clone())
+        sink.finish(&fingerprint, t0, shard_entry.clone(), plan.layout)
     })?;
     Ok(summary)
 }
@@ -426,7 +431,7 @@ pub fn write_library(out: &Path, report: &BuildReport, opts: &BuildOptions) -> R
     replace_library(out, |tmp| {
         let mut sink = LibrarySink::create(tmp, opts.ingest.joints, true, false)?;
         sink.push(&mut Tables::from_report(report, opts.ingest.joints)?)?;
-        sink.finish(&opts.fingerprint(), t0, None)
+        sink.finish(&opts.fingerprint(), t0, None, Layout::File)
     })
 }
 

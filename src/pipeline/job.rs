@@ -17,6 +17,7 @@ use super::spec::{
     expand_inputs, load_body, load_pipeline, relative_to, resolve, resolve_fit, Overrides,
 };
 use crate::force_model::ForceModelKind;
+use crate::library::layout::Layout;
 
 /// What the command line adds to a pipeline file.
 #[derive(Debug, Clone)]
@@ -92,6 +93,11 @@ pub fn pipeline_job(path: &Path, cl: &CommandLine<'_>) -> anyhow::Result<Pipelin
         threads,
         plan: BuildPlan {
             incremental: cl.incremental,
+            layout: pipe
+                .layout
+                .as_deref()
+                .and_then(Layout::parse)
+                .unwrap_or_default(),
             ..Default::default()
         },
         rules: OutputRules {

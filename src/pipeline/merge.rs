@@ -21,6 +21,7 @@ use super::build::replace_library;
 use super::output::{claim, is_library, OutputRules};
 use super::sink::{sorted, ClipCursor, LibrarySink, Tables};
 use crate::error::{Error, Result};
+use crate::library::layout::{locate, table_exists, Layout};
 use crate::library::read::read_parquet;
 use crate::library::schema::{
     CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, KINEMATICS_SAMPLES_FILE,
@@ -96,7 +97,7 @@ fn open_shard(dir: &Path) -> Result<ShardLib> {
     if joints {
         need.push(JOINTS_FILE);
     }
-    if let Some(missing) = need.iter().find(|f| !dir.join(f).is_file()) {
+    if let Some(missing) = need.iter().find(|f| !table_exists(dir, f)) {
         return Err(bad(dir, format!("{missing} is missing")));
     }
     Ok(ShardLib {
@@ -208,27 +209,36 @@ fn clip_plan(libs: &[ShardLib]) -> Result<Vec<(String, usize)>> {
 
 /// Spill a shard's samples table into `sink` a row group's worth at a time (never the
 /// whole table in memory).
-fn push_samples(sink: &mut LibrarySink, path: &Path) -> Result<()> {
-    let total = crate::library::read::parquet_rows(path)?;
-    let mut at = 0;
-    while at < total {
-        let rows = crate::library::stream::read_rows(path, at, ROW_GROUP_ROWS)?;
-        if rows.height() == 0 {
-            break;
+/// A `dataset` shard's samples are read partition by partition.
+fn push_samples(sink: &mut LibrarySink, lib: &Path) -> Result<()> {
+    for path in locate(lib, KINEMATICS_SAMPLES_FILE)?.files() {
+        let total = crate::library::read::parquet_rows(&path)?;
+        let mut at = 0;
+        while at < total {
+            let rows = crate::library::stream::read_rows(&path, at, ROW_GROUP_ROWS)?;
+            if rows.height() == 0 {
+                break;
+            }
+            at += rows.height();
+            sink.push_samples(&rows)?;
         }
-        at += rows.height();
-        sink.push_samples(&rows)?;
     }
     Ok(())
 }
 
-/// Merge the shard libraries `shards` into the library `out` under `rules` (module docs).
+/// Merge the shard libraries `shards` (of either layout) into the library `out` under
+/// `rules`, written in `layout` (module docs).
 ///
 /// # Errors
 /// A shard that is missing, unfinished or of another build (the error names it), an `out`
 /// the output policy refuses or another build holds, or a table that cannot be read or
 /// written.
-pub fn merge_into(shards: &[PathBuf], out: &Path, rules: &OutputRules) -> Result<MergeSummary> {
+pub fn merge_into(
+    shards: &[PathBuf],
+    out: &Path,
+    rules: &OutputRules,
+    layout: Layout,
+) -> Result<MergeSummary> {
     let libs = check_shards(
         shards
             .iter()
@@ -254,7 +264,7 @@ pub fn merge_into(shards: &[PathBuf], out: &Path, rules: &OutputRules) -> Result
         let mut cursors: Vec<Vec<ClipCursor>> = Vec::new();
         for lib in &libs {
             sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
-            push_samples(&mut sink, &lib.dir.join(KINEMATICS_SAMPLES_FILE))?;
+            push_samples(&mut sink, &lib.dir)?;
             let names: Vec<&str> = sink.template().named().iter().map(|(n, _)| *n).collect();
             cursors.push(
                 names
@@ -296,7 +306,7 @@ pub fn merge_into(shards: &[PathBuf], out: &Path, rules: &OutputRules) -> Result
             sink.push(&mut t)?;
             start = end;
         }
-        sink.finish(&fingerprint, t0, None)
+        sink.finish(&fingerprint, t0, None, layout)
     })?;
     Ok(summary)
 }

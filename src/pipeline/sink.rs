@@ -25,16 +25,18 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::library::kinematics::{
-    add_character_legs, facets_table, points_frame, samples_table, Facet, Sample, SAMPLES_SORT_KEYS,
+    add_character_legs, facets_table, points_frame, samples_table, Facet, Sample,
 };
+use crate::library::layout::{convert_to_dataset, locate_path, read_source, Layout, TableSource};
 use crate::library::read::parquet_rows;
 use crate::library::schema::{
-    clips, contacts, errors, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE,
-    FRAMES_FILE, JOINTS_FILE, KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE,
-    MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
+    clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
+    KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE,
+    MANIFEST_SCHEMA_PREFIX, SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::schema::{
-    INPUTS_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION, TOOL_VERSION_KEY,
+    INPUTS_KEY, LAYOUT_MANIFEST_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION,
+    TOOL_VERSION_KEY,
 };
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::spill::SampleSpill;
@@ -54,34 +56,7 @@ pub(crate) fn pe(name: &str, e: PolarsError) -> Error {
     Error::io(name, "cannot build table", e)
 }
 
-/// Sort keys per table (the order a full build writes).
-pub(crate) fn sort_keys(name: &str) -> &'static [&'static str] {
-    match name {
-        // Joint rows keep the skeleton's order within a frame (the sort is stable).
-        FRAMES_FILE | JOINTS_FILE => &[frames::CLIP, frames::FRAME],
-        CONTACTS_FILE => &[contacts::CLIP, contacts::EFFECTOR, contacts::FIRST_FRAME],
-        CLIPS_FILE => &[clips::CLIP],
-        STANCES_FILE => &[S::CLIP, S::FIRST_FRAME, S::LABEL],
-        KINEMATICS_SAMPLES_FILE => &SAMPLES_SORT_KEYS,
-        _ => &[errors::PATH, errors::STAGE, errors::MESSAGE],
-    }
-}
-
-/// `df` sorted by the keys of table `name` (stable).
-pub(crate) fn sorted(df: DataFrame, name: &str) -> Result<DataFrame> {
-    if df.height() < 2 {
-        return Ok(df);
-    }
-    let keys: Vec<PlSmallStr> = sort_keys(name).iter().map(|k| (*k).into()).collect();
-    let mut all = df
-        .sort(
-            keys,
-            SortMultipleOptions::default().with_maintain_order(true),
-        )
-        .map_err(|e| pe(name, e))?;
-    all.rechunk_mut();
-    Ok(all)
-}
+pub(crate) use crate::library::layout::sorted;
 
 /// `fresh` and `old` rows of one table, in the table's order.
 pub(crate) fn combine(fresh: &DataFrame, old: DataFrame, name: &str) -> Result<DataFrame> {
@@ -298,12 +273,15 @@ impl LibrarySink {
     }
 
     /// Write the remaining tables, the footers and `manifest.json`; `shard` is recorded in
-    /// the manifest of a shard library.
+    /// the manifest of a shard library. A `dataset` library's tables are then split into
+    /// their datasets ([`convert_to_dataset`]) and its manifest names the layout (a `file`
+    /// library's has no `layout` key, as before there were two).
     pub fn finish(
         mut self,
         fingerprint: &str,
         t0: Instant,
         shard: Option<serde_json::Value>,
+        layout: Layout,
     ) -> Result<()> {
         let dir = self.dir.clone();
         let mut errors = concat(
@@ -329,6 +307,9 @@ impl LibrarySink {
             write_samples(&self.samples, &dir, &kv)?;
         }
         kinematics(&self.samples, &self.legs, &dir, &kv)?;
+        if layout == Layout::Dataset {
+            convert_to_dataset(&dir)?;
+        }
         let count = |s: &str| self.status.iter().filter(|v| *v == s).count();
         let mut manifest = serde_json::json!({
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
@@ -349,6 +330,11 @@ impl LibrarySink {
         });
         if let (Some(s), Some(m)) = (shard, manifest.as_object_mut()) {
             m.insert("shard".into(), s);
+        }
+        if layout == Layout::Dataset {
+            if let Some(m) = manifest.as_object_mut() {
+                m.insert(LAYOUT_MANIFEST_KEY.into(), layout.as_str().into());
+            }
         }
         let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
         crate::library::atomic::write_text_atomic(&dir.join(MANIFEST_FILE), &text)
@@ -470,43 +456,48 @@ pub(crate) struct ClipCursor {
     /// The last row group read (its first row and rows): the next batches of clips
     /// usually lie in it, and decoding it again per batch dominated a merge of 8 shards.
     cache: Option<(usize, DataFrame)>,
+    /// The whole table, when it is not one file (a partitioned table of a `dataset`
+    /// library, read whole and put in file order).
+    whole: Option<DataFrame>,
 }
 
 impl ClipCursor {
-    /// Index the `clip` column of `path` (read a row group's worth at a time).
+    /// Index the `clip` column of table `path` (a library table in its library's layout:
+    /// one file is read a row group's worth at a time, a partitioned table whole).
     pub fn open(path: &Path) -> Result<ClipCursor> {
-        let total = parquet_rows(path)?;
+        let src = locate_path(path)?;
+        let (path, whole) = match &src {
+            TableSource::File(p) => (p.clone(), None),
+            TableSource::Parts { dir, .. } => (dir.clone(), Some(read_source(&src, None)?)),
+        };
         let mut runs: Vec<(String, usize)> = Vec::new();
-        let mut at = 0;
-        while at < total {
-            let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
-            let df = ParquetReader::new(f)
-                .with_columns(Some(vec!["clip".into()]))
-                .with_slice(Some((at, ROW_GROUP_ROWS)))
-                .finish()
-                .map_err(|e| Error::io(path, "cannot read parquet", e))?;
-            if df.height() == 0 {
-                break;
-            }
-            at += df.height();
-            for c in strings(&df, "clip") {
+        let mut add = |df: &DataFrame| {
+            for c in strings(df, frames::CLIP) {
                 match runs.last_mut() {
                     Some((last, n)) if *last == c => *n += 1,
                     _ => runs.push((c, 1)),
                 }
             }
+        };
+        match &whole {
+            Some(df) => add(df),
+            None => index_clips(&path, &mut add)?,
         }
         Ok(ClipCursor {
-            path: path.to_path_buf(),
+            path,
             runs,
             next: 0,
             offset: 0,
             cache: None,
+            whole,
         })
     }
 
     /// Rows `start .. start + len`, read a row group's worth at a time through the cache.
     fn rows(&mut self, start: usize, len: usize) -> Result<DataFrame> {
+        if let Some(df) = &self.whole {
+            return Ok(df.slice(start as i64, len));
+        }
         let (end, mut at) = (start + len, start);
         let mut out: Option<DataFrame> = None;
         while at < end {
@@ -570,6 +561,26 @@ impl ClipCursor {
             .map(Some)
             .map_err(|e| Error::io(&self.path, "cannot filter rows", e))
     }
+}
+
+/// Call `add` on the `clip` column of the file `path`, a row group's worth at a time.
+fn index_clips(path: &Path, add: &mut dyn FnMut(&DataFrame)) -> Result<()> {
+    let total = parquet_rows(path)?;
+    let mut at = 0;
+    while at < total {
+        let f = std::fs::File::open(path).map_err(|e| Error::io(path, "cannot open", e))?;
+        let df = ParquetReader::new(f)
+            .with_columns(Some(vec![frames::CLIP.into()]))
+            .with_slice(Some((at, ROW_GROUP_ROWS)))
+            .finish()
+            .map_err(|e| Error::io(path, "cannot read parquet", e))?;
+        if df.height() == 0 {
+            break;
+        }
+        at += df.height();
+        add(&df);
+    }
+    Ok(())
 }
 
 mod erased {

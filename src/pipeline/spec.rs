@@ -16,6 +16,7 @@ use crate::contacts::ContactOptions;
 use crate::error::{Error, Result};
 use crate::force_model::fit::{MAX_SAMPLES, MIN_SAMPLES};
 use crate::ingest::{IngestOptions, DEFAULT_MASS_KG};
+use crate::library::layout::Layout;
 use crate::pipeline::batch::check_threads;
 use crate::query::feasibility::check_mu;
 use crate::query::map::{check_grid, Axis, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};
@@ -138,6 +139,8 @@ pub struct PipelineFile {
     pub up_axis: Option<String>,
     /// Rayon threads (0 = all cores).
     pub threads: Option<usize>,
+    /// Library layout, `file` (default) or `dataset` ([`Layout`]).
+    pub layout: Option<String>,
     /// Contact options.
     pub contacts: Option<ContactsTable>,
     /// Force-model options.
@@ -328,6 +331,12 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
                 "max_harmonics must be at least 1".into(),
             ));
         }
+    }
+    if let Some(l) = p.layout.as_deref().filter(|l| Layout::parse(l).is_none()) {
+        return Err(bad(
+            "layout",
+            format!("layout must be file or dataset, found '{l}'"),
+        ));
     }
     if let Some(l) = p.constraints.as_ref().and_then(|c| c.limits.as_ref()) {
         if !["per_query", "absolute", "relative"].contains(&l.as_str()) {
@@ -641,6 +650,11 @@ mod tests {
                 "no [queries] stage",
             ),
             ("threads = 1000000\n".to_string(), 3, "MAX_THREADS_PER_CORE"),
+            (
+                "layout = \"hive\"\n".to_string(),
+                3,
+                "layout must be file or dataset",
+            ),
             (
                 "[contacts]\nfloor_window_s = 0\n".to_string(),
                 4,

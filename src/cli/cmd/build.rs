@@ -31,6 +31,7 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
         incremental: a.incremental,
         shard: a.shard,
         batch_clips: 0,
+        layout: a.layout.into(),
     };
     execute(
         &discover(&a.inputs)?,
@@ -52,7 +53,7 @@ pub fn run_merge(a: MergeArgs) -> anyhow::Result<Outcome> {
         inputs: a.shards.clone(),
         force: a.force,
     };
-    let s = merge_into(&a.shards, &a.out, &rules)
+    let s = merge_into(&a.shards, &a.out, &rules, a.layout.into())
         .with_context(|| format!("merging into {}", a.out.display()))?;
     println!(
         "{} shards merged: {} clips, {} failed; library in {}",
