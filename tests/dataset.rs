@@ -129,6 +129,17 @@ fn both_layouts_give_the_same_tables_and_query_outputs() {
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(ds.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(m["layout"], "dataset");
+    // `info` reads either layout and says which (same counts as the file library).
+    let info = |lib: &Path| -> serde_json::Value {
+        serde_json::from_str(ok(&["info", lib.to_str().unwrap(), "--json"]).trim()).unwrap()
+    };
+    let (fi, di) = (info(file_lib), info(&ds));
+    assert_eq!(
+        (fi["layout"].as_str(), di["layout"].as_str()),
+        (Some("file"), Some("dataset"))
+    );
+    assert_eq!(fi["stances_by_label"], di["stances_by_label"]);
+    assert_eq!(fi["clips_by_character"], di["clips_by_character"]);
     // The layout on disk: partitioned tables by character, the others one file each.
     let chars = read_table(file_lib, STANCES_FILE).unwrap();
     let id = chars.column("character_id").unwrap().str().unwrap().get(0);

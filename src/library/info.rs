@@ -27,6 +27,9 @@ pub struct LibraryInfo {
     pub manifest_sha256: String,
     /// `schema_version` of the manifest.
     pub schema_version: Option<String>,
+    /// How the tables are laid out: `file` (one Parquet file per table) or `dataset`
+    /// (hive-partitioned folders).
+    pub layout: &'static str,
     /// Version of the tool that built it.
     pub tool_version: Option<String>,
     /// When it was built (RFC 3339 UTC); absent in libraries of older versions.
@@ -100,6 +103,7 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
         library: lib.to_path_buf(),
         manifest_sha256: manifest_sha256(lib)?,
         schema_version: s("schema_version"),
+        layout: super::layout::layout_of(lib)?.as_str(),
         tool_version: s("tool_version"),
         created_utc: s("created_utc"),
         command_line: m
@@ -134,9 +138,10 @@ impl fmt::Display for LibraryInfo {
         writeln!(f, "library {}", self.library.display())?;
         writeln!(
             f,
-            "  tool {}, schema {}, built {}",
+            "  tool {}, schema {}, layout {}, built {}",
             or(&self.tool_version),
             or(&self.schema_version),
+            self.layout,
             or(&self.created_utc)
         )?;
         if let Some(cmd) = &self.command_line {

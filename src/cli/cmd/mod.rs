@@ -12,4 +12,3 @@ pub mod query;
 pub mod run;
 pub mod synth;
 pub mod twopac;
-
