@@ -49,6 +49,7 @@
 pub mod path;
 pub mod plan;
 pub mod pose;
+pub mod posture;
 pub mod rotation;
 
 /// COM tolerance of a written frame, m (the 1 mm): a frame whose pose COM is
@@ -74,6 +75,19 @@ pub const DEFAULT_MAX_REACH: f64 = 0.999;
 /// stays on the floor where the reference's is; 50° is about the ankle's range of
 /// plantarflexion beyond standing.
 pub const DEFAULT_MAX_TOE_PIVOT_DEG: f64 = 50.0;
+/// Largest turn of the pelvis (root) about each of its axes to let a support leg reach,
+/// degrees ([`posture`]): a foot still out of reach on its upright toe (the end of a push
+/// faster than recorded) is reached by moving the COM relative to the stance hip instead
+/// of leaving the floor. 10° of rotation, hip hike or pitch is within a runner's own
+/// cycle-to-cycle pelvis motion.
+pub const DEFAULT_MAX_PELVIS_TURN_DEG: f64 = 10.0;
+/// Largest extra forward or backward lean of the trunk (about its first joint) for the same
+/// purpose, degrees: runners lean further forward as they go faster.
+pub const DEFAULT_MAX_TRUNK_LEAN_DEG: f64 = 15.0;
+/// Ramp of a solved posture change in and out, s ([`posture::envelope`]): the change grows
+/// from zero over this time before the frames that need it and decays over it after, so
+/// that a lean of 10° turns at most a few degrees per frame at 120 Hz.
+pub const DEFAULT_POSTURE_RAMP_S: f64 = 0.1;
 /// Resting band of a planted foot point, m: from the first to the last frame of a stance
 /// where the ankle or the toe tip is within this of its lowest height in the stance, its
 /// horizontal motion is the capture's slide and is removed from the planted foot
@@ -103,6 +117,12 @@ pub struct EditOptions {
     pub max_reach: f64,
     /// [`DEFAULT_MAX_TOE_PIVOT_DEG`].
     pub max_toe_pivot_deg: f64,
+    /// [`DEFAULT_MAX_PELVIS_TURN_DEG`].
+    pub max_pelvis_turn_deg: f64,
+    /// [`DEFAULT_MAX_TRUNK_LEAN_DEG`].
+    pub max_trunk_lean_deg: f64,
+    /// [`DEFAULT_POSTURE_RAMP_S`].
+    pub posture_ramp_s: f64,
 }
 
 impl Default for EditOptions {
@@ -113,6 +133,9 @@ impl Default for EditOptions {
             max_iterations: DEFAULT_MAX_ITERATIONS,
             max_reach: DEFAULT_MAX_REACH,
             max_toe_pivot_deg: DEFAULT_MAX_TOE_PIVOT_DEG,
+            max_pelvis_turn_deg: DEFAULT_MAX_PELVIS_TURN_DEG,
+            max_trunk_lean_deg: DEFAULT_MAX_TRUNK_LEAN_DEG,
+            posture_ramp_s: DEFAULT_POSTURE_RAMP_S,
         }
     }
 }
