@@ -18,6 +18,9 @@
 //!            hip:  the smallest rotation taking A − H onto ankle* − H
 //! root       t_root ← t_root + to_file(c_plan − COM(q))  (COM is affine in t_root)
 //!            repeat IK and root until |c_plan − COM| ≤ solve tol (10 µm), at most max_iterations
+//! posture    a support leg short of its goal after the root shift: pelvis and trunk turned
+//!            by the damped least-squares step of super::posture, inside the same iteration;
+//!            pass 2 re-poses the frames whose ramped posture (posture::envelope) differs
 //! ```
 //! `c` is the contact point (COM at touchdown plus the stance's contact point `cp`), so the
 //! reference foot's motion about its contact point, heel–toe roll included, is kept and
