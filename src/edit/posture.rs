@@ -14,13 +14,16 @@
 //!   (G_k: the ankle goal after the toe pivot, H_k: hip, R_k: reach, c: COM of the pose)
 //! J_kd = ∂s_k/∂x_d by finite differences of FK + foot IK + COM (once per frame)
 //! x = x_base + y,  y = argmin |y|² + |J y − t|²/λ²  (damped least squares, λ = DAMPING_M)
-//!   rows: legs with s_k − J_k y > 0,  t_k = −margin − (s_k − J_k y)
+//!   rows: legs with s_k − J_k y > 0,  t_k = −margin − (s_k − J_k y)  (margin: solve tol, 10 µm)
 //!   box x ∈ [−1, 1]: a DOF past its bound is fixed there and the rest re-solved
 //! in time: x_base(i) = P_i − N_i per DOF,  P_i = max_j x_j⁺ κ(t_i − t_j),  N_i likewise for x⁻,
 //!   κ(τ) = 1 − smoothstep(|τ|/T_ramp)   (the solved postures, ramped in and out over T_ramp)
 //! ```
 //! The minimum-norm update leaves the reference posture untouched wherever the leg reaches
 //! (`y = 0` when no row is active) and otherwise changes the most effective joints most.
+//! On the CMU run at 1.1 × its speed the left push-offs then end within 0.91 frames of the
+//! plan (2.0 frames early with the leg alone) and every frame converges (10 did not);
+//! method and figures in `docs/edited-motion.md`.
 //!
 //! # Frames and units
 //! Axes and rotations in file axes; shortfalls, the Jacobian's rows and the damping in metres
