@@ -13,6 +13,10 @@
 //!   (`edit::posture`: a second pass over the ramped frames and a finite-difference
 //!   Jacobian on the frames a leg falls short), against 2.27 ms (2.22–2.31 ms) for the
 //!   code before it, both at load 4–5 (2026-12-02): +28 %.
+//! - `cargo bench --profile profiling --bench edit -- --warm-up-time 1 --measurement-time 5`
+//!   (release with line tables), with the posture for reach: 2.98 ms (2.94–3.02 ms) at
+//!   load about 4 (2026-12-02); the code before it was not measured in this profile (a
+//!   second release build did not fit the session).
 //! - Earlier: 2.94 ms (2.90–2.97 ms) with the toe pivot and the slide removal, at load 7–9.
 
 use std::hint::black_box;
