@@ -144,7 +144,8 @@ pub(super) fn measure(out: &Path) -> Figures {
     for i in 0..plan.com.len() {
         assert!(
             dist(plan.pose_com[i], frames.com[i]) < 1e-6,
-            "pose COM column = re-ingested COM"
+            "pose COM column = re-ingested COM: frame {i}, {} m",
+            dist(plan.pose_com[i], frames.com[i])
         );
     }
     // Planned stances: windows and feet.

@@ -18,6 +18,9 @@
 //!            hip:  the smallest rotation taking A − H onto ankle* − H
 //! root       t_root ← t_root + to_file(c_plan − COM(q))  (COM is affine in t_root)
 //!            repeat IK and root until |c_plan − COM| ≤ solve tol (10 µm), at most max_iterations
+//! posture    a support leg short of its goal after the root shift: pelvis and trunk turned
+//!            by the damped least-squares step of super::posture, inside the same iteration;
+//!            pass 2 re-poses the frames whose ramped posture (posture::envelope) differs
 //! ```
 //! `c` is the contact point (COM at touchdown plus the stance's contact point `cp`), so the
 //! reference foot's motion about its contact point, heel–toe roll included, is kept and
@@ -28,6 +31,7 @@
 //! reports in metres, internal Z-up frame.
 
 use super::path::{ComPath, Phase};
+use super::posture::{self, Posture, PostureFrame, Row, POSTURE_ZERO};
 use super::rotation::{self as rot, Quat};
 use super::EditOptions;
 use crate::bvh::Motion;
@@ -95,6 +99,10 @@ pub struct Reference {
     pub legs: [[usize; 3]; 2],
     /// Root joint.
     pub root: usize,
+    /// First joint of the trunk (the child of the root on the way to the neck base), when
+    /// it has three rotation channels and no leg below it: the trunk lean of
+    /// [`super::posture`].
+    pub trunk: Option<usize>,
     /// Toe-tip point of each leg (left, right) when it moves with the ankle (a point below
     /// it in the tree): the pivot of [`DEFAULT_MAX_TOE_PIVOT_DEG`](super::DEFAULT_MAX_TOE_PIVOT_DEG).
     pub toes: [Option<usize>; 2],
@@ -167,6 +175,7 @@ impl Reference {
                 j == legs[k][2] || below(legs[k][2], j)
             })
         });
+        let trunk = trunk_joint(sk, root, lm.cerv, &axes, &legs);
         let n = motion.n_frames();
         let mut quats = Vec::with_capacity(n * nj);
         let mut com = Vec::with_capacity(n);
@@ -194,6 +203,7 @@ impl Reference {
             axes,
             legs,
             root,
+            trunk,
             toes,
             com,
             feet,
@@ -342,6 +352,35 @@ impl PoseWorkspace {
     }
 }
 
+/// The child of `root` on the way from it to point `cerv` (the neck base), when it has
+/// three distinct rotation channels and no hip below it (`None` otherwise).
+fn trunk_joint(
+    sk: &crate::skeleton::Skeleton,
+    root: usize,
+    cerv: usize,
+    axes: &[Vec<usize>],
+    legs: &[[usize; 3]; 2],
+) -> Option<usize> {
+    let nj = sk.n_joints();
+    let mut j = if cerv < nj {
+        cerv
+    } else {
+        sk.end_sites.get(cerv - nj)?.0
+    };
+    while sk.parents[j]? != root {
+        j = sk.parents[j]?;
+    }
+    let above = |a: usize, mut b: usize| loop {
+        match sk.parents[b] {
+            Some(p) if p == a => return true,
+            Some(p) => b = p,
+            None => return false,
+        }
+    };
+    let ok = rot::is_tait_bryan(&axes[j]) && legs.iter().all(|l| !above(j, l[0]));
+    ok.then_some(j)
+}
+
 /// World rotations of one frame's local rotations (parents before children).
 fn world_quats(sk: &crate::skeleton::Skeleton, local: &[Quat]) -> Vec<Quat> {
     let mut w: Vec<Quat> = Vec::with_capacity(local.len());
@@ -410,6 +449,9 @@ pub struct FramePose {
     pub iterations: usize,
     /// COM within tolerance and feet on their targets.
     pub converged: bool,
+    /// The posture change that let the support legs reach ([`super::posture`]; zero
+    /// where they reach with the reference's posture).
+    pub posture: Posture,
 }
 
 /// The whole edited motion.
@@ -637,14 +679,14 @@ fn reference_pose(
 /// One IK pass of the feet (step 2 of [`pose_frame`]): each pulled ankle goes part way
 /// (`w`) from where FK puts it towards its goal, by two-bone IK and the goal orientation;
 /// `ws` is left with FK of the result. Returns the largest distance of a planted (support)
-/// foot from its goal, m.
+/// foot from its goal (m) and each pulled ankle's goal after the toe pivot (file).
 fn place_feet(
     r: &Reference,
     ws: &mut PoseWorkspace,
     pulls: &[Option<(V3, Quat, f64)>; 2],
     planted: [bool; 2],
     opts: &EditOptions,
-) -> f64 {
+) -> (f64, [Option<V3>; 2]) {
     let body = &r.body;
     let max_reach = opts.max_reach;
     let goal: [Option<(V3, Quat)>; 2] = std::array::from_fn(|side| {
@@ -670,14 +712,33 @@ fn place_feet(
     }
     forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
     // Support feet only: a swing foot may be out of reach and is not planted.
-    (0..2)
+    let err = (0..2)
         .filter(|&side| planted[side])
         .filter_map(|side| goal[side].map(|(p, _)| norm(sub(ws.file[r.legs[side][2]], p))))
         .fold(0.0, f64::max)
-        * body.unit_m
+        * body.unit_m;
+    (err, goal.map(|g| g.map(|(p, _)| p)))
 }
 
-/// Poses one output time into `ws.pose`; returns the frame's outcome.
+/// What one frame's root/IK iteration aims at: the planned COM (m), the foot pulls
+/// ([`foot_goal`]) and which legs are planted (support).
+struct FrameGoal {
+    com: V3,
+    pulls: [Option<(V3, Quat, f64)>; 2],
+    planted: [bool; 2],
+}
+
+/// What one frame's root/IK iteration reached.
+struct Solved {
+    iterations: usize,
+    err_m: f64,
+    foot_err: f64,
+    com_pose: V3,
+    posture: Posture,
+}
+
+/// Poses one output time into `ws.pose`, starting from posture `base`
+/// ([`super::posture`]; zero in the first pass); returns the frame's outcome.
 pub fn pose_frame(
     r: &Reference,
     path: &ComPath,
@@ -685,36 +746,96 @@ pub fn pose_frame(
     opts: &EditOptions,
     t: f64,
     ws: &mut PoseWorkspace,
+    base: &Posture,
 ) -> FramePose {
     let phase = path.phase(t);
     let st = &path.stances;
     let src_of = |k: usize| &src[st[k].source];
     // 1. Reference pose, foot anchors and yaw.
     let (yaw, stance) = reference_pose(r, path, src, t, ws);
-    let body = &r.body;
-    let q_yaw = rot::axis_angle(up_file(body), yaw);
+    let q_yaw = rot::axis_angle(up_file(&r.body), yaw);
     let (com_plan, _) = path.com(t);
     let contact = stance.map(|k| st[k].contact_point());
     ws.pose.q[r.root] = rot::mul(q_yaw, ws.pose.q[r.root]);
     ws.free_q.clone_from(&ws.pose.q);
+    // 2. Root, posture and IK until the COM is on the plan.
+    let goal = FrameGoal {
+        com: com_plan,
+        pulls: [0, 1].map(|side| foot_goal(r, path, src, t, side)),
+        planted: [0, 1].map(|side| stance.is_some_and(|k| src_of(k).feet[side])),
+    };
+    let s = solve_frame(r, opts, &goal, base, ws);
+    let support = stance.and_then(|k| src_of(k).feet.iter().position(|&f| f));
+    let foot = support.map(|side| ws.pts[r.legs[side][2]]);
+    FramePose {
+        time_s: t,
+        phase,
+        com_plan,
+        com_pose: s.com_pose,
+        contact,
+        window: stance.map(|k| {
+            let (td, lo) = st[k].contact_window();
+            (td - path.t_start, lo - path.t_start)
+        }),
+        foot,
+        foot_error_m: s.foot_err,
+        iterations: s.iterations,
+        converged: s.err_m <= opts.com_tol_m && s.foot_err <= opts.com_tol_m,
+        posture: s.posture,
+    }
+}
+
+/// Step 2 of [`pose_frame`]: from the free pose in `ws.free_q`, alternate posture (base plus
+/// the reach step of [`reach_update`]), foot IK and the root shift that puts the COM on
+/// the plan, until the COM error is below the solve tolerance and the posture settled.
+fn solve_frame(
+    r: &Reference,
+    opts: &EditOptions,
+    g: &FrameGoal,
+    base: &Posture,
+    ws: &mut PoseWorkspace,
+) -> Solved {
+    let body = &r.body;
     let root_ch = body.skeleton.channels[r.root].translations;
-    // 2. Root and IK until the COM is on the plan.
+    let frame =
+        (g.planted.iter().any(|&p| p) || *base != POSTURE_ZERO).then(|| posture_frame(r, ws, opts));
+    let mut reach = ReachState {
+        y: POSTURE_ZERO,
+        jac: None,
+    };
     let mut iterations = 0;
     let (mut err_m, mut foot_err) = (f64::INFINITY, 0.0);
     let mut com_pose = [0.0; 3];
-    let pulls: [Option<(V3, Quat, f64)>; 2] = [0, 1].map(|side| foot_goal(r, path, src, t, side));
-    let planted = [0, 1].map(|side| stance.is_some_and(|k| src_of(k).feet[side]));
+    let mut settled = false;
+    let mut x_used = *base;
     while iterations < opts.max_iterations {
         iterations += 1;
+        let x: Posture = std::array::from_fn(|d| base[d] + reach.y[d]);
+        x_used = x;
         ws.pose.q.copy_from_slice(&ws.free_q);
+        if let Some(fr) = &frame {
+            fr.apply(&x, &mut ws.pose.q);
+        }
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-        if pulls.iter().any(Option::is_some) {
-            foot_err = place_feet(r, ws, &pulls, planted, opts);
+        let mut goals = [None; 2];
+        if g.pulls.iter().any(Option::is_some) {
+            (foot_err, goals) = place_feet(r, ws, &g.pulls, g.planted, opts);
         }
         com_pose = body.com(&ws.pts);
-        let e = sub(com_plan, com_pose);
+        let e = sub(g.com, com_pose);
         err_m = norm(e);
-        if err_m <= opts.com_solve_tol_m {
+        let moved = frame.as_ref().is_some_and(|fr| {
+            let at = ReachAt {
+                frame: fr,
+                x: &x,
+                base,
+                goals: &goals,
+                com_pose,
+            };
+            reach_update(r, opts, g, &at, &mut reach, ws)
+        });
+        if err_m <= opts.com_solve_tol_m && !moved {
+            settled = true;
             break;
         }
         let d = body.to_file(e);
@@ -724,29 +845,153 @@ pub fn pose_frame(
             }
         }
     }
-    if err_m > opts.com_solve_tol_m {
+    if !settled {
         // The last root shift is not yet seen by FK: measure the pose as written.
         forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
         com_pose = body.com(&ws.pts);
-        err_m = norm(sub(com_plan, com_pose));
+        err_m = norm(sub(g.com, com_pose));
     }
-    let support = stance.and_then(|k| src_of(k).feet.iter().position(|&f| f));
-    let foot = support.map(|side| ws.pts[r.legs[side][2]]);
-    FramePose {
-        time_s: t,
-        phase,
-        com_plan,
-        com_pose,
-        contact,
-        window: stance.map(|k| {
-            let (td, lo) = st[k].contact_window();
-            (td - path.t_start, lo - path.t_start)
-        }),
-        foot,
-        foot_error_m: foot_err,
+    Solved {
         iterations,
-        converged: err_m <= opts.com_tol_m && foot_err <= opts.com_tol_m,
+        err_m,
+        foot_err,
+        com_pose,
+        posture: x_used,
     }
+}
+
+/// The free pose's posture frame ([`PostureFrame`]): its hips, the trunk joint's world
+/// rotations and the bounds of `opts` (`ws` is left with FK of the free pose).
+fn posture_frame(r: &Reference, ws: &mut PoseWorkspace, opts: &EditOptions) -> PostureFrame {
+    ws.pose.q.copy_from_slice(&ws.free_q);
+    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+    let trunk = r.trunk.map(|j| {
+        let parent = r.body.skeleton.parents[j].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
+        (j, parent, ws.world_q[j])
+    });
+    PostureFrame::new(
+        [ws.file[r.legs[0][0]], ws.file[r.legs[1][0]]],
+        up_file(&r.body),
+        r.root,
+        trunk,
+        [
+            opts.max_pelvis_turn_deg.to_radians(),
+            opts.max_trunk_lean_deg.to_radians(),
+        ],
+    )
+}
+
+/// The reach step's state within one frame: the posture on top of the base, and the
+/// Jacobian of the support legs' shortfalls (computed once, when a shortfall first shows).
+struct ReachState {
+    y: Posture,
+    jac: Option<[Posture; 2]>,
+}
+
+/// Where the current iteration stands: its posture frame, posture `x` (base included),
+/// the base, the pivoted ankle goals (file) and the pose's COM (m).
+struct ReachAt<'a> {
+    frame: &'a PostureFrame,
+    x: &'a Posture,
+    base: &'a Posture,
+    goals: &'a [Option<V3>; 2],
+    com_pose: V3,
+}
+
+/// One reach step ([`super::posture`]): the support legs' shortfalls after the coming root
+/// shift, `s_k = |G_k − H_k − (c_plan − c)| − R_k` (m), and when one is positive the damped
+/// least-squares posture that brings them to `−tol` (Jacobian by finite differences, once
+/// per frame). Returns whether the posture moved (a support ankle by more than the solve
+/// tolerance); `ws` keeps FK of the current pose.
+fn reach_update(
+    r: &Reference,
+    opts: &EditOptions,
+    g: &FrameGoal,
+    at: &ReachAt,
+    st: &mut ReachState,
+    ws: &mut PoseWorkspace,
+) -> bool {
+    let body = &r.body;
+    let shift = sub(g.com, at.com_pose);
+    let rows: [Option<(f64, V3, V3)>; 2] = std::array::from_fn(|k| {
+        let goal = at.goals[k].filter(|_| g.planted[k])?;
+        let [hip, knee, ankle] = r.legs[k];
+        let (h, kn, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
+        let reach = opts.max_reach * (norm(sub(h, kn)) + norm(sub(a, kn))) * body.unit_m;
+        let hip_m = ws.pts[hip];
+        let v = sub(sub(body.to_internal(goal), hip_m), shift);
+        let d = norm(v);
+        (d > 0.0).then(|| (d - reach, v.map(|c| c / d), hip_m))
+    });
+    let tol = opts.com_solve_tol_m;
+    if st.jac.is_none() {
+        if !rows.iter().flatten().any(|row| row.0 > tol) {
+            return false;
+        }
+        st.jac = Some(reach_jacobian(r, opts, g, at, &rows, ws));
+    }
+    let Some(jac) = st.jac else { return false };
+    let active: Vec<Row> = (0..2)
+        .filter_map(|k| {
+            let s0 = rows[k]?.0 - dot_dof(&jac[k], &st.y);
+            (s0 > 0.0).then_some((jac[k], -tol - s0))
+        })
+        .collect();
+    let lo: Posture = std::array::from_fn(|d| -1.0 - at.base[d]);
+    let hi: Posture = std::array::from_fn(|d| 1.0 - at.base[d]);
+    let y = if active.is_empty() {
+        POSTURE_ZERO
+    } else {
+        posture::dls_step(&active, posture::DAMPING_M, &lo, &hi)
+    };
+    let dy: Posture = std::array::from_fn(|d| y[d] - st.y[d]);
+    let change = (0..2)
+        .filter(|&k| rows[k].is_some())
+        .map(|k| dot_dof(&jac[k], &dy).abs())
+        .fold(0.0, f64::max);
+    let moved = change > tol;
+    if moved {
+        st.y = y;
+    }
+    moved
+}
+
+fn dot_dof(a: &Posture, b: &Posture) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// `∂s_k/∂x_d` of the support legs' shortfalls at posture `at.x` (m per unit of `x`):
+/// each DOF stepped by [`posture::FD_STEP`], FK, foot IK and COM again, and the hip's move
+/// after the root shift, `ΔH − Δc`, projected on the leg's direction `u_k` (`rows`:
+/// shortfall, `u_k`, hip in m). `ws` is left with the pose it was given.
+fn reach_jacobian(
+    r: &Reference,
+    opts: &EditOptions,
+    g: &FrameGoal,
+    at: &ReachAt,
+    rows: &[Option<(f64, V3, V3)>; 2],
+    ws: &mut PoseWorkspace,
+) -> [Posture; 2] {
+    ws.other.q.copy_from_slice(&ws.pose.q);
+    let mut jac = [POSTURE_ZERO; 2];
+    for d in 0..posture::N_DOF {
+        let mut xd = *at.x;
+        xd[d] += posture::FD_STEP;
+        ws.pose.q.copy_from_slice(&ws.free_q);
+        at.frame.apply(&xd, &mut ws.pose.q);
+        forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+        place_feet(r, ws, &g.pulls, g.planted, opts);
+        let dc = sub(r.body.com(&ws.pts), at.com_pose);
+        for (k, row) in rows.iter().enumerate() {
+            if let Some((_, u, h)) = *row {
+                let dh = sub(sub(ws.pts[r.legs[k][0]], h), dc);
+                jac[k][d] = -dot(u, dh) / posture::FD_STEP;
+            }
+        }
+    }
+    ws.pose.q.copy_from_slice(&ws.other.q);
+    forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
+    jac
 }
 
 /// The foot goal `(ankle, orientation)` (file frame) of leg `side`, turned about its toe
@@ -871,6 +1116,9 @@ fn write_angles(r: &Reference, ws: &mut PoseWorkspace) {
 
 /// Poses every output frame `t = t_start + i·Δt` of the plan (`frame_time_s` = Δt, s: the
 /// source clip's own value unless `--fps`, so that the written `Frame Time` is the source's).
+/// Two passes: every frame from the reference's posture (the posture solved where a support
+/// leg falls short), then the frames whose solved posture, ramped in and out over
+/// `opts.posture_ramp_s` ([`posture::envelope`]), differs again from that base.
 pub fn pose_motion(
     r: &Reference,
     path: &ComPath,
@@ -881,16 +1129,34 @@ pub fn pose_motion(
     let dt = frame_time_s;
     let n = ((path.t_end - path.t_start) / dt + 1e-9).floor() as usize + 1;
     let nc = r.body.skeleton.n_channels;
-    let mut values = Vec::with_capacity(n * nc);
-    let mut frames = Vec::with_capacity(n);
     let mut ws = PoseWorkspace::new(r);
+    let time = |i: usize| path.t_start + i as f64 * dt;
+    let mut poses = Vec::with_capacity(n);
+    let mut frames = Vec::with_capacity(n);
     for i in 0..n {
-        let t = path.t_start + i as f64 * dt;
-        let mut f = pose_frame(r, path, src, opts, t, &mut ws);
+        frames.push(pose_frame(
+            r,
+            path,
+            src,
+            opts,
+            time(i),
+            &mut ws,
+            &POSTURE_ZERO,
+        ));
+        poses.push(ws.pose.clone());
+    }
+    let solved: Vec<Posture> = frames.iter().map(|f: &FramePose| f.posture).collect();
+    let base = posture::envelope(&solved, dt, opts.posture_ramp_s);
+    for i in (0..n).filter(|&i| base[i] != solved[i]) {
+        frames[i] = pose_frame(r, path, src, opts, time(i), &mut ws, &base[i]);
+        poses[i].clone_from(&ws.pose);
+    }
+    let mut values = Vec::with_capacity(n * nc);
+    for (i, (f, p)) in frames.iter_mut().zip(&poses).enumerate() {
         f.time_s = i as f64 * dt;
+        ws.pose.clone_from(p);
         write_angles(r, &mut ws);
         values.extend_from_slice(&ws.pose.row);
-        frames.push(f);
     }
     EditedMotion {
         motion: Motion {

@@ -6,11 +6,18 @@
 //! with a message without it).
 //!
 //! # Results
-//! 2.94 ms (criterion interval 2.90–2.97 ms) with the toe pivot and the slide removal,
-//! `cargo bench --profile dev --bench edit -- --warm-up-time 1 --measurement-time 5`:
-//! the test profile (this crate at opt-level 1; a release build did not fit the session),
-//! so an upper bound of the release figure, on a shared 2-core x86_64 sandbox at load
-//! 7–9 (2026-12-02).
+//! `cargo bench --profile dev --bench edit -- --warm-up-time 1 --measurement-time 5` (the
+//! test profile, this crate at opt-level 1: the `profiling` release build did not fit the
+//! session, so these are upper bounds of the release figure), shared 2-core x86_64 sandbox:
+//! - 2.89 ms (criterion interval 2.79–2.99 ms) with the posture for reach
+//!   (`edit::posture`: a second pass over the ramped frames and a finite-difference
+//!   Jacobian on the frames a leg falls short), against 2.27 ms (2.22–2.31 ms) for the
+//!   code before it, both at load 4–5 (2026-12-02): +28 %.
+//! - `cargo bench --profile profiling --bench edit -- --warm-up-time 1 --measurement-time 5`
+//!   (release with line tables), with the posture for reach: 2.98 ms (2.94–3.02 ms) at
+//!   load about 4 (2026-12-02); the code before it was not measured in this profile (a
+//!   second release build did not fit the session).
+//! - Earlier: 2.94 ms (2.90–2.97 ms) with the toe pivot and the slide removal, at load 7–9.
 
 use std::hint::black_box;
 use std::path::Path;
