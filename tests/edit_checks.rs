@@ -3,7 +3,10 @@
 //! planned COM is beyond the leg's reach), and a real run's support foot holds still (the
 //! capture's slide of a resting foot point is removed).
 
-use super::edit_motion::{assert_bounds_except, cycle_of, edit_cycle, fixture, library, measure};
+use super::edit_motion::{
+    assert_bounds_except, cycle_of, edit_cycle, first_cycle_against_source, fixture, library,
+    measure,
+};
 use super::util::{ok, shared_or_skip};
 
 // See: issue 14 item 3 — "iterate root correction and leg IK until the COM error is below
@@ -51,7 +54,8 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let lib = library(dir.path(), &[data.join("bvh/run/cmu_09_01_run_mb.bvh")]);
+    let src = data.join("bvh/run/cmu_09_01_run_mb.bvh");
+    let lib = library(dir.path(), std::slice::from_ref(&src));
     let (id, v0) = cycle_of(&lib, "cmu_09_01_run_mb");
     for (scale, misses, most_unconverged) in [(1.0, &[][..], 0), (1.1, &[][..], 0)] {
         let v = scale * v0;
@@ -65,5 +69,25 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
             f.unconverged,
             most_unconverged
         );
+        if scale == 1.0 {
+            // The recorded speed should reproduce the recording (issue 14: joint-angle RMS
+            // ≤ 3°, root path ≤ 2 cm). KNOWN MISS on this real clip (measured 2026-12-02):
+            // over the first cycle 4.58° and 11.6 cm (the first stance alone: 2.71°, and
+            // the same 11.6 cm); the fixture run meets both bounds. The ceilings keep the
+            // miss from growing until it is found and fixed (issue 14 stays open).
+            let (rms, root) = first_cycle_against_source(&out, &src, &lib);
+            eprintln!(
+                "KNOWN MISS CMU identity cycle: joint-angle RMS {rms:.3}° (issue bound 3, \
+                 ceiling 5), root path {root:.4} m (bound 0.02, ceiling 0.13)"
+            );
+            assert!(
+                rms <= 5.0,
+                "joint-angle RMS {rms}° above the recorded miss 5°"
+            );
+            assert!(
+                root <= 0.13,
+                "root path {root} m above the recorded miss 0.13 m"
+            );
+        }
     }
 }

@@ -712,3 +712,28 @@ fn edit_of_a_female_library_poses_with_the_female_segment_model() {
         "the two segment models differ by {male} m only"
     );
 }
+
+/// Joint-angle RMS (degrees) and largest root distance (m) of an edit's first cycle (from
+/// the start to the liftoff of its second planned stance) against its source clip, for a
+/// request at the recorded speed: output time 0 is source time `td_clip − td_out` of the
+/// first stance.
+pub(super) fn first_cycle_against_source(out: &Path, source: &Path, lib: &Path) -> (f64, f64) {
+    let plan = read_plan(out);
+    let mut windows: Vec<(f64, f64, String)> = Vec::new();
+    for (w, s) in plan.window.iter().zip(&plan.stance) {
+        if let (Some(w), Some(s)) = (w, s) {
+            if windows.last().is_none_or(|l| l.0 != w.0) {
+                windows.push((w.0, w.1, s.clone()));
+            }
+        }
+    }
+    assert!(windows.len() >= 2, "two planned stances: {windows:?}");
+    let (td, _, first) = &windows[0];
+    let end = windows[1].1;
+    let t = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+    let td_clip = t[stance_index(lib, first)].td_clip_s;
+    let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
+    let clip = first.split(':').next().unwrap();
+    let unit_m = clips[clip].unit_scale.expect("unit scale");
+    against_source(out, source, unit_m, 0.0, td_clip - td, end)
+}
