@@ -233,13 +233,7 @@ fn manifest(lib: &Path) -> serde_json::Value {
 }
 
 fn kv(path: &Path) -> BTreeMap<String, String> {
-    let mut f = std::fs::File::open(path).unwrap();
-    let meta = polars_parquet::read::read_metadata(&mut f).unwrap();
-    meta.key_value_metadata()
-        .iter()
-        .flatten()
-        .map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default()))
-        .collect()
+    super::util::parquet_kv(path)
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {

@@ -65,14 +65,9 @@ fn queries(lib: &Path, out: &Path) {
 /// The key-value metadata of a Parquet file (its footer), `ARROW:schema` left out (it
 /// encodes the same pairs).
 fn kv(path: &Path) -> BTreeMap<String, String> {
-    let mut f = std::fs::File::open(path).unwrap();
-    let meta = polars_parquet::read::read_metadata(&mut f).unwrap();
-    meta.key_value_metadata()
-        .iter()
-        .flatten()
-        .filter(|kv| kv.key != "ARROW:schema")
-        .map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default()))
-        .collect()
+    let mut kv = crate::util::parquet_kv(path);
+    kv.remove("ARROW:schema");
+    kv
 }
 
 fn frame(path: &Path) -> DataFrame {

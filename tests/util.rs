@@ -504,3 +504,14 @@ pub fn listing(dir: &Path) -> Vec<String> {
     v.sort();
     v
 }
+
+/// The key-value metadata of a Parquet file's footer (`ARROW:schema` included).
+pub fn parquet_kv(path: &Path) -> std::collections::BTreeMap<String, String> {
+    let mut f = std::fs::File::open(path).unwrap();
+    let meta = polars_parquet::read::read_metadata(&mut f).unwrap();
+    meta.key_value_metadata()
+        .iter()
+        .flatten()
+        .map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default()))
+        .collect()
+}
