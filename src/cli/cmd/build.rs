@@ -1,13 +1,13 @@
 //! `stancelib build`: ingest clips and write a stance library.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::Context;
 
 use super::super::args::{BuildArgs, MergeArgs};
 use super::super::Outcome;
 use crate::pipeline::batch::discover;
-use crate::pipeline::build::{build_library, BuildOptions, BuildPlan};
+use crate::pipeline::build::{build_library, BuildOptions, BuildPlan, BuildSummary};
 use crate::pipeline::merge::merge_into;
 use crate::pipeline::output::OutputRules;
 use crate::pipeline::spec::{load_body, resolve, resolve_fit};
@@ -33,14 +33,9 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
         batch_clips: 0,
         layout: a.layout.into(),
     };
-    execute(
-        &discover(&a.inputs)?,
-        &a.out,
-        &opts,
-        a.body.threads,
-        &plan,
-        &rules,
-    )
+    let files = discover(&a.inputs)?;
+    let report = build_library(&files, &a.out, &opts, a.body.threads, &plan, &rules)?;
+    Ok(report_build(&report, &a.out, &plan))
 }
 
 /// Run `merge`.
@@ -69,20 +64,10 @@ pub fn run_merge(a: MergeArgs) -> anyhow::Result<Outcome> {
     })
 }
 
-/// Build `files` into the library folder `out` under the output `rules`.
-///
-/// # Errors
-/// No readable inputs, a thread pool that cannot start, an `out` the output policy
-/// refuses or another build holds, or an unwritable library folder.
-pub fn execute(
-    files: &[PathBuf],
-    out: &Path,
-    opts: &BuildOptions,
-    threads: usize,
-    plan: &BuildPlan,
-    rules: &OutputRules,
-) -> anyhow::Result<Outcome> {
-    let report = build_library(files, out, opts, threads, plan, rules)?;
+/// Prints a finished build's per-clip failures, summary and `--json` line; the outcome
+/// for the exit code (a shard whose clips all failed is one part of a build, so it is
+/// `SomeFailed`: the merge decides).
+pub fn report_build(report: &BuildSummary, out: &Path, plan: &BuildPlan) -> Outcome {
     let reused = report.reused;
     let outcome = super::frames::report(&report.records, out);
     crate::say!("{} stances rebuilt, {reused} clips reused", report.stances);
@@ -90,9 +75,8 @@ pub fn execute(
     summary["stances_rebuilt"] = report.stances.into();
     summary["clips_reused"] = reused.into();
     crate::cli::summary_json(&summary);
-    // A shard whose clips all failed is one part of a build: the merge decides.
     if (reused > 0 || plan.shard.is_some()) && outcome == Outcome::AllFailed {
-        return Ok(Outcome::SomeFailed);
+        return Outcome::SomeFailed;
     }
-    Ok(outcome)
+    outcome
 }

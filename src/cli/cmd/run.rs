@@ -6,6 +6,7 @@ use anyhow::Context;
 
 use super::super::args::RunArgs;
 use super::super::Outcome;
+use crate::pipeline::build::build_library;
 use crate::pipeline::job::{pipeline_job, CommandLine};
 use crate::pipeline::queries::{map_jumps, run_query};
 
@@ -24,7 +25,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
         incremental: a.incremental,
     };
     let job = pipeline_job(&a.pipeline, &cl)?;
-    let outcome = super::build::execute(
+    let report = build_library(
         &job.files,
         &job.lib,
         &job.opts,
@@ -32,6 +33,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<Outcome> {
         &job.plan,
         &job.rules,
     )?;
+    let outcome = super::build::report_build(&report, &job.lib, &job.plan);
     let stage = || format!("{}: [queries]", a.pipeline.display());
     if let Some(r) = &job.run {
         super::query::print_run(&run_query(r).with_context(stage)?, &r.out);
