@@ -10,8 +10,13 @@
 //!     root so that COM(pose) = planned COM (iterated below the tolerance)     [pose]
 //! ```
 //! Choices where the method is silent, in short:
-//! - A run cycle is made exactly periodic (the two apexes where its stances meet are
-//!   averaged) so that any number of cycles chain with continuous COM position and velocity.
+//! - A run cycle is made exactly periodic so that any number of cycles chain with
+//!   continuous COM position and velocity: the first stance is the run policy's own
+//!   request, the second runs from its end apex back to its start apex ([`plan`]).
+//! - Where a request asks a stance for a speed change its scaled recorded impulse does not
+//!   carry (the periodic second stance), the difference is a constant friction-ratio offset
+//!   (the body leans), not a rescaling of the whole horizontal force ([`lean`]; a departure
+//!   from the paper: its `β_h = Δv/J_h` is ill-conditioned for a running stance).
 //! - The reference is the source stance's own frames; stance time is warped linearly
 //!   between touchdown and liftoff, flight time linearly on each side of the apex, and
 //!   a flight blends the pose after one stance into the pose before the next (quaternion
@@ -54,6 +59,7 @@
 //! (editing the full body from the COM), §6.8 (run at speed v), §6.9 (jumps), §9 (new
 //! characters); the closed forms of the force model (`force_model::model`).
 
+pub mod lean;
 pub mod path;
 pub mod plan;
 pub mod pose;

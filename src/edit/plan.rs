@@ -4,11 +4,13 @@
 //! # Model
 //! ```text
 //! run cycle S1, S2 at k = v / v_orig (the run-at-speed policy: (vs, ve, x)·k, vp kept),
-//! made exactly periodic so N cycles chain (the recorded S2 → S1 join is not checked):
-//!   Z_a = ½((zs1 + z_c1) + (ze2 + z_c2)),   Z_b = ½((ze1 + z_c1) + (zs2 + z_c2))
-//!   U_a = ½(k·vs1 + |(k·ve2, vp2)|),         U_b = ½(k·vs2 + |(k·ve1, vp1)|)
-//!   S1: zs = Z_a − z_c1, vs = U_a, ze = Z_b − z_c1, ve = √(U_b² − vp1²), vp1, vps = 0, x = k·x1
-//!   S2: zs = Z_b − z_c2, vs = U_b, ze = Z_a − z_c2, ve = √(U_a² − vp2²), vp2, vps = 0, x = k·x2
+//! made exactly periodic so N cycles chain: S1 is the policy's own request, and S2 carries
+//! the recorded S2 → S1 mismatch (it runs from S1's end apex back to S1's start apex):
+//!   S1: zs = zs1, vs = k·vs1, ze = ze1, ve = k·ve1, vp1, vps = 0, x = k·x1
+//!   S2: zs = ze1 + z_c1 − z_c2, vs = |(k·ve1, vp1)|, ze = zs1 + z_c1 − z_c2,
+//!       ve = √((k·vs1)² − vp2²), vp2, vps = 0, x = k·x2
+//!   each solved leaned (`lean`): β_h = k, β_p = 1, the speed change S2's recorded impulse
+//!   does not carry added as a constant friction-ratio offset
 //! jump: the requests of `query::jump` (they chain by construction: ve1 = vs2 = u_apex)
 //! placement: the first stance keeps its recorded heading, and its COM at touchdown is the
 //!   recorded one; every later stance is chained at the apex (`path`)
@@ -56,27 +58,22 @@ impl EditStance {
 /// The periodic requests of a run cycle at `k` (see the module docs).
 pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
     let (p1, p2) = (&s[0].params, &s[1].params);
-    let (z1, z2) = (s[0].z_c, s[1].z_c);
-    let za = 0.5 * ((p1.zs + z1) + (p2.ze + z2));
-    let zb = 0.5 * ((p1.ze + z1) + (p2.zs + z2));
-    let ua = 0.5 * (k * p1.vs + (k * p2.ve).hypot(p2.vp));
-    let ub = 0.5 * (k * p2.vs + (k * p1.ve).hypot(p1.vp));
-    let ve = |u: f64, vp: f64| (u * u - vp * vp).max(0.0).sqrt();
+    let dz = s[0].z_c - s[1].z_c;
     [
         Request {
-            zs: za - z1,
-            vs: ua,
-            ze: zb - z1,
-            ve: ve(ub, p1.vp),
+            zs: p1.zs,
+            vs: k * p1.vs,
+            ze: p1.ze,
+            ve: k * p1.ve,
             vp: p1.vp,
             vps: 0.0,
             x: k * p1.x,
         },
         Request {
-            zs: zb - z2,
-            vs: ub,
-            ze: za - z2,
-            ve: ve(ua, p2.vp),
+            zs: p1.ze + dz,
+            vs: (k * p1.ve).hypot(p1.vp),
+            ze: p1.zs + dz,
+            ve: ((k * p1.vs).powi(2) - p2.vp * p2.vp).max(0.0).sqrt(),
             vp: p2.vp,
             vps: 0.0,
             x: k * p2.x,

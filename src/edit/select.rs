@@ -4,7 +4,8 @@
 //! # Policy
 //! ```text
 //! run:  every run cycle of a clip that is not time-scaled (or the one named), each solved
-//!       at k = v / (v_orig·√L) refined until the cycle's speed is v (`refine_run_k`);
+//!       at k = v / (v_orig·√L) refined until the cycle's speed is v (`refine_run_k`),
+//!       its stances leaned to the periodic requests (`lean`: β_h = k, β_p = 1);
 //!       best = feasible first, then the least |k − 1| (the least change of the recorded
 //!       speed), ties by the order of the cycles (stance id order)
 //! jump: the named pair; else, without both a height and a distance, the library's first
@@ -16,6 +17,7 @@
 
 use std::collections::BTreeMap;
 
+use super::lean::leaned;
 use super::plan::{refine_run_k, run_requests, solve_stance, EditStance, StanceTiming};
 use crate::error::{Error, Result};
 use crate::library::read::StanceLibrary;
@@ -111,8 +113,9 @@ pub fn choose_run(
                 (0..2)
                     .map(|n| {
                         let lim = stance_limits(&prep[n], limits.form, &absolute, limits.mu);
+                        let lean = leaned(&prep[n], &req[n], [k, 1.0], limits.active);
                         let i = cy.stances[n];
-                        solve_stance(&lib.stances[i], times[i], &prep[n], req[n], &lim)
+                        solve_stance(&lib.stances[i], times[i], &lean, req[n], &lim)
                     })
                     .collect()
             })
