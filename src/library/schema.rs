@@ -688,7 +688,9 @@ pub mod flight_ref {
     pub const FREE: &str = "free";
     /// `a_z_mps2`: Fitted vertical COM acceleration, m/s².
     pub const A_Z: &str = "a_z_mps2";
-    /// `vel_mps`: World COM velocity at the stance edge (list of 3), m/s.
+    /// `vel_mps`: World COM velocity at the stance edge (list of 3), m/s: of the −g
+    /// parabola the stance's edge state comes from (the flight's own fit when there is
+    /// none).
     pub const VEL: &str = "vel_mps";
     /// Every column, in file order.
     pub const COLUMNS: [&str; 6] = [FIRST_FRAME, LAST_FRAME, N_INT, FREE, A_Z, VEL];

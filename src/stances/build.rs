@@ -117,9 +117,12 @@ fn contact_point(seg: &Segment, fr: &ClipFrames) -> Option<V3> {
     (n > 0.0).then(|| acc.map(|v| v / n))
 }
 
-/// The adjacent flight of a `flight` boundary; without a fit (`n_int < 2`) its curvature
-/// is the mean SG acceleration `ā_z` and its velocity is null.
-fn flight_ref(f: &Flight, t: f64) -> FlightRef {
+/// The adjacent flight of a `flight` boundary: its own curvature (free fit, else the
+/// fixed one; without a fit, `n_int < 2`, the mean SG acceleration `ā_z`) and the velocity
+/// at `t` of the parabola the stance's edge state comes from ([`ballistic_fit`], else the
+/// flight's own fit; null without either).
+fn flight_ref(fr: &ClipFrames, f: &Flight, t: f64) -> FlightRef {
+    let edge = ballistic_fit(fr, f).or_else(|| f.fit.clone());
     FlightRef {
         first_frame: f.first_frame,
         last_frame: f.last_frame,
@@ -131,7 +134,7 @@ fn flight_ref(f: &Flight, t: f64) -> FlightRef {
             .map(|fit| fit.axes[2].curvature())
             .or(f.a_z_mean)
             .unwrap_or(f64::NAN),
-        vel: f.fit.as_ref().map(|fit| fit.velocity(t)),
+        vel: edge.map(|fit| fit.velocity(t)),
     }
 }
 
@@ -186,22 +189,28 @@ fn flight_ending_at(summary: &ClipSummary, last_frame: i64) -> Option<&Flight> {
     summary.flights.iter().find(|f| f.last_frame == last_frame)
 }
 
-/// The ballistic fit of a flight that a stance takes its edge state from: the flight's own
-/// free fit when it has one (≥ 4 interior frames), else the raw COM with `x(t)`, `y(t)`
-/// lines and `z(t)` a parabola of curvature −g over the frames strictly between the
-/// flight's sub-frame liftoff and touchdown ([`Flight::events_s`]; every such frame is
-/// airborne, and a 60 Hz running flight keeps 4–5 of its frames), or, without events, over
-/// the flight's frames less [`BALLISTIC_EDGE_FRAMES`] at each end. Both stances beside one
-/// flight use the same parabola, so they agree on its state. `None` for a non-ballistic
-/// flight or fewer than [`BALLISTIC_MIN_FRAMES`] frames.
+/// The ballistic fit of a flight that a stance takes its edge state from: the raw COM
+/// with `x(t)`, `y(t)` lines and `z(t)` a parabola of curvature −g over the frames strictly
+/// between the flight's sub-frame liftoff and touchdown ([`Flight::events_s`]; every such
+/// frame is airborne, and a 60 Hz running flight keeps 4–5 of its frames), or, without
+/// events, over the flight's frames less [`BALLISTIC_EDGE_FRAMES`] at each end. Both
+/// stances beside one flight use the same parabola, so they agree on its state. `None` for
+/// a non-ballistic flight or fewer than [`BALLISTIC_MIN_FRAMES`] frames.
+///
+/// The curvature is −g even where the flight has its own free-curvature fit (a departure
+/// from spec com-from-bvh §7.7, which takes the free fit's state): a 0.1 s flight at
+/// 120 Hz leaves 8 interior frames, and their free curvature is as noisy as the COM
+/// estimate (−5.6, −8.9 and −9.6 m/s² on the three flights of `cmu_09_01_run_mb`). With
+/// −5.6 m/s² the liftoff and touchdown velocities that joined the 102 ms flight were
+/// 0.57 m/s apart instead of g·0.102 = 1.0 m/s, so the stances beside it put their apexes
+/// 44 ms apart and an edit at the recorded speed (ballistic flights) touched down 44 ms
+/// early: 4.5° joint-angle RMS against the source over the first cycle, 1.8° with −g
+/// (measured 2026-12-03). The free fit still gives the flight's `a_z`, the ballistic test
+/// and the clip's time scale `s_eff`; a clip whose flights say it is time-scaled is not
+/// eligible for queries (`stances::limits`), so −g is the physics of every stance used.
 fn ballistic_fit(fr: &ClipFrames, f: &Flight) -> Option<FlightFit> {
     if !f.ballistic {
         return None;
-    }
-    if f.tested {
-        // A flight long enough for its own free-curvature fit (spec com-from-bvh §7.7):
-        // that parabola is the flight the data show, and both neighbours share it.
-        return f.fit.clone();
     }
     let frame0 = fr.frame[0];
     let (first, last) = (
@@ -605,8 +614,8 @@ impl<'a> ClipData<'a> {
             boundary_start: seg.start,
             boundary_end: seg.end,
             rest_at_edge,
-            flight_before: self.flight_before(seg).map(|f| flight_ref(f, t_td)),
-            flight_after: self.flight_after(seg).map(|f| flight_ref(f, t_lo)),
+            flight_before: self.flight_before(seg).map(|f| flight_ref(fr, f, t_td)),
+            flight_after: self.flight_after(seg).map(|f| flight_ref(fr, f, t_lo)),
             heading: h,
             z_c,
             params: prm,
