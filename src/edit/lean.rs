@@ -72,7 +72,7 @@ pub fn leaned(p: &Prepared, req: &Request, beta_ref: [f64; 2], active: f64) -> P
 mod tests {
     use super::*;
     use crate::query::solve::{solve, Refs};
-    use crate::query::testkit::{bell_model, pool_stance, simulate, Rng};
+    use crate::query::testkit::{assert_reaches_end_apex, bell_model, pool_stance, simulate, Rng};
     use crate::stances::segment::Boundary;
 
     /// A running stance (flight on both sides) of a random bell model.
@@ -116,24 +116,7 @@ mod tests {
             // Independent of the closed form: RK4 on the leaned force reaches the request's
             // end apex (RK4 error ≲ 1e-12 m; the closed form's roundoff 1e-9).
             let y = simulate(&l.stance.model, &req, &s);
-            assert!(
-                (y[3] - req.ve).abs() < 1e-8,
-                "seed {seed}: ve {} vs {}",
-                y[3],
-                req.ve
-            );
-            assert!(
-                (y[0] - req.x).abs() < 1e-8,
-                "seed {seed}: x {} vs {}",
-                y[0],
-                req.x
-            );
-            assert!(
-                (y[2] - req.ze).abs() < 1e-8,
-                "seed {seed}: ze {} vs {}",
-                y[2],
-                req.ze
-            );
+            assert_reaches_end_apex(&y, &req, 1e-8, &format!("seed {seed}"));
         }
         assert!(solved >= 10, "only {solved} of 20 requests solved");
     }

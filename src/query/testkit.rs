@@ -95,6 +95,18 @@ pub fn simulate(m: &ForceModel, req: &Request, s: &Solution) -> State {
     rk4(m, [0.0; 3], s.t_td, y, s.t_lo, s.t_e, 4)
 }
 
+/// Asserts that a simulated end state `y` (of [`simulate`]) is the request's end apex:
+/// `x`, `ze` and `ve` within `tol` (m, m/s); `what` names the case in the message.
+pub fn assert_reaches_end_apex(y: &State, req: &Request, tol: f64, what: &str) {
+    for (name, got, want) in [
+        ("x", y[0], req.x),
+        ("ze", y[2], req.ze),
+        ("ve", y[3], req.ve),
+    ] {
+        assert!((got - want).abs() < tol, "{what}: {name} {got} vs {want}");
+    }
+}
+
 /// A stance-like model (`testkit::bell_model`): vertical bell `A(1 − cos 2πτ)` plus small
 /// ringing (up to 0.04 body weights), random horizontal forces.
 pub fn bell_model(rng: &mut Rng) -> ForceModel {

@@ -5,7 +5,7 @@
 use super::*;
 use crate::query::feasibility::relative_limits;
 use crate::query::solve::Solution;
-use crate::query::testkit::{bell_model, pool_stance, simulate, Rng};
+use crate::query::testkit::{assert_reaches_end_apex, bell_model, pool_stance, simulate, Rng};
 
 /// A runner-like stance: touchdown at 3–5 m/s descending, liftoff rising (a flight on
 /// both sides, so §6.5 rule 3 holds for the recorded stance itself).
@@ -57,19 +57,7 @@ fn policy_keeps_vertical_solution_and_scales_horizontal_forces() {
             }
             // Independent check: RK4 on the scaled model force, start apex → end apex.
             let end = simulate(&p.stance.model, &req, &sol);
-            assert!((end[0] - req.x).abs() < 1e-6, "x {} vs {}", end[0], req.x);
-            assert!(
-                (end[2] - req.ze).abs() < 1e-6,
-                "ze {} vs {}",
-                end[2],
-                req.ze
-            );
-            assert!(
-                (end[3] - req.ve).abs() < 1e-6,
-                "ve {} vs {}",
-                end[3],
-                req.ve
-            );
+            assert_reaches_end_apex(&end, &req, 1e-6, "scaled stance");
             assert!((end[4] - req.vp).abs() < 1e-6 && end[5].abs() < 1e-6);
         }
     }
