@@ -119,10 +119,9 @@ fn contact_point(seg: &Segment, fr: &ClipFrames) -> Option<V3> {
 
 /// The adjacent flight of a `flight` boundary: its own curvature (free fit, else the
 /// fixed one; without a fit, `n_int < 2`, the mean SG acceleration `ā_z`) and the velocity
-/// at `t` of the parabola the stance's edge state comes from ([`ballistic_fit`], else the
-/// flight's own fit; null without either).
-fn flight_ref(fr: &ClipFrames, f: &Flight, t: f64) -> FlightRef {
-    let edge = ballistic_fit(fr, f).or_else(|| f.fit.clone());
+/// at the stance edge `t`: `edge_vel`, the stance's edge state when it came from the
+/// flight's −g parabola ([`ballistic_fit`]), else the flight's own fit (null without one).
+fn flight_ref(f: &Flight, t: f64, edge_vel: Option<V3>) -> FlightRef {
     FlightRef {
         first_frame: f.first_frame,
         last_frame: f.last_frame,
@@ -134,7 +133,7 @@ fn flight_ref(fr: &ClipFrames, f: &Flight, t: f64) -> FlightRef {
             .map(|fit| fit.axes[2].curvature())
             .or(f.a_z_mean)
             .unwrap_or(f64::NAN),
-        vel: edge.map(|fit| fit.velocity(t)),
+        vel: edge_vel.or_else(|| f.fit.as_ref().map(|fit| fit.velocity(t))),
     }
 }
 
@@ -614,8 +613,12 @@ impl<'a> ClipData<'a> {
             boundary_start: seg.start,
             boundary_end: seg.end,
             rest_at_edge,
-            flight_before: self.flight_before(seg).map(|f| flight_ref(fr, f, t_td)),
-            flight_after: self.flight_after(seg).map(|f| flight_ref(fr, f, t_lo)),
+            flight_before: self
+                .flight_before(seg)
+                .map(|f| flight_ref(f, t_td, edges.fit_before.then_some(edges.td.1))),
+            flight_after: self
+                .flight_after(seg)
+                .map(|f| flight_ref(f, t_lo, edges.fit_after.then_some(edges.lo.1))),
             heading: h,
             z_c,
             params: prm,
