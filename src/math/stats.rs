@@ -36,7 +36,8 @@ pub fn median(v: &[f64]) -> Option<f64> {
 }
 
 /// Percentile `p` of `v` over the window `i − half ..= i + half` (clipped at the ends), for
-/// every `i`. Sliding sorted window: O(n · half).
+/// every `i`. Sliding sorted window (`f64::total_cmp` order): O(n · half), one shift of
+/// the window per step where a value leaves and one enters ([`slide`]).
 pub fn running_percentile(v: &[f64], half: usize, p: f64) -> Vec<f64> {
     let n = v.len();
     let mut out = Vec::with_capacity(n);
@@ -46,6 +47,10 @@ pub fn running_percentile(v: &[f64], half: usize, p: f64) -> Vec<f64> {
     for i in 0..n {
         let want_hi = (i + half + 1).min(n);
         let want_lo = i.saturating_sub(half);
+        while hi < want_hi && lo < want_lo {
+            slide(&mut win, v[lo], v[hi]);
+            (lo, hi) = (lo + 1, hi + 1);
+        }
         while hi < want_hi {
             let x = v[hi];
             let pos = win.partition_point(|y| y.total_cmp(&x).is_lt());
@@ -61,6 +66,24 @@ pub fn running_percentile(v: &[f64], half: usize, p: f64) -> Vec<f64> {
         out.push(percentile_sorted(&win, p).unwrap_or(f64::NAN));
     }
     out
+}
+
+/// Replaces `old` (present in the sorted `win`) by `new`, keeping `win` sorted: the values
+/// between the two positions move by one place (one shift instead of a remove and an
+/// insert, which moved the tail of the window twice). On the bulk CMU set, one thread:
+/// the running percentile went from 5.5 % to 4.2 % of a `frames` run's samples (`perf`),
+/// the run 1.5 % faster (median of 9 paired runs), outputs byte-identical.
+fn slide(win: &mut [f64], old: f64, new: f64) {
+    let r = win.partition_point(|y| y.total_cmp(&old).is_lt());
+    let i = win.partition_point(|y| y.total_cmp(&new).is_lt());
+    if i <= r {
+        win[i..=r].rotate_right(1);
+        win[i] = new;
+    } else {
+        // `win[r] = old < new`, so `new` goes before the `i − 1` smaller values left.
+        win[r..i].rotate_left(1);
+        win[i - 1] = new;
+    }
 }
 
 #[cfg(test)]
@@ -86,6 +109,31 @@ mod tests {
             let lo = i.saturating_sub(13);
             let hi = (i + 14).min(v.len());
             assert_eq!(*ri, percentile(&v[lo..hi], 5.0).unwrap());
+        }
+    }
+
+    #[test]
+    fn running_percentile_equals_brute_force_with_ties_signed_zeros_and_nan() {
+        let mut rng = crate::testkit::Rng::new(0x51de);
+        let pool = [0.0, -0.0, 1.5, -2.0, f64::NAN, 1.5, 7.25];
+        let v: Vec<f64> = (0..400)
+            .map(|i| {
+                if i % 3 == 0 {
+                    pool[i % pool.len()]
+                } else {
+                    rng.uniform(-5.0, 5.0)
+                }
+            })
+            .collect();
+        for (half, p) in [(0, 50.0), (1, 5.0), (7, 95.0), (40, 5.0), (500, 30.0)] {
+            let r = running_percentile(&v, half, p);
+            for (i, ri) in r.iter().enumerate() {
+                let w = &v[i.saturating_sub(half)..(i + half + 1).min(v.len())];
+                let mut s = w.to_vec();
+                s.sort_by(f64::total_cmp);
+                let want = percentile_sorted(&s, p).unwrap();
+                assert_eq!(ri.to_bits(), want.to_bits(), "half {half}, p {p}, i {i}");
+            }
         }
     }
 
