@@ -37,7 +37,7 @@ pub fn median(v: &[f64]) -> Option<f64> {
 
 /// Percentile `p` of `v` over the window `i − half ..= i + half` (clipped at the ends), for
 /// every `i`. Sliding sorted window (`f64::total_cmp` order): O(n · half), one shift of
-/// the window per step where a value leaves and one enters ([`slide`]).
+/// the window per step where a value leaves and one enters (`slide`).
 pub fn running_percentile(v: &[f64], half: usize, p: f64) -> Vec<f64> {
     let n = v.len();
     let mut out = Vec::with_capacity(n);
