@@ -20,8 +20,9 @@
 //! CMU run `cmu_09_01_run_mb` decelerates 0.094 m/s per recorded cycle): its first stance
 //! had `J_h = 0.014 m/s` and was asked for 0.061 m/s, so `β_h = 4.5` quadrupled its braking
 //! and push-off, the planned COM dipped 1.2 m/s instead of the recorded 0.27 m/s and fell
-//! 10 cm behind the recording by liftoff (measured 2026-12-03). With the correction the
-//! same request adds `ε_h ≈ 0.015` to the friction ratio.
+//! 10 cm behind the recording by liftoff (measured 2026-12-03). Now the first stance is the
+//! policy's own request (`ε = 0`) and the second, which carries the cycle's 0.094 m/s, leans
+//! by `ε_h ≈ 0.027`.
 //!
 //! # Frames and units
 //! Stance frame `h, p, v`; `Δv`, `J` in m/s; forces in N.
@@ -30,13 +31,18 @@ use crate::constraints::coefficients::force_coefficients;
 use crate::query::pool::Prepared;
 use crate::query::solve::Request;
 
+/// Offsets at or below this size are roundoff of the stored parameters (a request equal
+/// to the policy's own gives `|ε| ≲ 1e-15`) and count as 0, so such a stance is untouched.
+pub const ZERO_OFFSET: f64 = 1e-12;
+
 /// `ε_a = (Δv_a / β_a,ref − J_a) / J_v` for `a = h, p`; 0 where it is undefined
-/// (`J_v ≤ 0`, a non-positive reference, or a non-finite value).
+/// (`J_v ≤ 0`, a non-positive reference, or a non-finite value) or within
+/// [`ZERO_OFFSET`] of 0.
 pub fn ratio_offsets(j: [f64; 3], req: &Request, beta_ref: [f64; 2]) -> [f64; 2] {
     let dv = [req.ve - req.vs, req.vp - req.vps];
     std::array::from_fn(|a| {
         let e = (dv[a] / beta_ref[a] - j[a]) / j[2];
-        if j[2] > 0.0 && beta_ref[a] > 0.0 && e.is_finite() {
+        if j[2] > 0.0 && beta_ref[a] > 0.0 && e.is_finite() && e.abs() > ZERO_OFFSET {
             e
         } else {
             0.0

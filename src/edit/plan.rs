@@ -15,8 +15,9 @@
 //! placement: the first stance keeps its recorded heading, and its COM at touchdown is the
 //!   recorded one; every later stance is chained at the apex (`path`)
 //! ```
-//! Each request is solved and checked by the query code (`query::run::scale_and_check`), so
-//! an edit is feasible exactly when the query says its stances are.
+//! Each request is solved and checked by the query code (`query::run::scale_and_check`) on
+//! the stance the edit plays (the leaned one for a run, `lean`), against the recorded
+//! stance's limits.
 
 use super::path::{ComPath, PlannedStance};
 use super::pose::{Reference, StanceSource};
@@ -97,9 +98,9 @@ pub fn cycle_speed(stances: &[EditStance]) -> f64 {
 /// The run policy's `k` refined so that the solved periodic cycle runs at `speed` (m/s).
 ///
 /// `k = v / v_orig` scales `x` and the edge speeds, but the periodic requests (module docs)
-/// keep `vp` and average the joins, so the solved times `T_k` move and the planned mean
-/// speed `Σ x_k / Σ T_k` is not exactly `v` (1.89 m/s for a 2 m/s request on the
-/// 3.5 m/s fixture run). Fixed point `k ← k · v / cycle_speed(k)`, at most
+/// keep `vp` and close the cycle in the second stance, so its solved time `T_2` moves and
+/// the planned mean speed `Σ x_k / Σ T_k` is not exactly `v` (with the earlier averaged
+/// joins: 1.89 m/s for a 2 m/s request on the 3.5 m/s fixture run). Fixed point `k ← k · v / cycle_speed(k)`, at most
 /// [`MAX_SPEED_ITERATIONS`] times, until within [`SPEED_TOL`]; the last `k` whose cycle
 /// solves is kept (the first one's error is returned when `k0` itself does not solve).
 pub fn refine_run_k(

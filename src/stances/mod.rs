@@ -34,8 +34,8 @@ pub struct FlightRef {
     /// Fitted or fixed vertical curvature, or `ā_z` without a fit, m/s².
     pub a_z: f64,
     /// The edge parabola's velocity at this stance's touchdown (before) or liftoff (after),
-    /// world m/s (curvature −g; the flight's own fit when that has none); `None` when the
-    /// flight is too short to fit (`n_int < 2`).
+    /// world m/s (curvature −g; the flight's own fit when that has none); `None` when
+    /// neither exists.
     pub vel: Option<[f64; 3]>,
 }
 

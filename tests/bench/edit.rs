@@ -24,6 +24,7 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use stancelib::bvh::parse_file;
+use stancelib::edit::lean::leaned;
 use stancelib::edit::plan::{place, run_requests, solve_stance};
 use stancelib::edit::pose::{pose_motion, Reference};
 use stancelib::edit::EditOptions;
@@ -57,11 +58,22 @@ fn edit_one_second(c: &mut Criterion) {
     let cy = run_cycles(&l.stances)[0];
     let prep = cy.stances.map(|i| Prepared::new(l.stances[i].clone()));
     let req = run_requests([&prep[0].stance, &prep[1].stance], 1.1);
+    // As `edit run` plays them: each stance leaned to its periodic request (`edit::lean`).
+    let leaned: Vec<Prepared> = (0..2)
+        .map(|n| {
+            leaned(
+                &prep[n],
+                &req[n],
+                [1.1, 1.0],
+                prep[n].tables.active_fraction,
+            )
+        })
+        .collect();
     let stances: Vec<_> = (0..2)
         .map(|n| {
             let i = cy.stances[n];
             let lim = relative_limits(&prep[n].stance.coef);
-            solve_stance(&l.stances[i], times[i], &prep[n], req[n], &lim).expect("solved")
+            solve_stance(&l.stances[i], times[i], &leaned[n], req[n], &lim).expect("solved")
         })
         .collect();
     let bvh = parse_file(&clip).expect("clip");
