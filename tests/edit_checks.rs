@@ -46,7 +46,9 @@ fn jump_higher_than_recorded_pivots_on_the_toes_and_converges() {
 // puts the COM 1.127 m from the contact at liftoff, 3 % beyond the recorded 1.094 m, with
 // the foot already upright on its toe. With the posture for reach (pelvis and trunk turn
 // so the stance hip comes nearer the foot, `edit::posture`): events 0.84 / 0.91 frames at
-// 1.0 × / 1.1 ×, every frame converged (measured 2026-12-02).
+// 1.0 × / 1.1 ×, every frame converged (measured 2026-12-02). After the leaned cycle and
+// the −g stance edges: events 0.86 / 0.85 frames, slide 5.3 mm, every frame converged
+// (2026-12-03).
 #[test]
 fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
     let Some(data) = shared_or_skip("real_run_edit_support_foot_holds_still_and_lifts_on_time")

@@ -462,6 +462,7 @@ fn running_stances_are_feasible_as_recorded() {
     use stancelib::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
     use stancelib::query::limits::{absolute_limits, stance_limits};
     use stancelib::query::run::{policy_request, scale_and_check};
+    use stancelib::query::solve::Refs;
     use stancelib::stances::segment::Boundary;
     let Some(lib) = nightly_library() else { return };
     let (library, pool) = load_pool(lib, DEFAULT_QUERY_ACTIVE_FRACTION).unwrap();
@@ -476,7 +477,7 @@ fn running_stances_are_feasible_as_recorded() {
         }
         n += 1;
         let lim = stance_limits(p, LimitForm::Absolute, &limits, Some(0.7));
-        match scale_and_check(p, &policy_request(&p.stance, 1.0), &lim) {
+        match scale_and_check(p, &policy_request(&p.stance, 1.0), &Refs::run(1.0), &lim) {
             Ok(c) if c.verdict.feasible => ok += 1,
             Ok(c) => *why.entry(format!("{:?}", c.verdict.violated)).or_default() += 1,
             Err(e) => *why.entry(format!("unsolved: {e:?}")).or_default() += 1,

@@ -21,8 +21,12 @@
 //! had `J_h = 0.014 m/s` and was asked for 0.061 m/s, so `β_h = 4.5` quadrupled its braking
 //! and push-off, the planned COM dipped 1.2 m/s instead of the recorded 0.27 m/s and fell
 //! 10 cm behind the recording by liftoff (measured 2026-12-03). Now the first stance is the
-//! policy's own request (`ε = 0`) and the second, which carries the cycle's 0.094 m/s, leans
-//! by `ε_h ≈ 0.027`.
+//! policy's own request and the second, which carries the cycle's 0.094 m/s, leans by
+//! `ε_h ≈ 0.027`. The first stance's request differs from the policy's only in `vps = 0`
+//! (the plan chains every stance with its heading along the incoming apex velocity,
+//! `edit::path`); a running stance's recorded `vps` is 0 by the same convention (a flight
+//! before it sets its heading), so its `ε = 0` too. A stance without a flight before it
+//! (recorded `vps ≠ 0`, e.g. the clip's first) would lean sideways by `ε_p = vps / J_v`.
 //!
 //! # Frames and units
 //! Stance frame `h, p, v`; `Δv`, `J` in m/s; forces in N.
@@ -101,30 +105,34 @@ mod tests {
         for seed in 1..=20u64 {
             let p = running(seed);
             let q = p.stance.params;
-            // 0.05 m/s more speed change than the stance's own impulse, and vps = 0.
-            let req = Request {
-                zs: q.zs,
-                vs: q.vs,
-                ze: q.ze,
-                ve: q.ve + 0.05,
-                vp: q.vp,
-                vps: 0.0,
-                x: q.x,
-            };
-            let l = leaned(&p, &req, [1.0, 1.0], p.tables.active_fraction);
-            let Ok(s) = solve(&l.shape, &req, &Refs::default(), Some(q.t_e)) else {
-                continue;
-            };
-            solved += 1;
-            assert!((l.stance.model.j()[0] - 0.05 - (q.ve - q.vs)).abs() < 1e-9);
-            assert!((s.beta[0] - 1.0).abs() < 1e-9, "β_h {}", s.beta[0]);
-            assert!((s.beta[1] - 1.0).abs() < 1e-9, "β_p {}", s.beta[1]);
-            // Independent of the closed form: RK4 on the leaned force reaches the request's
-            // end apex (RK4 error ≲ 1e-12 m; the closed form's roundoff 1e-9).
-            let y = simulate(&l.stance.model, &req, &s);
-            assert_reaches_end_apex(&y, &req, 1e-8, &format!("seed {seed}"));
+            // The policy's request at k (identity and a faster run), with 0.05 m/s more
+            // speed change than its scaled impulse carries.
+            for k in [1.0, 1.3] {
+                let req = Request {
+                    zs: q.zs,
+                    vs: k * q.vs,
+                    ze: q.ze,
+                    ve: k * q.ve + 0.05,
+                    vp: q.vp,
+                    vps: q.vps,
+                    x: k * q.x,
+                };
+                let l = leaned(&p, &req, [k, 1.0], p.tables.active_fraction);
+                let Ok(s) = solve(&l.shape, &req, &Refs::run(k), Some(q.t_e)) else {
+                    continue;
+                };
+                solved += 1;
+                let j_h = l.stance.model.j()[0];
+                assert!((j_h - 0.05 / k - (q.ve - q.vs)).abs() < 1e-9, "J'_h {j_h}");
+                assert!((s.beta[0] - k).abs() < 1e-9, "β_h {} at k {k}", s.beta[0]);
+                assert!((s.beta[1] - 1.0).abs() < 1e-9, "β_p {}", s.beta[1]);
+                // Independent of the closed form: RK4 on the leaned force reaches the
+                // request's end apex (RK4 error ≲ 1e-12 m; the closed form's roundoff 1e-9).
+                let y = simulate(&l.stance.model, &req, &s);
+                assert_reaches_end_apex(&y, &req, 1e-8, &format!("seed {seed}, k {k}"));
+            }
         }
-        assert!(solved >= 10, "only {solved} of 20 requests solved");
+        assert!(solved >= 20, "only {solved} of 40 requests solved");
     }
 
     #[test]

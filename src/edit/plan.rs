@@ -24,7 +24,7 @@ use super::pose::{Reference, StanceSource};
 use crate::query::feasibility::Limits;
 use crate::query::pool::{PoolStance, Prepared};
 use crate::query::run::{scale_and_check, ScaledStance};
-use crate::query::solve::Request;
+use crate::query::solve::{Refs, Request};
 use crate::query::tables::violation_name;
 
 use crate::math::v3::V3;
@@ -133,9 +133,10 @@ pub fn solve_stance(
     timing: StanceTiming,
     prepared: &Prepared,
     request: Request,
+    refs: &Refs,
     limits: &Limits,
 ) -> Result<EditStance, String> {
-    let scaled = scale_and_check(prepared, &request, limits)
+    let scaled = scale_and_check(prepared, &request, refs, limits)
         .map_err(|e| format!("{}: {e}", source.stance_id))?;
     Ok(EditStance {
         source: source.clone(),

@@ -27,6 +27,7 @@ use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
 use crate::query::pairs::jump_rank;
 use crate::query::pool::Prepared;
 use crate::query::run::{run_cycles, scale_limits};
+use crate::query::solve::Refs;
 
 /// The limits an edit's stances are checked against (§7.5).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,7 +116,8 @@ pub fn choose_run(
                         let lim = stance_limits(&prep[n], limits.form, &absolute, limits.mu);
                         let lean = leaned(&prep[n], &req[n], [k, 1.0], limits.active);
                         let i = cy.stances[n];
-                        solve_stance(&lib.stances[i], times[i], &lean, req[n], &lim)
+                        let refs = Refs::run(k);
+                        solve_stance(&lib.stances[i], times[i], &lean, req[n], &refs, &lim)
                     })
                     .collect()
             })

@@ -190,10 +190,11 @@ pub struct ScaledStance {
 pub fn scale_and_check(
     p: &Prepared,
     req: &Request,
+    refs: &Refs,
     lim: &Limits,
 ) -> Result<ScaledStance, super::solve::Infeasible> {
     let s = &p.stance;
-    let sol = solve(&p.shape, req, &Refs::default(), Some(s.params.t_e))?;
+    let sol = solve(&p.shape, req, refs, Some(s.params.t_e))?;
     Ok(check_solution(p, req, &sol, lim))
 }
 
@@ -305,7 +306,7 @@ pub fn run_at_speed(
     let k = speed / v_orig;
     let check = |i: usize| {
         let p = cycle[i];
-        scale_and_check(p, &policy_request(&p.stance, k), lims[i])
+        scale_and_check(p, &policy_request(&p.stance, k), &Refs::run(k), lims[i])
     };
     let stances = [check(0), check(1)];
     RunCandidate {

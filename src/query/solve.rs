@@ -110,6 +110,17 @@ impl Default for Refs {
     }
 }
 
+impl Refs {
+    /// The references of the run-at-speed policy at `k = v / v_orig` (`β_h = k`, the others
+    /// 1): a stance whose `J_h ≈ 0` keeps the policy's fore-aft scale.
+    pub fn run(k: f64) -> Self {
+        Refs {
+            beta_h: k,
+            ..Refs::default()
+        }
+    }
+}
+
 /// Tolerances of [`solve_with`]; see the `DEFAULT_*` constants.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveOptions {
@@ -193,7 +204,10 @@ impl StanceShape {
         ref_signs: Option<(f64, f64)>,
     ) -> Self {
         let j_scale = m.axes.each_ref().map(|a| {
-            let sum: f64 = a.c0.abs() + a.terms().map(|(_, c, _)| c.abs()).sum::<f64>();
+            // A bound on max |f| over τ ∈ [0, 1]: |c0| + Σ|c_i| + Σ|p_k| (τ^k ≤ 1).
+            let sum: f64 = a.c0.abs()
+                + a.terms().map(|(_, c, _)| c.abs()).sum::<f64>()
+                + a.poly.iter().map(|p| p.abs()).sum::<f64>();
             m.dt_s / m.mass_kg * sum
         });
         let (j, k) = (m.j(), m.k());

@@ -34,6 +34,7 @@ use stancelib::pipeline::build::{build_and_write, BuildOptions};
 use stancelib::query::feasibility::relative_limits;
 use stancelib::query::pool::Prepared;
 use stancelib::query::run::run_cycles;
+use stancelib::query::solve::Refs;
 use stancelib::skeleton::com::Sex;
 use stancelib::skeleton::units::UpAxis;
 
@@ -73,7 +74,15 @@ fn edit_one_second(c: &mut Criterion) {
         .map(|n| {
             let i = cy.stances[n];
             let lim = relative_limits(&prep[n].stance.coef);
-            solve_stance(&l.stances[i], times[i], &leaned[n], req[n], &lim).expect("solved")
+            solve_stance(
+                &l.stances[i],
+                times[i],
+                &leaned[n],
+                req[n],
+                &Refs::run(1.1),
+                &lim,
+            )
+            .expect("solved")
         })
         .collect();
     let bvh = parse_file(&clip).expect("clip");

@@ -242,6 +242,35 @@ fn degenerate_branch_no_net_horizontal_impulse_or_moment() {
 }
 
 #[test]
+fn polynomial_force_with_roundoff_impulse_is_degenerate() {
+    // A friction-ratio style fore-aft force with no harmonics: f_h = −50 + 100 τ (N) plus
+    // a roundoff-sized DC, so J_h ≈ 1e-16 m/s while the force is 50 N at the edges. Its
+    // scale counts the polynomial, so the J_h ≈ 0 branch takes it (β_h is not Δv/1e-16).
+    let mut m = model_with([0.0, 0.0, 1400.0], 0.0);
+    m.axes[0] = AxisModel {
+        c0: 1e-13,
+        poly: vec![-50.0, 100.0],
+        ..AxisModel::default()
+    };
+    let j_h = m.j()[0];
+    assert!(j_h != 0.0 && j_h.abs() < 1e-14, "J_h {j_h}");
+    let shape = StanceShape::from_model(&m, false, false, None);
+    assert!(shape.j_scale[0] > 1e3 * j_h.abs());
+    let t = m.j()[2] / GRAVITY;
+    let req = Request {
+        x: 3.0 * t - 0.01,
+        ..BASE
+    };
+    let s = solve(&shape, &req, &Refs::default(), None).unwrap();
+    assert_eq!(s.branch, Branch::NoNetHorizontal);
+    assert!(
+        (s.beta[0] - 0.01 / m.k()[0]).abs() < 1e-9,
+        "β_h {}",
+        s.beta[0]
+    );
+}
+
+#[test]
 fn degenerate_branch_no_net_perpendicular_impulse() {
     let (refs, base) = (Refs::default(), BASE);
     // (iii) J_p = 0: vp must equal vps, β_p = β_p,ref.
