@@ -4,9 +4,12 @@
 //!
 //! The build streams: clips are taken in name order in batches of
 //! [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads, and each batch's rows are
-//! appended to the tables (`pipeline::sink`) before the next batch is read, so memory
-//! depends on the largest clips and the thread count, not on the number of clips. The
-//! files are the same, byte for byte, whatever the batch size and thread count.
+//! appended to the tables (`pipeline::sink`) while the next batch is built (two batches in
+//! memory at most), so memory depends on the largest clips and the thread count, not on
+//! the number of clips. The files are the same, byte for byte, whatever the batch size and
+//! thread count. Overlapping the writing with the next batch: bulk CMU set, 2 threads,
+//! `farm-bench -n 9` against the build that wrote before reading on (2026-12-03), wall
+//! median 0.744 → 0.664 s (ratio 1.11; 1.16 in a quieter run), peak RSS 93 → 105 MiB.
 //!
 //! With `incremental`, the rows of clips whose path, content hash and options are those
 //! of the previous library are taken from it instead of being rebuilt; the result is the
@@ -388,18 +391,11 @@ pub fn build_into(
             sink.push_errors(previous_errors(out, &reuse)?);
             Some(Previous::open(out, sink.template())?)
         };
-        for chunk in named.chunks(batch) {
-            let todo: Vec<(PathBuf, String)> = chunk
-                .iter()
-                .filter(|(_, c)| !reuse.contains(c))
-                .cloned()
-                .collect();
-            let report = build_named(&todo, opts, &bar);
+        // Batch i is written while batch i + 1 is built (two batches in memory at most):
+        // the writing is mostly one thread's work, and the other workers build meanwhile.
+        let mut write = |report: BuildReport, last: Option<&String>| -> Result<()> {
             let mut t = Tables::from_report(&report, joints)?;
-            if let (Some(prev), Some((_, last))) = (prev.as_mut(), chunk.last()) {
-                prev.add_rows(&mut t, last, &reuse)?;
-            }
-            sink.push(&mut t)?;
+            // The frames are in the tables now: free them before the tables are encoded.
             summary.stances += report.stances.len();
             summary
                 .records
@@ -408,6 +404,27 @@ pub fn build_into(
                     r.contacts = Vec::new();
                     r
                 }));
+            if let (Some(prev), Some(last)) = (prev.as_mut(), last) {
+                prev.add_rows(&mut t, last, &reuse)?;
+            }
+            sink.push(&mut t)
+        };
+        let mut pending: Option<(BuildReport, Option<&String>)> = None;
+        for chunk in named.chunks(batch) {
+            let todo: Vec<(PathBuf, String)> = chunk
+                .iter()
+                .filter(|(_, c)| !reuse.contains(c))
+                .cloned()
+                .collect();
+            let (written, report) = rayon::join(
+                || pending.take().map_or(Ok(()), |(r, last)| write(r, last)),
+                || build_named(&todo, opts, &bar),
+            );
+            written?;
+            pending = Some((report, chunk.last().map(|(_, c)| c)));
+        }
+        if let Some((r, last)) = pending {
+            write(r, last)?;
         }
         bar.bar.finish_and_clear();
         sink.finish(&fingerprint, t0, shard_entry.clone(), plan.layout)
