@@ -43,7 +43,7 @@ fn stances_and_summary(rel: &str) -> Option<(Vec<Stance>, ClipSummary, ClipFrame
 
 /// Stances of one shared clip.
 fn stances_of(rel: &str) -> Option<Vec<Stance>> {
-    stances_and_flights(rel).map(|s| s.0)
+    stances_and_summary(rel).map(|s| s.0)
 }
 
 const RUNS_AND_JUMPS: [&str; 8] = [

@@ -100,7 +100,8 @@ pub fn cycle_speed(stances: &[EditStance]) -> f64 {
 /// `k = v / v_orig` scales `x` and the edge speeds, but the periodic requests (module docs)
 /// keep `vp` and close the cycle in the second stance, so its solved time `T_2` moves and
 /// the planned mean speed `Σ x_k / Σ T_k` is not exactly `v` (with the earlier averaged
-/// joins: 1.89 m/s for a 2 m/s request on the 3.5 m/s fixture run). Fixed point `k ← k · v / cycle_speed(k)`, at most
+/// joins: 1.89 m/s for a 2 m/s request on the 3.5 m/s fixture run). Fixed point
+/// `k ← k · v / cycle_speed(k)`, at most
 /// [`MAX_SPEED_ITERATIONS`] times, until within [`SPEED_TOL`]; the last `k` whose cycle
 /// solves is kept (the first one's error is returned when `k0` itself does not solve).
 pub fn refine_run_k(
