@@ -20,14 +20,26 @@ pub fn percentile_sorted(s: &[f64], p: f64) -> Option<f64> {
     if s.is_empty() {
         return None;
     }
-    let r = (p / 100.0).clamp(0.0, 1.0) * (s.len() - 1) as f64;
+    let (k, frac) = percentile_rank(s.len(), p);
+    Some(interpolate_rank(s[k], s.get(k + 1).copied(), frac))
+}
+
+/// The rank of percentile `p` among `n ≥ 1` sorted values: `(k, r − k)` with
+/// `r = p/100 · (n − 1)`, `k = ⌊r⌋` (the module's formula). The percentile needs only the
+/// order statistics `v₍ₖ₎` and `v₍ₖ₊₁₎`, so a stream can keep the `n − k` largest values
+/// instead of all of them.
+pub fn percentile_rank(n: usize, p: f64) -> (usize, f64) {
+    let r = (p / 100.0).clamp(0.0, 1.0) * n.saturating_sub(1) as f64;
     let k = r.floor() as usize;
-    let frac = r - k as f64;
-    Some(if k + 1 < s.len() {
-        s[k] + frac * (s[k + 1] - s[k])
-    } else {
-        s[k]
-    })
+    (k, r - k as f64)
+}
+
+/// `v₍ₖ₎ + frac (v₍ₖ₊₁₎ − v₍ₖ₎)`, or `v₍ₖ₎` when `k` is the last rank (`hi = None`).
+pub fn interpolate_rank(lo: f64, hi: Option<f64>, frac: f64) -> f64 {
+    match hi {
+        Some(hi) => lo + frac * (hi - lo),
+        None => lo,
+    }
 }
 
 /// Median of `v` (`None` when empty).

@@ -104,8 +104,9 @@ pub struct BuildReport {
 /// What a written build did.
 #[derive(Debug)]
 pub struct BuildSummary {
-    /// One record per rebuilt input file, sorted by clip, without its frames and contact
-    /// runs (those are in the library).
+    /// One record per rebuilt input file, sorted by clip, without its frames, contact runs
+    /// and summary (those are in the library; the flights and warnings of a large build's
+    /// summaries grew its memory by about 10 kB a clip).
     pub records: Vec<ClipRecord>,
     /// Stances of the rebuilt clips.
     pub stances: usize,
@@ -402,12 +403,16 @@ pub fn build_into(
                 .extend(report.records.into_iter().map(|mut r| {
                     r.frames = None;
                     r.contacts = Vec::new();
+                    r.summary = Default::default();
                     r
                 }));
             if let (Some(prev), Some(last)) = (prev.as_mut(), last) {
                 prev.add_rows(&mut t, last, &reuse)?;
             }
-            sink.push(&mut t)
+            sink.push(&mut t)?;
+            drop(t);
+            super::memory::release_free_memory();
+            Ok(())
         };
         let mut pending: Option<(BuildReport, Option<&String>)> = None;
         for chunk in named.chunks(batch) {

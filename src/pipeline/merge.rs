@@ -304,6 +304,8 @@ pub fn merge_into(
                 })
                 .unwrap_or(0);
             sink.push(&mut t)?;
+            drop(t);
+            super::memory::release_free_memory();
             start = end;
         }
         sink.finish(&fingerprint, t0, None, layout)

@@ -10,6 +10,7 @@ pub mod edit_outputs;
 pub mod equilibrium;
 pub mod inputs;
 pub mod job;
+pub mod memory;
 pub mod merge;
 pub mod names;
 pub mod output;

@@ -46,7 +46,8 @@ use crate::library::write::{
     clips_table, contacts_table, frames_table, joints_table, write_atomic, ROW_GROUP_ROWS,
 };
 use crate::stances::limits::{limits, ClipFacts, StanceFacts};
-use crate::twopac::kinematic::kinematic_polytope;
+use crate::twopac::hull::{HullOptions, StreamedHull};
+use crate::twopac::kinematic::OutlierRule;
 
 /// The scratch file of a library's kinematic samples, in its temporary folder
 /// ([`SampleSpill`]; removed before the folder is swapped into place).
@@ -193,7 +194,10 @@ impl LibrarySink {
         let mut template = Tables::empty(joints)?;
         let mut writers = Vec::new();
         for (name, df) in template.named() {
-            writers.push((name, TableWriter::create(dir, name, df)?));
+            let w = TableWriter::create(dir, name, df)?;
+            // The per-clip tables of few rows a clip wait on disk for their row groups.
+            let few_rows = [CLIPS_FILE, CONTACTS_FILE, STANCES_FILE].contains(&name);
+            writers.push((name, if few_rows { w.with_pending_spill() } else { w }));
         }
         Ok(LibrarySink {
             dir: dir.to_path_buf(),
@@ -300,6 +304,7 @@ impl LibrarySink {
         ];
         for (_, w) in std::mem::take(&mut self.writers) {
             w.finish(&kv)?;
+            super::memory::release_free_memory();
         }
         write_atomic(&dir, ERRORS_FILE, &mut errors, &kv)?;
         self.samples.seal()?;
@@ -382,10 +387,10 @@ fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Re
 }
 
 /// The two kinematics tables of the spilled samples with each character's leg length (m),
-/// written into `dir`: per (character, effector) the outlier rules and the polytope
-/// ([`kinematic_polytope`]) on the group's points (held for the group alone: see the
-/// module docs of [`crate::twopac::kinematic`]), then the kept samples streamed from the
-/// spill; a group with fewer than 4 non-coplanar points after the rules has points but no
+/// written into `dir`: per (character, effector) the outlier rules ([`OutlierRule`], three
+/// passes over the spilled group) and one more pass that streams the kept samples to the
+/// table and into the polytope's [`StreamedHull`] (bounded memory: see the module docs of
+/// [`crate::twopac::kinematic`]); a group with fewer than 4 non-coplanar points after the rules has points but no
 /// facets (an error at query time).
 fn kinematics(
     spill: &SampleSpill,
@@ -397,37 +402,35 @@ fn kinematics(
         points_frame(&Default::default(), &[]).map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
     let mut w = TableWriter::create(dir, KINEMATICS_POINTS_FILE, &empty)?;
     let mut facets: Vec<Facet> = Vec::new();
-    for (key, n) in spill.groups() {
-        let mut pts: Vec<[f64; 3]> = Vec::with_capacity(n as usize);
+    for (key, _) in spill.groups() {
+        let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
+        let rule = OutlierRule::fit(leg, |f| {
+            spill.read_group(key, &mut |b| {
+                b.iter().for_each(|s| f(&s.rc));
+                Ok(())
+            })
+        })?;
+        let mut hull = StreamedHull::default();
+        let mut rows = GroupRows {
+            key,
+            rows: Vec::new(),
+            w: &mut w,
+        };
         spill.read_group(key, &mut |b| {
-            pts.extend(b.iter().map(|s| s.rc));
+            for s in b.iter().filter(|s| rule.keeps(&s.rc)) {
+                hull.push(s.rc);
+                rows.add(s)?;
+            }
             Ok(())
         })?;
-        let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
-        let (keep, poly) = kinematic_polytope(pts, leg);
-        if let Some(p) = poly {
+        rows.flush()?;
+        if let Ok(p) = hull.finish(&HullOptions::default()) {
             facets.extend(
                 p.a.iter()
                     .zip(&p.b)
                     .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d)),
             );
         }
-        let mut rows = GroupRows {
-            key,
-            rows: Vec::new(),
-            w: &mut w,
-        };
-        let mut at = 0;
-        spill.read_group(key, &mut |b| {
-            for s in b {
-                if keep[at] {
-                    rows.add(s)?;
-                }
-                at += 1;
-            }
-            Ok(())
-        })?;
-        rows.flush()?;
     }
     w.finish(kv)?;
     let mut facets = facets_table(facets).map_err(|e| pe(KINEMATICS_FILE, e))?;
