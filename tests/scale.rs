@@ -195,6 +195,45 @@ fn a_streaming_build_does_not_depend_on_batch_size_or_threads() {
     }
 }
 
+/// `frames` streams its tables batch by batch (4 clips per thread), writing one batch while
+/// the next is ingested: the files equal one in-memory batch of every clip, byte for byte,
+/// at 1 and 2 threads (batches of 4 and 8 clips), `--joints` included.
+#[test]
+fn a_streamed_frames_run_equals_one_batch_of_every_clip() {
+    use stancelib::ingest::IngestOptions;
+    use stancelib::pipeline::batch::{frames_into, ingest_all};
+    let mut files = fixture_inputs();
+    if let Some(real) = real_subset("a_streamed_frames_run_equals_one_batch", 6) {
+        files.extend(real);
+    }
+    let d = tmp();
+    let opts = IngestOptions {
+        joints: true,
+        ..IngestOptions::default()
+    };
+    let whole = d.path().join("whole");
+    stancelib::library::write::write_all(&whole, &ingest_all(&files, &opts), true).unwrap();
+    let tables = files_of(&whole);
+    assert!(tables.len() >= 4, "{tables:?}");
+    for threads in [1, 2] {
+        let out = d.path().join(format!("t{threads}"));
+        let records = frames_into(&files, &out, &opts, threads).unwrap();
+        assert_eq!(records.len(), files.len());
+        assert!(
+            records.iter().all(|r| r.frames.is_none()),
+            "frames kept in memory"
+        );
+        assert_eq!(files_of(&out), tables, "{threads} threads");
+        for t in &tables {
+            let (a, b) = (
+                std::fs::read(whole.join(t)).unwrap(),
+                std::fs::read(out.join(t)).unwrap(),
+            );
+            assert!(a == b, "{t} differs at {threads} threads");
+        }
+    }
+}
+
 #[test]
 fn row_groups_hold_64_ki_rows_whatever_the_batches() {
     // 150,000 rows pushed in uneven pieces: groups of 65,536, 65,536 and 18,928 rows.

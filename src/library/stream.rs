@@ -236,6 +236,9 @@ impl TableWriter {
         }
         // Free the buffers of the rows just written (the remainder is copied once).
         self.pending.rechunk_mut();
+        if self.spill && self.pending.estimated_size() > PENDING_SPILL_BYTES {
+            self.spill_pending()?;
+        }
         Ok(())
     }
 
@@ -277,7 +280,8 @@ impl TableWriter {
     /// Every pending row, the spilled ones first (their scratch files removed).
     fn take_pending(&mut self) -> Result<DataFrame> {
         let mut all = self.pending.clear();
-        for part in std::mem::take(&mut self.spilled) {
+        // A part stays listed (and is removed on drop) until it has been read.
+        for part in self.spilled.clone() {
             let rows = File::open(&part)
                 .map_err(|e| io(&part, "cannot open scratch file", e))
                 .and_then(|f| {
@@ -292,6 +296,7 @@ impl TableWriter {
             all.vstack_mut(&cols)
                 .map_err(|e| io(&part, "scratch rows of another schema", e))?;
         }
+        self.spilled.clear();
         self.spilled_rows = 0;
         let pending = std::mem::replace(&mut self.pending, DataFrame::empty());
         all.vstack_mut(&pending)

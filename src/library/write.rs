@@ -5,7 +5,7 @@
 //! one shorter: [`super::stream`]), so the files
 //! do not depend on thread count or input order.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
 use rayon::prelude::*;
@@ -413,47 +413,108 @@ fn base64(bytes: &[u8]) -> String {
 /// The tables a `frames` run writes.
 const FRAMES_RUN_FILES: [&str; 4] = [FRAMES_FILE, CLIPS_FILE, CONTACTS_FILE, JOINTS_FILE];
 
-/// Build and write every table of a `frames` run into `dir`: each table replaces only the
-/// file of its own name; nothing else in `dir` is touched, except the temporary tables
-/// (`.<table>.tmp-<pid>`) of killed runs, which are removed.
+/// The tables of a `frames` run, written batch by batch into `dir` ([`TableWriter`]s: the
+/// same bytes as one batch of every clip, when the batches come in clip order). Each table
+/// replaces only the file of its own name at [`FramesWriter::finish`]; nothing else in
+/// `dir` is touched, except the temporary tables (`.<table>.tmp-<pid>`) of killed runs,
+/// which are removed. Dropped unfinished, it leaves the old tables as they were.
+pub struct FramesWriter {
+    dir: PathBuf,
+    writers: Vec<(&'static str, TableWriter)>,
+    joints: bool,
+}
+
+impl FramesWriter {
+    /// Start the tables in `dir` (made if missing), with the joints table when `joints`.
+    ///
+    /// # Errors
+    /// `dir` is not a folder and cannot be made one; a table's temporary file cannot be
+    /// created.
+    pub fn create(dir: &Path, joints: bool) -> Result<FramesWriter> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::io(dir, "cannot create output folder", e))?;
+        remove_stale(dir, &FRAMES_RUN_FILES, Scratch::Tmp);
+        let mut w = FramesWriter {
+            dir: dir.to_path_buf(),
+            writers: Vec::new(),
+            joints,
+        };
+        for (name, empty) in w.tables(&[])? {
+            w.writers
+                .push((name, TableWriter::create(dir, name, &empty)?));
+        }
+        Ok(w)
+    }
+
+    /// The tables of `records`, in [`FRAMES_RUN_FILES`] order (a table that cannot be
+    /// built names its file).
+    fn tables(&self, records: &[ClipRecord]) -> Result<Vec<(&'static str, DataFrame)>> {
+        let err = |name: &str| {
+            let path = self.dir.join(name);
+            move |e| polars_err(&path, e)
+        };
+        let mut tables = vec![
+            (
+                FRAMES_FILE,
+                frames_table(records).map_err(err(FRAMES_FILE))?,
+            ),
+            (CLIPS_FILE, clips_table(records).map_err(err(CLIPS_FILE))?),
+            (
+                CONTACTS_FILE,
+                contacts_table(records).map_err(err(CONTACTS_FILE))?,
+            ),
+        ];
+        if self.joints {
+            tables.push((
+                JOINTS_FILE,
+                joints_table(records).map_err(err(JOINTS_FILE))?,
+            ));
+        }
+        Ok(tables)
+    }
+
+    /// Append the rows of `records` (whole clips, after those of the batches before).
+    ///
+    /// # Errors
+    /// A table cannot be built or written.
+    pub fn push(&mut self, records: &[ClipRecord]) -> Result<()> {
+        let tables = self.tables(records)?;
+        // Side by side on the caller's pool (each table its own file).
+        let pushed: Vec<Result<()>> = tables
+            .into_par_iter()
+            .zip(self.writers.par_iter_mut())
+            .map(|((_, df), (_, w))| w.push(&df))
+            .collect();
+        pushed.into_iter().collect()
+    }
+
+    /// Write the last row groups and footers, and rename every table into place.
+    ///
+    /// # Errors
+    /// As [`TableWriter::finish`]; the first failure in table order is reported.
+    pub fn finish(self) -> Result<()> {
+        let kv = vec![
+            (SCHEMA_VERSION_KEY.to_string(), SCHEMA_VERSION.to_string()),
+            (TOOL_VERSION_KEY.to_string(), TOOL_VERSION.to_string()),
+        ];
+        let finished: Vec<Result<()>> = self
+            .writers
+            .into_par_iter()
+            .map(|(_, w)| w.finish(&kv))
+            .collect();
+        finished.into_iter().collect()
+    }
+}
+
+/// Build and write every table of a `frames` run into `dir` in one batch (see
+/// [`FramesWriter`]).
 ///
 /// # Errors
-/// `dir` is not a folder and cannot be made one; as [`write_atomic`]; a table that cannot
-/// be built names its file.
+/// As [`FramesWriter`].
 pub fn write_all(dir: &Path, records: &[ClipRecord], joints: bool) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create output folder", e))?;
-    remove_stale(dir, &FRAMES_RUN_FILES, Scratch::Tmp);
-    let mut tables = vec![
-        (
-            FRAMES_FILE,
-            frames_table(records).map_err(|e| polars_err(&dir.join(FRAMES_FILE), e))?,
-        ),
-        (
-            CLIPS_FILE,
-            clips_table(records).map_err(|e| polars_err(&dir.join(CLIPS_FILE), e))?,
-        ),
-        (
-            CONTACTS_FILE,
-            contacts_table(records).map_err(|e| polars_err(&dir.join(CONTACTS_FILE), e))?,
-        ),
-    ];
-    if joints {
-        tables.push((
-            JOINTS_FILE,
-            joints_table(records).map_err(|e| polars_err(&dir.join(JOINTS_FILE), e))?,
-        ));
-    }
-    let kv = vec![
-        (SCHEMA_VERSION_KEY.to_string(), SCHEMA_VERSION.to_string()),
-        (TOOL_VERSION_KEY.to_string(), TOOL_VERSION.to_string()),
-    ];
-    // Side by side on the caller's pool (each table its own file); the first failure in
-    // table order is reported.
-    let written: Vec<Result<()>> = tables
-        .par_iter_mut()
-        .map(|(name, df)| write_atomic(dir, name, df, &kv))
-        .collect();
-    written.into_iter().collect()
+    let mut w = FramesWriter::create(dir, joints)?;
+    w.push(records)?;
+    w.finish()
 }
 
 #[cfg(test)]

@@ -9,11 +9,13 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
+use super::build::DEFAULT_BATCH_CLIPS_PER_THREAD;
 use super::inputs::open_input;
 pub use super::inputs::{check_input, discover, none_readable, InputProblem, MAX_BVH_BYTES};
 use super::names::clip_names;
 use crate::error::{Error, ErrorKind, Result};
 use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions};
+use crate::library::write::FramesWriter;
 use crate::library::{ClipRecord, Status};
 
 /// A reader that hashes and counts what passes through it (one pass over a large file).
@@ -150,6 +152,17 @@ pub fn ingest_all(files: &[PathBuf], opts: &IngestOptions) -> Vec<ClipRecord> {
 /// Ingest `(file, clip name)` pairs in parallel; records sorted by clip name.
 pub fn ingest_named(files: &[(PathBuf, String)], opts: &IngestOptions) -> Vec<ClipRecord> {
     let bar = progress(files.len(), "clips ingested");
+    let recs = ingest_counted(files, opts, &bar);
+    bar.finish_and_clear();
+    recs
+}
+
+/// [`ingest_named`], counting the clips on `bar`.
+fn ingest_counted(
+    files: &[(PathBuf, String)],
+    opts: &IngestOptions,
+    bar: &ProgressBar,
+) -> Vec<ClipRecord> {
     let mut recs: Vec<ClipRecord> = files
         .par_iter()
         .map(|(p, n)| {
@@ -158,7 +171,6 @@ pub fn ingest_named(files: &[(PathBuf, String)], opts: &IngestOptions) -> Vec<Cl
             r
         })
         .collect();
-    bar.finish_and_clear();
     recs.sort_by(|a, b| a.clip.cmp(&b.clip));
     recs
 }
@@ -233,9 +245,47 @@ pub fn frames_into(
 ) -> anyhow::Result<Vec<ClipRecord>> {
     use anyhow::Context;
     let pool = worker_pool(files, threads)?;
-    let records = pool.install(|| ingest_all(files, opts));
-    // On the same workers: the tables and their columns are encoded in parallel.
-    pool.install(|| crate::library::write::write_all(out, &records, opts.joints))
-        .with_context(|| format!("writing tables to {}", out.display()))?;
+    pool.install(|| stream_frames(files, out, opts))
+        .with_context(|| format!("writing tables to {}", out.display()))
+}
+
+/// Ingest in batches of clips in name order, writing batch i (table assembly and Parquet
+/// encoding) while batch i + 1 is ingested; a batch's frames are freed once written, so
+/// memory depends on the batch, not on the number of clips. The tables are those of one
+/// batch of every clip, byte for byte ([`FramesWriter`]); batches are as a build's
+/// ([`DEFAULT_BATCH_CLIPS_PER_THREAD`] clips per worker). Records come back without their
+/// frames, contact runs and summaries (those are in the tables).
+fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<Vec<ClipRecord>> {
+    let mut named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
+    named.sort_by(|a, b| a.1.cmp(&b.1));
+    let batch = DEFAULT_BATCH_CLIPS_PER_THREAD * rayon::current_num_threads().max(1);
+    let bar = progress(files.len(), "clips ingested");
+    let mut w = FramesWriter::create(out, opts.joints)?;
+    let mut records: Vec<ClipRecord> = Vec::with_capacity(files.len());
+    let mut write = |recs: Vec<ClipRecord>| -> Result<()> {
+        w.push(&recs)?;
+        records.extend(recs.into_iter().map(|mut r| {
+            r.frames = None;
+            r.contacts = Vec::new();
+            r.summary = ClipSummary::default();
+            r
+        }));
+        super::memory::release_free_memory();
+        Ok(())
+    };
+    let mut pending: Option<Vec<ClipRecord>> = None;
+    for chunk in named.chunks(batch) {
+        let (written, recs) = rayon::join(
+            || pending.take().map_or(Ok(()), &mut write),
+            || ingest_counted(chunk, opts, &bar),
+        );
+        written?;
+        pending = Some(recs);
+    }
+    if let Some(recs) = pending {
+        write(recs)?;
+    }
+    bar.finish_and_clear();
+    w.finish()?;
     Ok(records)
 }

@@ -389,9 +389,9 @@ fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Re
 /// The two kinematics tables of the spilled samples with each character's leg length (m),
 /// written into `dir`: per (character, effector) the outlier rules ([`OutlierRule`], three
 /// passes over the spilled group) and one more pass that streams the kept samples to the
-/// table and into the polytope's [`StreamedHull`] (bounded memory: see the module docs of
-/// [`crate::twopac::kinematic`]); a group with fewer than 4 non-coplanar points after the rules has points but no
-/// facets (an error at query time).
+/// table and into the polytope's [`StreamedHull`] (bounded memory: see the module docs
+/// of [`crate::twopac::kinematic`]); a group with fewer than 4 non-coplanar points after
+/// the rules has points but no facets (an error at query time).
 fn kinematics(
     spill: &SampleSpill,
     legs: &BTreeMap<String, f64>,

@@ -149,10 +149,12 @@ fn triangle_planes(points: &[[f64; 3]]) -> Result<(Vec<[f64; 3]>, Vec<TrianglePl
 }
 
 /// Points deeper than this inside the hull (m) are dropped by [`StreamedHull`]: no such
-/// point is a vertex or the maximiser of a facet's `n·x` (a merged facet's normal is
-/// within the coplanar tolerance, ~1e-7, of its triangles', which moves `n·x` by ≤ 1e-7 m
-/// at the ~1 m of a contact frame), and 1 µm is ten orders of magnitude above the
-/// round-off of a depth.
+/// point is a vertex or the maximiser of a facet's `n·x`. A merged facet's normal is
+/// within twice the coplanar tolerance (2e-7, triangles are grouped against the group's
+/// first normal) of each of its triangles', which moves `n·x` by at most 2e-7 · |x − a|:
+/// under δ for point sets up to 5 m across, and a contact frame's COM samples lie within
+/// 1.3 leg lengths of the contact (the outlier rule). 1 µm is also ten orders of magnitude
+/// above the round-off of a depth.
 pub const KEEP_DEPTH_M: f64 = 1e-6;
 /// Points gathered by [`StreamedHull`] before its running hull is rebuilt and the deep
 /// points dropped.
@@ -175,7 +177,9 @@ pub const STREAM_CHUNK_POINTS: usize = 65_536;
 /// only grows with the body (`depth_H(p) ≥ depth_conv R(p)`), so a point dropped as deeper
 /// than δ in `conv R` is deeper than δ in `H`. The last reduction is over a set holding all
 /// of `H`'s vertices, so it yields `T(A)` itself, a set (sorted, without duplicates) that
-/// does not depend on the chunks; the hull of that set is the output.
+/// does not depend on the chunks; the hull of that set is the output. (Up to round-off: a
+/// point whose depth is within ~1e-16 m of δ may fall on either side of it, depending on
+/// the triangulation it is tested against.)
 ///
 /// Memory: the running set is the points within δ of the surface (a hull's vertices and
 /// points on its facets) plus one chunk, not the stream. A stream that is all coplanar

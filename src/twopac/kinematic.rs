@@ -15,13 +15,14 @@
 //!
 //! # Memory: streamed, a group at a time
 //! A library build keeps the samples on disk and reduces one (character, effector) at a
-//! time in passes over that group's samples, holding bounded state: the count, then the
+//! time in passes over that group's samples, holding little state: the count, then the
 //! centroid (summed in file order, as the in-memory rule), then the `n − k` largest
 //! distances (the P99.5 needs only the order statistics of ranks `k` and `k + 1`, about
 //! 0.5 % of the distances), then the kept points stream into a [`StreamedHull`], which
 //! holds only the points within 1 µm of its surface plus one chunk. The polytope is that
 //! of a canonical point set (sorted, see [`StreamedHull`]), so it is the same bit for bit
-//! whatever the build's batches, the shards of a merge or the order of the samples.
+//! whatever the build's batches or the shards of a merge (the samples come in (clip,
+//! frame) order every time, so the centroid's sum is too).
 //!
 //! # References
 //! spec two-pac §3; com-from-bvh §7.5 (contact frames).
