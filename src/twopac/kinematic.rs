@@ -34,6 +34,7 @@ use std::convert::Infallible;
 use super::hull::{hull_hrep, HullOptions, StreamedHull};
 use super::polytope::Polytope;
 use crate::math::stats::{interpolate_rank, percentile_rank};
+use crate::math::v3::{norm, sub};
 
 /// Distance percentile beyond which points are outliers.
 pub const OUTLIER_PERCENTILE: f64 = 99.5;
@@ -116,14 +117,13 @@ impl OutlierRule {
     /// The point survives: finite, within the P99.5 distance of the centroid and within
     /// the reach of the contact.
     pub fn keeps(&self, p: &[f64; 3]) -> bool {
-        let norm = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        is_finite(p) && distance(p, &self.centroid) <= self.limit_m && norm <= self.reach_m
+        is_finite(p) && distance(p, &self.centroid) <= self.limit_m && norm(*p) <= self.reach_m
     }
 }
 
 /// `|p − c|`, m.
 fn distance(p: &[f64; 3], c: &[f64; 3]) -> f64 {
-    ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt()
+    norm(sub(*p, *c))
 }
 
 /// A point visitor of one pass of [`OutlierRule::fit`].
