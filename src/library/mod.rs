@@ -71,3 +71,14 @@ pub struct ClipRecord {
     /// Contact runs (status `ok` only).
     pub contacts: Vec<ContactRun>,
 }
+
+impl ClipRecord {
+    /// The record without what its tables now hold (frames, contact runs, summary): what
+    /// a streamed run keeps of a written clip (path, name, hash, status, message).
+    pub fn written(mut self) -> ClipRecord {
+        self.frames = None;
+        self.contacts = Vec::new();
+        self.summary = ClipSummary::default();
+        self
+    }
+}

@@ -264,12 +264,7 @@ fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<
     let mut records: Vec<ClipRecord> = Vec::with_capacity(files.len());
     let mut write = |recs: Vec<ClipRecord>| -> Result<()> {
         w.push(&recs)?;
-        records.extend(recs.into_iter().map(|mut r| {
-            r.frames = None;
-            r.contacts = Vec::new();
-            r.summary = ClipSummary::default();
-            r
-        }));
+        records.extend(recs.into_iter().map(ClipRecord::written));
         super::memory::release_free_memory();
         Ok(())
     };

@@ -400,12 +400,7 @@ pub fn build_into(
             summary.stances += report.stances.len();
             summary
                 .records
-                .extend(report.records.into_iter().map(|mut r| {
-                    r.frames = None;
-                    r.contacts = Vec::new();
-                    r.summary = Default::default();
-                    r
-                }));
+                .extend(report.records.into_iter().map(ClipRecord::written));
             if let (Some(prev), Some(last)) = (prev.as_mut(), last) {
                 prev.add_rows(&mut t, last, &reuse)?;
             }
