@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
-use super::build::DEFAULT_BATCH_CLIPS_PER_THREAD;
+use super::build::{DEFAULT_BATCH_BYTES_PER_THREAD, DEFAULT_BATCH_CLIPS_PER_THREAD};
 use super::inputs::open_input;
 pub use super::inputs::{check_input, discover, none_readable, InputProblem, MAX_BVH_BYTES};
 use super::names::clip_names;
@@ -249,16 +249,71 @@ pub fn frames_into(
         .with_context(|| format!("writing tables to {}", out.display()))
 }
 
+/// Where each batch of a list of clips ends (exclusive indices, in order): consecutive
+/// clips, at most `max_clips` of them and at most `max_bytes` of file bytes in all, except
+/// that a clip larger than `max_bytes` is a batch of its own. `sizes` are the clips' file
+/// sizes in bytes. Bounding the bytes as well as the count keeps a batch of the largest
+/// clips of a collection within the memory of a batch of average ones.
+pub fn batch_ends(sizes: &[u64], max_clips: usize, max_bytes: u64) -> Vec<usize> {
+    let max_clips = max_clips.max(1);
+    let mut ends = Vec::new();
+    let (mut n, mut bytes) = (0usize, 0u64);
+    for (i, &size) in sizes.iter().enumerate() {
+        if n > 0 && (n == max_clips || bytes.saturating_add(size) > max_bytes) {
+            ends.push(i);
+            (n, bytes) = (0, 0);
+        }
+        n += 1;
+        bytes = bytes.saturating_add(size);
+    }
+    if n > 0 {
+        ends.push(sizes.len());
+    }
+    ends
+}
+
+/// `named` (clips in order) cut into batches by [`batch_ends`] with the file sizes on disk
+/// (0 for a file that cannot be read: its error is reported when it is ingested).
+pub fn file_batches<T>(
+    named: &[(PathBuf, T)],
+    max_clips: usize,
+    max_bytes: u64,
+) -> Vec<&[(PathBuf, T)]> {
+    let sizes: Vec<u64> = named
+        .iter()
+        .map(|(p, _)| std::fs::metadata(p).map_or(0, |m| m.len()))
+        .collect();
+    let mut start = 0;
+    batch_ends(&sizes, max_clips, max_bytes)
+        .into_iter()
+        .map(|end| {
+            let b = &named[start..end];
+            start = end;
+            b
+        })
+        .collect()
+}
+
+/// The batch bounds of the default plan on the current pool: clips and file bytes per
+/// worker thread ([`DEFAULT_BATCH_CLIPS_PER_THREAD`], [`DEFAULT_BATCH_BYTES_PER_THREAD`]).
+pub fn default_batch_bounds() -> (usize, u64) {
+    let threads = rayon::current_num_threads().max(1);
+    (
+        DEFAULT_BATCH_CLIPS_PER_THREAD * threads,
+        DEFAULT_BATCH_BYTES_PER_THREAD.saturating_mul(threads as u64),
+    )
+}
+
 /// Ingest in batches of clips in name order, writing batch i (table assembly and Parquet
 /// encoding) while batch i + 1 is ingested; a batch's frames are freed once written, so
 /// memory depends on the batch, not on the number of clips. The tables are those of one
 /// batch of every clip, byte for byte ([`FramesWriter`]); batches are as a build's
-/// ([`DEFAULT_BATCH_CLIPS_PER_THREAD`] clips per worker). Records come back without their
+/// ([`default_batch_bounds`]). Records come back without their
 /// frames, contact runs and summaries (those are in the tables).
 fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<Vec<ClipRecord>> {
     let mut named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
     named.sort_by(|a, b| a.1.cmp(&b.1));
-    let batch = DEFAULT_BATCH_CLIPS_PER_THREAD * rayon::current_num_threads().max(1);
+    let (max_clips, max_bytes) = default_batch_bounds();
     let bar = progress(files.len(), "clips ingested");
     let mut w = FramesWriter::create(out, opts.joints)?;
     let mut records: Vec<ClipRecord> = Vec::with_capacity(files.len());
@@ -269,7 +324,7 @@ fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<
         Ok(())
     };
     let mut pending: Option<Vec<ClipRecord>> = None;
-    for chunk in named.chunks(batch) {
+    for chunk in file_batches(&named, max_clips, max_bytes) {
         let (written, recs) = rayon::join(
             || pending.take().map_or(Ok(()), &mut write),
             || ingest_counted(chunk, opts, &bar),
@@ -283,4 +338,43 @@ fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<
     bar.finish_and_clear();
     w.finish()?;
     Ok(records)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::batch_ends;
+    use proptest::prelude::*;
+
+    proptest! {
+        // Every clip in exactly one batch, in order; no batch over either bound unless it
+        // is one clip; and each batch as long as the bounds allow (the next clip would
+        // break one), so the cut is the greedy one.
+        #[test]
+        fn batches_cover_the_clips_within_both_bounds(
+            sizes in proptest::collection::vec(0u64..10_000, 0..200),
+            max_clips in 1usize..12,
+            max_bytes in 1u64..30_000,
+        ) {
+            let ends = batch_ends(&sizes, max_clips, max_bytes);
+            let mut start = 0;
+            for &end in &ends {
+                prop_assert!(end > start);
+                let b = &sizes[start..end];
+                let bytes: u64 = b.iter().sum();
+                prop_assert!(b.len() == 1 || (b.len() <= max_clips && bytes <= max_bytes));
+                if end < sizes.len() {
+                    prop_assert!(b.len() == max_clips || bytes + sizes[end] > max_bytes);
+                }
+                start = end;
+            }
+            prop_assert_eq!(start, sizes.len());
+        }
+    }
+
+    #[test]
+    fn a_clip_larger_than_the_budget_is_a_batch_of_its_own() {
+        assert_eq!(batch_ends(&[1, 50, 1, 1], 8, 10), vec![1, 2, 4]);
+        assert_eq!(batch_ends(&[3, 3, 3, 3, 3], 2, 100), vec![2, 4, 5]);
+        assert!(batch_ends(&[], 4, 10).is_empty());
+    }
 }

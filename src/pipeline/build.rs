@@ -2,8 +2,9 @@
 //! per-character limits and polytopes, and write every table plus `manifest.json` into a
 //! temporary folder that replaces the library folder in one step.
 //!
-//! The build streams: clips are taken in name order in batches of
-//! [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads, and each batch's rows are
+//! The build streams: clips are taken in name order in batches of at most
+//! [`DEFAULT_BATCH_CLIPS_PER_THREAD`] clips and [`DEFAULT_BATCH_BYTES_PER_THREAD`] file
+//! bytes per worker thread (`batch::batch_ends`), and each batch's rows are
 //! appended to the tables (`pipeline::sink`) while the next batch is built (two batches in
 //! memory at most), so memory depends on the largest clips and the thread count, not on
 //! the number of clips. The files are the same, byte for byte, whatever the batch size and
@@ -57,6 +58,12 @@ use crate::stances::{build_clip, Stance, StanceOptions};
 /// Clips per batch and worker thread of a streaming build: a batch holds at most this
 /// many clips per thread in memory (with their frames) before its rows are written.
 pub const DEFAULT_BATCH_CLIPS_PER_THREAD: usize = 4;
+/// File bytes per batch and worker thread, at most (a larger clip is a batch of its own;
+/// `batch::batch_ends`): about four clips of the CMU set's mean size (0.97 MB). Without it a
+/// batch is bounded by its count alone, and the 25× replica, whose batches fall on other
+/// clips than the bulk set's, met a batch of the largest clips (heap peak 74 MB against
+/// 55 MB).
+pub const DEFAULT_BATCH_BYTES_PER_THREAD: u64 = 4 << 20;
 
 /// How a build runs: none of it changes the rows of a clip.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -65,7 +72,8 @@ pub struct BuildPlan {
     pub incremental: bool,
     /// Build only this shard of the inputs (`--shard I/N`).
     pub shard: Option<Shard>,
-    /// Clips per batch; 0 = [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads.
+    /// Most clips per batch; 0 = [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads
+    /// (the bytes per batch are bounded either way: [`DEFAULT_BATCH_BYTES_PER_THREAD`]).
     pub batch_clips: usize,
     /// How the tables are laid out (`--layout`; the rows are the same).
     pub layout: Layout,
@@ -373,8 +381,9 @@ pub fn build_into(
     } else {
         BTreeSet::new()
     };
-    let batch = match plan.batch_clips {
-        0 => DEFAULT_BATCH_CLIPS_PER_THREAD * rayon::current_num_threads().max(1),
+    let (default_clips, max_bytes) = super::batch::default_batch_bounds();
+    let max_clips = match plan.batch_clips {
+        0 => default_clips,
         n => n,
     };
     let bar = Progress::new(named.len() - reuse.len());
@@ -410,7 +419,7 @@ pub fn build_into(
             Ok(())
         };
         let mut pending: Option<(BuildReport, Option<&String>)> = None;
-        for chunk in named.chunks(batch) {
+        for chunk in super::batch::file_batches(&named, max_clips, max_bytes) {
             let todo: Vec<(PathBuf, String)> = chunk
                 .iter()
                 .filter(|(_, c)| !reuse.contains(c))
