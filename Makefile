@@ -46,13 +46,16 @@ fuzz:
 
 ## Criterion benchmarks: parse, FK+COM, ingest (stages); `frames` and `build` of the bulk
 ## set against the parse limit of the same files, 2 and 1 threads (ingest_ratio, prints the
-## ratios); full library build, 10k stances
+## ratios); peak RSS and wall of `build` on the bulk set and a 25× replica of it (scale,
+## issue 16; needs about 25 × the set's size in the temporary folder); full library build,
+## 10k stances
 ## (library); candidate evaluations and the 200 × 200 jump map (queries); 2PAC H-rep,
 ## transition QP and 10-phase trajectory (twopac); 1 s of edited motion at 120 Hz (edit).
 ## They run in the `profiling` profile (release code with line tables, for perf).
 bench:
 	$(CARGO) bench --profile profiling --bench stages
 	$(CARGO) bench --profile profiling --bench ingest_ratio
+	$(CARGO) bench --profile profiling --bench scale
 	$(CARGO) bench --profile profiling --bench library
 	$(CARGO) bench --profile profiling --bench queries
 	$(CARGO) bench --profile profiling --bench twopac

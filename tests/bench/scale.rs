@@ -1,0 +1,161 @@
+//! Peak memory and wall time of `build` against the size of the collection (issue 16).
+//!
+//! Run with `cargo bench --profile profiling --bench scale` (`make bench`). Input: every
+//! `*.bvh` under `$SCALE_DIR`, else `../shared/data/bvh-bulk/cmu` (93 CMU clips); without
+//! either it prints why and exits. The replica is `$SCALE_REPLICAS` (default
+//! [`DEFAULT_REPLICAS`]) copies of those files under new names in a temporary folder, laid
+//! out as `tests/bench/replica.sh` lays them out (`rNN/rNN_<name>.bvh`; copies, not links:
+//! the build reads a file reached twice through links once).
+//!
+//! Each of `$SCALE_ROUNDS` rounds (default [`DEFAULT_ROUNDS`]) runs the `stancelib` binary
+//! as a child, `build DIR --out LIB --threads 2`, on the set and on the replica, one after
+//! the other, and reads each child's peak RSS from the kernel (`wait4`'s `ru_maxrss`). It
+//! prints the medians, the replica's peak over the set's (target ≤ 1.3×, and ≤ 1 GiB) and
+//! its wall time over K × the set's (target within 10 % of linear). Nothing is asserted:
+//! the figures are printed for the record.
+//!
+//! # Results
+//! 2026-12-03, 2-core sandbox, nothing else running, `SCALE_ROUNDS=1`:
+//!
+//! ```text
+//! scale: 93 clips and a 25× replica, build --threads 2, 1 rounds (medians)
+//! set      wall   0.850 s  peak    80.8 MiB
+//! replica  wall  18.477 s  peak   114.4 MiB
+//! replica / set: peak 1.42× (target ≤ 1.3×, ≤ 1024 MiB), wall 0.87× of linear (target ≤ 1.10)
+//! ```
+//! Target missed: the peak ratio (`farm-bench -n 3` on the same commands: 82.0 and
+//! 117.6 MiB, 1.43×).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+/// The bulk set, relative to the crate root.
+const BULK: &str = "../shared/data/bvh-bulk/cmu";
+/// Copies in the replica when `$SCALE_REPLICAS` is not set (issue 16: a 25× replica).
+const DEFAULT_REPLICAS: usize = 25;
+/// Rounds when `$SCALE_ROUNDS` is not set.
+const DEFAULT_ROUNDS: usize = 3;
+/// Target of the replica's peak over the set's (issue 16).
+const TARGET_RATIO: f64 = 1.3;
+
+fn env_usize(name: &str, default: usize) -> usize {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or(default)
+}
+
+fn bvh_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "bvh") {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `k` renamed copies of `files` under `dst` (`rNN/rNN_<name>`).
+fn replica(files: &[PathBuf], dst: &Path, k: usize) -> std::io::Result<()> {
+    for n in 1..=k {
+        let d = dst.join(format!("r{n:02}"));
+        std::fs::create_dir_all(&d)?;
+        for f in files {
+            let name = f.file_name().unwrap_or_default().to_string_lossy();
+            std::fs::copy(f, d.join(format!("r{n:02}_{name}")))?;
+        }
+    }
+    Ok(())
+}
+
+/// Wall time (s) and peak RSS (MiB) of `bin build input --out out --threads 2`.
+#[expect(
+    clippy::zombie_processes,
+    reason = "the child is reaped by wait4, which also gives its own peak RSS"
+)]
+fn build(bin: &str, input: &Path, out: &Path) -> (f64, f64) {
+    let _ = std::fs::remove_dir_all(out);
+    let t0 = Instant::now();
+    let child = Command::new(bin)
+        .args(["--quiet", "build"])
+        .arg(input)
+        .arg("--out")
+        .arg(out)
+        .args(["--threads", "2"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start stancelib");
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
+    // SAFETY: `rusage` is plain data, zero is a valid value, and wait4 only writes it and
+    // `status`; the child is ours and not waited for elsewhere.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let got = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    let wall = t0.elapsed().as_secs_f64();
+    assert!(
+        got == pid && libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
+        "stancelib build {} failed (status {status})",
+        input.display()
+    );
+    (wall, usage.ru_maxrss as f64 / 1024.0)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--list") {
+        return;
+    }
+    let dir = std::env::var("SCALE_DIR").map_or_else(|_| PathBuf::from(BULK), PathBuf::from);
+    let files = bvh_files(&dir);
+    if files.is_empty() {
+        println!(
+            "scale: no *.bvh under {} (set SCALE_DIR): skipped",
+            dir.display()
+        );
+        return;
+    }
+    let (k, rounds) = (
+        env_usize("SCALE_REPLICAS", DEFAULT_REPLICAS),
+        env_usize("SCALE_ROUNDS", DEFAULT_ROUNDS),
+    );
+    let bin = env!("CARGO_BIN_EXE_stancelib");
+    let tmp = tempfile::tempdir().expect("temporary folder");
+    let rep = tmp.path().join("replica");
+    replica(&files, &rep, k).expect("write the replica");
+    let (mut set, mut big) = (Vec::new(), Vec::new());
+    for _ in 0..rounds {
+        set.push(build(bin, &dir, &tmp.path().join("lib_set")));
+        big.push(build(bin, &rep, &tmp.path().join("lib_replica")));
+    }
+    let wall = |v: &[(f64, f64)]| median(v.iter().map(|r| r.0).collect());
+    let peak = |v: &[(f64, f64)]| median(v.iter().map(|r| r.1).collect());
+    let (ws, wr, ps, pr) = (wall(&set), wall(&big), peak(&set), peak(&big));
+    println!(
+        "scale: {} clips and a {k}× replica, build --threads 2, {rounds} rounds (medians)",
+        files.len()
+    );
+    println!("set      wall {ws:7.3} s  peak {ps:7.1} MiB");
+    println!("replica  wall {wr:7.3} s  peak {pr:7.1} MiB");
+    println!(
+        "replica / set: peak {:.2}× (target ≤ {TARGET_RATIO}×, ≤ 1024 MiB), wall {:.2}× of linear (target ≤ 1.10)",
+        pr / ps,
+        wr / (k as f64 * ws)
+    );
+}
