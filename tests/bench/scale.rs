@@ -30,6 +30,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
+use stancelib::pipeline::batch::discover;
+
 /// The bulk set, relative to the crate root.
 const BULK: &str = "../shared/data/bvh-bulk/cmu";
 /// Copies in the replica when `$SCALE_REPLICAS` is not set (issue 16: a 25× replica).
@@ -45,26 +47,6 @@ fn env_usize(name: &str, default: usize) -> usize {
         .and_then(|v| v.parse().ok())
         .filter(|&n| n > 0)
         .unwrap_or(default)
-}
-
-fn bvh_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        let Ok(entries) = std::fs::read_dir(&d) else {
-            continue;
-        };
-        for e in entries.flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "bvh") {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 /// `k` renamed copies of `files` under `dst` (`rNN/rNN_<name>`).
@@ -123,7 +105,8 @@ fn main() {
         return;
     }
     let dir = std::env::var("SCALE_DIR").map_or_else(|_| PathBuf::from(BULK), PathBuf::from);
-    let files = bvh_files(&dir);
+    // The inputs `build` itself would take (`pipeline::batch::discover`).
+    let files = discover(std::slice::from_ref(&dir)).unwrap_or_default();
     if files.is_empty() {
         println!(
             "scale: no *.bvh under {} (set SCALE_DIR): skipped",
