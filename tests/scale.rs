@@ -195,9 +195,9 @@ fn a_streaming_build_does_not_depend_on_batch_size_or_threads() {
     }
 }
 
-/// `frames` streams its tables batch by batch (4 clips per thread), writing one batch while
-/// the next is ingested: the files equal one in-memory batch of every clip, byte for byte,
-/// at 1 and 2 threads (batches of 4 and 8 clips), `--joints` included.
+/// `frames` streams its tables batch by batch (at most 4 clips and 4 MiB of files per
+/// thread), writing one batch while the next is ingested: the files equal one in-memory
+/// batch of every clip, byte for byte, at 1 and 2 threads, `--joints` included.
 #[test]
 fn a_streamed_frames_run_equals_one_batch_of_every_clip() {
     use stancelib::ingest::IngestOptions;

@@ -20,8 +20,8 @@
 //! Each column is copied into one buffer on its own while it is encoded (never the whole
 //! group a second time), and a group whose rows wait in scratch files is read back one
 //! column at a time ([`TableWriter::with_pending_spill`]); a row group's compressed pages
-//! are held until it is written. Replica of the bulk set 25× (2,325 clips), 2 threads:
-//! build peak RSS 170 → 134 MB with these two (`/usr/bin/time`, 2026-12-03).
+//! are held until it is written (the build's peak memory on a 25× replica of the bulk set:
+//! `tests/bench/scale.rs`).
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -128,7 +128,8 @@ fn column_array(column: Column) -> PolarsResult<ArrayRef> {
     let batch = df
         .iter_chunks(CompatLevel::newest(), false)
         .next()
-        .ok_or_else(|| polars_err!(ComputeError: "a column without rows"))?;
+        // `iter_chunks` yields at least one batch, empty for no rows.
+        .ok_or_else(|| polars_err!(ComputeError: "no record batch"))?;
     Ok(batch.columns()[0].clone())
 }
 
@@ -332,9 +333,10 @@ impl TableWriter {
 
     /// Write the first `group_rows` pending rows (all of them if fewer) as one row group,
     /// one column at a time from the scratch files and the rows in memory, and keep the
-    /// rest pending. Only a column of the group is held at a time (per worker), with the
-    /// compressed pages: a group of wide rows loaded whole (the stances of a large build)
-    /// would be tens of MB. The pages are those of [`write_groups`] on the same rows.
+    /// rest pending. Each worker holds one column of the pending rows at a time; the
+    /// compressed pages and the rows left over are kept until the group is written. A
+    /// group of wide rows loaded whole (the stances of a large build) would be tens of MB.
+    /// The pages are those of [`write_groups`] on the same rows.
     fn write_pending_by_column(&mut self, group_rows: usize) -> Result<()> {
         let n = group_rows.min(self.spilled_rows + self.pending.height());
         let fields: Vec<(PlSmallStr, DataType)> = self
@@ -356,18 +358,21 @@ impl TableWriter {
             .collect::<Result<_>>()?;
         let (pages, rest): (Vec<_>, Vec<Column>) = encoded.into_iter().unzip();
         let pages: Vec<Vec<CompressedPage>> = pages.into_iter().flatten().collect();
+        // The rows left over are put together before anything is written, so that a
+        // failure leaves the writer as it was (parts listed, rows pending).
+        let rest = DataFrame::new_infer_height(rest)
+            .map_err(|e| io(&self.path, "rows of another schema", e))?;
         if n > 0 {
             if let Some(w) = self.writer.as_mut() {
                 w.write_row_group(n as u64, &pages)
                     .map_err(|e| io(&self.tmp, "cannot write parquet", e))?;
             }
         }
-        for part in std::mem::take(&mut self.spilled) {
-            let _ = std::fs::remove_file(&part);
-        }
+        self.pending = rest;
         self.spilled_rows = 0;
-        self.pending = DataFrame::new_infer_height(rest)
-            .map_err(|e| io(&self.path, "rows of another schema", e))?;
+        // A part that cannot be removed now stays listed, for `Drop` to try again.
+        self.spilled
+            .retain(|part| std::fs::remove_file(part).is_err());
         Ok(())
     }
 
@@ -552,5 +557,22 @@ mod tests {
         let (pieced, spilled) = write(&pieces);
         assert!(spilled > 0, "no piece waited in a scratch file");
         assert!(pieced == whole, "the bytes differ");
+        // Small pieces that wait in scratch files, then one push of two groups' rows that
+        // meets them, the total ending exactly on a group boundary.
+        let exact = table(3 * ROW_GROUP_ROWS);
+        let (whole, _) = write(std::slice::from_ref(&exact));
+        let small = 40 * 1000;
+        let mut pieces: Vec<DataFrame> = (0..small)
+            .step_by(1000)
+            .map(|at| exact.slice(at as i64, 1000))
+            .collect();
+        pieces.push(exact.slice(small as i64, 2 * ROW_GROUP_ROWS));
+        pieces.push(exact.slice((small + 2 * ROW_GROUP_ROWS) as i64, usize::MAX));
+        let (pieced, spilled) = write(&pieces);
+        assert!(spilled > 0, "no piece waited in a scratch file");
+        assert!(
+            pieced == whole,
+            "the bytes differ (a large push after spilled rows)"
+        );
     }
 }

@@ -251,8 +251,8 @@ pub fn frames_into(
 
 /// Where each batch of a list of clips ends (exclusive indices, in order): consecutive
 /// clips, at most `max_clips` of them and at most `max_bytes` of file bytes in all, except
-/// that a clip larger than `max_bytes` is a batch of its own. `sizes` are the clips' file
-/// sizes in bytes. Bounding the bytes as well as the count keeps a batch of the largest
+/// that a clip larger than `max_bytes` is a batch of its own (`max_clips` 0 counts as 1).
+/// `sizes` are the clips' file sizes in bytes. Bounding the bytes as well as the count keeps a batch of the largest
 /// clips of a collection within the memory of a batch of average ones.
 pub fn batch_ends(sizes: &[u64], max_clips: usize, max_bytes: u64) -> Vec<usize> {
     let max_clips = max_clips.max(1);
@@ -273,7 +273,8 @@ pub fn batch_ends(sizes: &[u64], max_clips: usize, max_bytes: u64) -> Vec<usize>
 }
 
 /// `named` (clips in order) cut into batches by [`batch_ends`] with the file sizes on disk
-/// (0 for a file that cannot be read: its error is reported when it is ingested).
+/// (0 for a file whose size cannot be looked up: its error is reported when it is
+/// ingested).
 pub fn file_batches<T>(
     named: &[(PathBuf, T)],
     max_clips: usize,
@@ -352,8 +353,8 @@ mod tests {
         #[test]
         fn batches_cover_the_clips_within_both_bounds(
             sizes in proptest::collection::vec(0u64..10_000, 0..200),
-            max_clips in 1usize..12,
-            max_bytes in 1u64..30_000,
+            max_clips in 0usize..12,
+            max_bytes in 0u64..30_000,
         ) {
             let ends = batch_ends(&sizes, max_clips, max_bytes);
             let mut start = 0;
@@ -361,9 +362,10 @@ mod tests {
                 prop_assert!(end > start);
                 let b = &sizes[start..end];
                 let bytes: u64 = b.iter().sum();
-                prop_assert!(b.len() == 1 || (b.len() <= max_clips && bytes <= max_bytes));
+                let most = max_clips.max(1);
+                prop_assert!(b.len() == 1 || (b.len() <= most && bytes <= max_bytes));
                 if end < sizes.len() {
-                    prop_assert!(b.len() == max_clips || bytes + sizes[end] > max_bytes);
+                    prop_assert!(b.len() == most || bytes + sizes[end] > max_bytes);
                 }
                 start = end;
             }
@@ -376,5 +378,10 @@ mod tests {
         assert_eq!(batch_ends(&[1, 50, 1, 1], 8, 10), vec![1, 2, 4]);
         assert_eq!(batch_ends(&[3, 3, 3, 3, 3], 2, 100), vec![2, 4, 5]);
         assert!(batch_ends(&[], 4, 10).is_empty());
+        assert_eq!(
+            batch_ends(&[u64::MAX, u64::MAX, 1], 8, u64::MAX - 1),
+            vec![1, 2, 3]
+        );
+        assert_eq!(batch_ends(&[1, 1], 0, 10), vec![1, 2]);
     }
 }

@@ -122,6 +122,19 @@ fn main() {
     let tmp = tempfile::tempdir().expect("temporary folder");
     let rep = tmp.path().join("replica");
     replica(&files, &rep, k).expect("write the replica");
+    // Copies are named by file name: two inputs of one name in different folders would
+    // overwrite each other and make the replica smaller than k × the set.
+    let copies = discover(std::slice::from_ref(&rep))
+        .unwrap_or_default()
+        .len();
+    if copies != k * files.len() {
+        println!(
+            "scale: the replica has {copies} clips, not {k} × {} (inputs with the same file \
+             name in different folders): skipped",
+            files.len()
+        );
+        return;
+    }
     let (mut set, mut big) = (Vec::new(), Vec::new());
     for _ in 0..rounds {
         set.push(build(bin, &dir, &tmp.path().join("lib_set")));
