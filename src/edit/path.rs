@@ -15,10 +15,14 @@
 //! ```
 //! With that request the joint is exact: the flight between two stances is one parabola of
 //! curvature −g, its position and velocity continuous at the apex where the stances meet.
+//! A stance may carry the recording's detail `d(u)` (`edit::detail`): added to `(h, p, v)`
+//! in stance, `d(1)` after liftoff; it is 0 with zero velocity at touchdown and has zero
+//! velocity at liftoff, so the joins above stay exact and the flights ballistic.
 //!
 //! # Frames and units
 //! World: metres, seconds, internal Z-up frame. Stance axes `h, p, v` (index 0, 1, 2).
 
+use super::detail::StanceDetail;
 use crate::force_model::{ForceModel, GRAVITY};
 
 use crate::math::v3::V3;
@@ -54,6 +58,8 @@ pub struct PlannedStance {
     pub origin: [f64; 2],
     /// Unit heading `e_h` in world `(x, y)`.
     pub heading: [f64; 2],
+    /// The recording's detail added to the model's path (`None`: the model's path alone).
+    pub detail: Option<StanceDetail>,
 }
 
 impl PlannedStance {
@@ -74,23 +80,42 @@ impl PlannedStance {
         }
     }
 
+    /// The detail `(d, ḋ)` at local time `s` (m, m/s; zero before touchdown).
+    fn detail_at(&self, s: f64) -> (V3, V3) {
+        match &self.detail {
+            Some(d) if s > self.t_td => {
+                let span = self.t_lo - self.t_td;
+                let u = if span > 0.0 {
+                    (s - self.t_td) / span
+                } else {
+                    1.0
+                };
+                let (p, dp) = d.at(u);
+                let rate = if span > 0.0 { 1.0 / span } else { 0.0 };
+                (p, dp.map(|x| x * rate))
+            }
+            _ => ([0.0; 3], [0.0; 3]),
+        }
+    }
+
     /// COM position and velocity in stance axes `(h, p, v)` at local time `s` (v: height
-    /// above `z_c`).
+    /// above `z_c`), the detail included.
     pub fn local(&self, s: f64) -> (V3, V3) {
         let b = self.beta;
         let (eh, dh) = self.e(0, s);
         let (ep, dp) = self.e(1, s);
         let (ev, dv) = self.e(2, s);
+        let (d, dd) = self.detail_at(s);
         (
             [
-                self.vs * s + b[0] * eh,
-                self.vps * s + b[1] * ep,
-                self.zs - 0.5 * GRAVITY * s * s + b[2] * ev,
+                self.vs * s + b[0] * eh + d[0],
+                self.vps * s + b[1] * ep + d[1],
+                self.zs - 0.5 * GRAVITY * s * s + b[2] * ev + d[2],
             ],
             [
-                self.vs + b[0] * dh,
-                self.vps + b[1] * dp,
-                -GRAVITY * s + b[2] * dv,
+                self.vs + b[0] * dh + dd[0],
+                self.vps + b[1] * dp + dd[1],
+                -GRAVITY * s + b[2] * dv + dd[2],
             ],
         )
     }
@@ -237,6 +262,7 @@ mod tests {
             t0: 0.0,
             origin: [0.0, 0.0],
             heading: [1.0, 0.0],
+            detail: None,
         }
     }
 
@@ -257,6 +283,52 @@ mod tests {
             );
             assert!((v[0] - (3.0 + u)).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn a_detail_keeps_the_joins_smooth_and_the_flight_after_ballistic() {
+        // ρ: 2 cm forward, 1 cm sideways, 1.5 cm up over the stance, with a bump.
+        let u: Vec<f64> = (0..=24).map(|i| i as f64 / 24.0).collect();
+        let rho: Vec<V3> = u
+            .iter()
+            .map(|&x| {
+                let b = (std::f64::consts::PI * x).sin();
+                [0.02 * x + 0.005 * b, 0.01 * x * x, 0.015 * x + 0.004 * b]
+            })
+            .collect();
+        let plain = stance(20.0, 1400.0);
+        let s = PlannedStance {
+            detail: StanceDetail::from_samples(&u, &rho),
+            ..plain.clone()
+        };
+        let end = s.detail.as_ref().unwrap().end_offset();
+        let (h, eps) = (1e-6, 1e-9);
+        for &t in &[s.t_td, s.t_lo] {
+            let ((p0, v0), (p1, v1)) = (s.com(t - eps), s.com(t + eps));
+            for a in 0..3 {
+                // Continuous value and slope: differences of O(eps·|c̈|) only.
+                assert!(
+                    (p1[a] - p0[a]).abs() < 1e-7 && (v1[a] - v0[a]).abs() < 1e-6,
+                    "t = {t}"
+                );
+            }
+        }
+        // Before touchdown the model's path; after liftoff the model's plus d(1), a
+        // constant: same velocity, curvature −g (second difference, roundoff ~1e-4 m/s²).
+        let (pa, va) = (s.com(0.05), plain.com(0.05));
+        assert_eq!(pa, va);
+        for &t in &[0.37, 0.42] {
+            let ((p, v), (q, w)) = (s.com(t), plain.com(t));
+            let off = s.to_world(end);
+            for a in 0..3 {
+                assert!((p[a] - q[a] - off[a]).abs() < 1e-12 && (v[a] - w[a]).abs() < 1e-12);
+            }
+            let z = |t: f64| s.com(t).0[2];
+            let acc = (z(t + h) - 2.0 * z(t) + z(t - h)) / (h * h);
+            assert!((acc + GRAVITY).abs() < 1e-3, "flight curvature {acc}");
+        }
+        // Heights end where the model's do.
+        assert!(end[2].abs() < 1e-15 && (end[0] - 0.02).abs() < 1e-12);
     }
 
     #[test]

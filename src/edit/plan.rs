@@ -5,20 +5,26 @@
 //! ```text
 //! run cycle S1, S2 at k = v / v_orig (the run-at-speed policy: (vs, ve, x)·k, vp kept),
 //! made exactly periodic so N cycles chain: S1 is the policy's own request, and S2 carries
-//! the recorded S2 → S1 mismatch (it runs from S1's end apex back to S1's start apex):
-//!   S1: zs = zs1, vs = k·vs1, ze = ze1, ve = k·ve1, vp1, vps = 0, x = k·x1
-//!   S2: zs = ze1 + z_c1 − z_c2, vs = |(k·ve1, vp1)|, ze = zs1 + z_c1 − z_c2,
+//! the recorded S2 → S1 speed mismatch (it runs from S1's end apex back to S1's start
+//! apex); the recorded cycle's height change is split between its start and its end (the
+//! whole cycle sits δ higher, half of what the recording gains over it):
+//!   δ = (ze2 − (z_c1 − z_c2) − zs1) / 2
+//!   S1: zs = zs1 + δ, vs = k·vs1, ze = ze1 + δ, ve = k·ve1, vp1, vps = 0, x = k·x1
+//!   S2: zs = ze1 + δ + z_c1 − z_c2, vs = |(k·ve1, vp1)|, ze = zs1 + δ + z_c1 − z_c2,
 //!       ve = √((k·vs1)² − vp2²), vp2, vps = 0, x = k·x2
 //!   each solved leaned (`lean`): β_h = k, β_p = 1, the speed change S2's recorded impulse
 //!   does not carry added as a constant friction-ratio offset
 //! jump: the requests of `query::jump` (they chain by construction: ve1 = vs2 = u_apex)
 //! placement: the first stance keeps its recorded heading, and its COM at touchdown is the
 //!   recorded one; every later stance is chained at the apex (`path`)
+//! detail: each stance carries its recording's residual from the model it plays, heights
+//!   ending at 0 and travel offsets balanced over the edit's stances (`detail`)
 //! ```
 //! Each request is solved and checked by the query code (`query::run::scale_and_check`) on
 //! the stance the edit plays (the leaned one for a run, `lean`), against the recorded
 //! stance's limits.
 
+use super::detail::{balance_travel, recorded_residual, StanceDetail};
 use super::path::{ComPath, PlannedStance};
 use super::pose::{Reference, StanceSource};
 use crate::query::feasibility::Limits;
@@ -57,14 +63,20 @@ impl EditStance {
 }
 
 /// The periodic requests of a run cycle at `k` (see the module docs).
+///
+/// The height shift `δ`: `cmu_09_01_run_mb`'s first cycle ends 1.2 cm higher than it
+/// starts; with the whole mismatch at the end (δ = 0) the recorded-speed edit's COM was
+/// 1.7 cm from the recording in the second stance, with `δ` 1.2 cm at most.
 pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
     let (p1, p2) = (&s[0].params, &s[1].params);
-    let dz = s[0].z_c - s[1].z_c;
+    let dz0 = s[0].z_c - s[1].z_c;
+    let shift = 0.5 * (p2.ze - dz0 - p1.zs);
+    let dz = dz0 + shift;
     [
         Request {
-            zs: p1.zs,
+            zs: p1.zs + shift,
             vs: k * p1.vs,
-            ze: p1.ze,
+            ze: p1.ze + shift,
             ve: k * p1.ve,
             vp: p1.vp,
             vps: 0.0,
@@ -154,8 +166,55 @@ pub fn feet_of(label: &str) -> [bool; 2] {
     [feet.contains('L'), feet.contains('R')]
 }
 
+/// The model a stance plays, at β = 1 from its own recorded start apex and times (no
+/// detail): what its recording is compared with.
+fn own_path(e: &EditStance) -> PlannedStance {
+    let (st, p) = (&e.prepared.stance, &e.prepared.stance.params);
+    PlannedStance {
+        source: 0,
+        model: st.model.clone(),
+        beta: [1.0; 3],
+        zs: p.zs,
+        vs: p.vs,
+        vps: p.vps,
+        t_td: p.t_td,
+        t_lo: p.t_lo,
+        t_e: p.t_e,
+        z_c: st.z_c,
+        cp: st.cp,
+        t0: 0.0,
+        origin: [0.0, 0.0],
+        heading: e.timing.heading,
+        detail: None,
+    }
+}
+
+/// The recording's detail of every solved stance (`detail`), travel offsets balanced over
+/// them; `None` for a stance with too few recorded frames.
+pub fn details(stances: &[EditStance], reference: &Reference) -> Vec<Option<StanceDetail>> {
+    let mut out: Vec<Option<StanceDetail>> = stances
+        .iter()
+        .map(|e| {
+            let own = own_path(e);
+            let t = &e.timing;
+            let (u, rho) = recorded_residual(
+                |c| reference.com_at(c),
+                |s| own.local(s).0,
+                t.heading,
+                (t.td_clip_s, t.lo_clip_s),
+                reference.motion.frame_time_s,
+                (own.t_td, own.t_lo),
+            );
+            StanceDetail::from_samples(&u, &rho)
+        })
+        .collect();
+    balance_travel(&mut out);
+    out
+}
+
 /// Places the sequence `order` of solved stances in the world: the first keeps its recorded
-/// heading and touchdown COM (from `reference`), the rest chain at their apexes. With
+/// heading and touchdown COM (from `reference`), the rest chain at their apexes; each
+/// carries its recording's detail ([`details`]). With
 /// `from_touchdown` the path starts at the first touchdown (a jump from rest), else at the
 /// first start apex; with `to_liftoff` it ends at the last liftoff, else at the last apex.
 pub fn place(
@@ -165,6 +224,7 @@ pub fn place(
     from_touchdown: bool,
     to_liftoff: bool,
 ) -> (ComPath, Vec<StanceSource>) {
+    let detail = details(stances, reference);
     let planned_of = |e: &EditStance, source: usize| PlannedStance {
         source,
         model: e.prepared.stance.model.clone(),
@@ -180,6 +240,7 @@ pub fn place(
         t0: 0.0,
         origin: [0.0, 0.0],
         heading: e.timing.heading,
+        detail: detail[source].clone(),
     };
     let mut planned: Vec<PlannedStance> = Vec::with_capacity(order.len());
     for &i in order {

@@ -1,0 +1,346 @@
+//! The recording's COM detail: the part of a source stance's recorded COM path that its
+//! force model does not carry, added back to the planned stance (displacement mapping).
+//!
+//! # Model
+//! ```text
+//! source stance, u = (t − t_TD)/(t_LO − t_TD) ∈ [0, 1], axes (h, p, v) of its heading:
+//!   ρ(u) = [c_rec(u) − c_rec(0)] − [M(u) − M(0)]            recorded minus model displacement
+//!   M: the stance's own force model at β = 1 from its own start apex (zs, vs, vps, t_TD)
+//! ρ through the source frames (natural cubic spline in u), then made to join the plan:
+//!   d(u) = ρ(u) − ρ'(0) a(u) − ρ'(1) b(u) − q c(u)
+//!   a(u) = u (1 − u)²,  b(u) = u² (u − 1),  c(u) = 3u² − 2u³
+//!   ⇒ d(0) = 0, d'(0) = d'(1) = 0, d(1) = ρ(1) − q
+//!   q_v = ρ_v(1)                         heights: the requested apexes are met exactly
+//!   q_h = mean over the edit's stances of ρ_h(1)    travel: the requested distances hold
+//!   q_p = 0                              sideways: the recorded offset is kept (not requested)
+//! planned stance at its own times: c(t) = c_model(t) + d(u(t)) in its axes, and the end
+//!   offset d(1) carried by the flight after it (constant: the flight stays ballistic)
+//! ```
+//! The force model matches a stance's impulses, so the planned edge velocities, flight
+//! times, apex heights and (over the edit) distances are the query's; the detail moves
+//! positions only, inside the stance and by a constant afterwards. A request for the
+//! recorded motion then gives back the recorded stance paths instead of the model's: the
+//! CMU run's model path drifts 2.2 cm sideways and 1.6 cm along the travel from the
+//! recording over one stance, which no soft position target in the fit removed without
+//! spoiling the friction demand against the force plates (`docs/edited-motion.md`).
+//!
+//! # Frames and units
+//! Metres, internal Z-up frame; stance axes `h, p, v` (index 0, 1, 2) of the source
+//! stance's heading for the recording, of the planned stance's heading where it is added.
+//!
+//! # References
+//! Witkin and Popović, *Motion Warping*, SIGGRAPH 1995 (displacement maps added to a
+//! warped motion); Pollard and Behmaram-Mosavat §5 (the full body follows the edited COM).
+
+use crate::math::spline::NaturalSpline;
+use crate::math::v3::V3;
+
+/// Fewest samples of a recorded stance (touchdown, liftoff and one frame between) for a
+/// detail: with fewer the stance keeps the model's path.
+pub const MIN_DETAIL_SAMPLES: usize = 3;
+
+/// Most samples of a recorded stance: a stance longer than this many source frames is
+/// sampled at this many even steps instead of at its frames (bounded work on any input).
+pub const MAX_DETAIL_SAMPLES: usize = 4096;
+
+/// The detail of one stance: the recorded residual `ρ(u)` and the corrections that make
+/// it join the plan (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceDetail {
+    /// `ρ_a(u)` per stance axis.
+    rho: [NaturalSpline; 3],
+    /// `ρ'(0)` per axis (per unit `u`).
+    slope0: V3,
+    /// `ρ'(1)` per axis (per unit `u`).
+    slope1: V3,
+    /// The end offset removed, `q` per axis (m).
+    removed: V3,
+}
+
+/// `(a, b, c)` of the module docs and their derivatives at `u`.
+fn shapes(u: f64) -> ([f64; 3], [f64; 3]) {
+    let w = 1.0 - u;
+    (
+        [u * w * w, u * u * (u - 1.0), u * u * (3.0 - 2.0 * u)],
+        [w * (1.0 - 3.0 * u), u * (3.0 * u - 2.0), 6.0 * u * w],
+    )
+}
+
+impl StanceDetail {
+    /// A detail from samples `ρ(u_i)` (stance axes, m) at strictly increasing `u_i` from
+    /// 0 to 1; `None` with fewer than [`MIN_DETAIL_SAMPLES`], knots not increasing or
+    /// not spanning `[0, 1]`, or a value that is not finite.
+    pub fn from_samples(u: &[f64], rho: &[V3]) -> Option<StanceDetail> {
+        let spans = u.first() == Some(&0.0) && u.last() == Some(&1.0);
+        let finite = rho.iter().flatten().all(|v| v.is_finite());
+        if u.len() < MIN_DETAIL_SAMPLES || u.len() != rho.len() || !spans || !finite {
+            return None;
+        }
+        let axis = |a: usize| {
+            let y: Vec<f64> = rho.iter().map(|r| r[a] - rho[0][a]).collect();
+            NaturalSpline::new(u, &y)
+        };
+        let rho = [axis(0)?, axis(1)?, axis(2)?];
+        let slope0 = std::array::from_fn(|a| rho[a].derivative(0.0));
+        let slope1 = std::array::from_fn(|a| rho[a].derivative(1.0));
+        let mut d = StanceDetail {
+            rho,
+            slope0,
+            slope1,
+            removed: [0.0; 3],
+        };
+        d.removed[2] = d.end_offset()[2];
+        Some(d)
+    }
+
+    /// `d(1)`: the offset the stance ends with (m, stance axes).
+    pub fn end_offset(&self) -> V3 {
+        std::array::from_fn(|a| self.rho[a].eval(1.0) - self.removed[a])
+    }
+
+    /// Removes `q_h` more of the travel offset (the edit's mean, [`balance_travel`]).
+    fn remove_travel(&mut self, q_h: f64) {
+        self.removed[0] += q_h;
+    }
+
+    /// `(d(u), d'(u))` (m, m per unit `u`), `u` clamped to `[0, 1]`; the derivative is 0
+    /// outside.
+    pub fn at(&self, u: f64) -> (V3, V3) {
+        let inside = (0.0..=1.0).contains(&u);
+        let u = u.clamp(0.0, 1.0);
+        let (s, ds) = shapes(u);
+        let mut p = [0.0; 3];
+        let mut dp = [0.0; 3];
+        for a in 0..3 {
+            let r = &self.rho[a];
+            p[a] =
+                r.eval(u) - self.slope0[a] * s[0] - self.slope1[a] * s[1] - self.removed[a] * s[2];
+            dp[a] = r.derivative(u)
+                - self.slope0[a] * ds[0]
+                - self.slope1[a] * ds[1]
+                - self.removed[a] * ds[2];
+        }
+        (p, if inside { dp } else { [0.0; 3] })
+    }
+}
+
+/// Removes the mean travel offset of `details` from each (module docs: `q_h`), so that
+/// their end offsets along the travel sum to 0 and an edit's distances stay the query's.
+pub fn balance_travel(details: &mut [Option<StanceDetail>]) {
+    let ends: Vec<f64> = details
+        .iter()
+        .flatten()
+        .map(|d| d.end_offset()[0])
+        .collect();
+    if ends.is_empty() {
+        return;
+    }
+    let mean = ends.iter().sum::<f64>() / ends.len() as f64;
+    details
+        .iter_mut()
+        .flatten()
+        .for_each(|d| d.remove_travel(mean));
+}
+
+/// The samples `(u_i, ρ(u_i))` of a recorded stance: `u` at touchdown, at every source
+/// frame strictly inside the stance and at liftoff, with the recorded COM `rec(t)` (world,
+/// clip time `t`) and the model's own path `model(s)` (stance axes, time `s` from its start
+/// apex) expressed in the stance axes of `heading`.
+///
+/// `td, lo`: recorded touchdown and liftoff (clip time, s); `frame_time_s`: the source's
+/// frame time; `model_td, model_lo`: the model's touchdown and liftoff (s from its apex).
+/// A stance of no finite positive length gives its two edges only (and no detail).
+pub fn recorded_residual(
+    rec: impl Fn(f64) -> V3,
+    model: impl Fn(f64) -> V3,
+    heading: [f64; 2],
+    (td, lo): (f64, f64),
+    frame_time_s: f64,
+    (model_td, model_lo): (f64, f64),
+) -> (Vec<f64>, Vec<V3>) {
+    let span = lo - td;
+    let mut u = vec![0.0];
+    let frames = span / frame_time_s;
+    let usable = td.is_finite() && span > 0.0 && frame_time_s > 0.0;
+    if usable && frames <= MAX_DETAIL_SAMPLES as f64 {
+        let first = (td / frame_time_s).floor() + 1.0;
+        for i in 0..=frames.ceil() as usize {
+            let x = ((first + i as f64) * frame_time_s - td) / span;
+            // A frame within 1e-6 of an edge is that edge (knots must increase).
+            if x > 1e-6 && x < 1.0 - 1e-6 {
+                u.push(x);
+            }
+        }
+    } else if usable {
+        u.extend((1..MAX_DETAIL_SAMPLES).map(|i| i as f64 / MAX_DETAIL_SAMPLES as f64));
+    }
+    u.push(1.0);
+    let [hx, hy] = heading;
+    let (c0, m0) = (rec(td), model(model_td));
+    let rho = u
+        .iter()
+        .map(|&x| {
+            let c = rec(td + x * span);
+            let m = model(model_td + x * (model_lo - model_td));
+            let (dx, dy) = (c[0] - c0[0], c[1] - c0[1]);
+            let local = [hx * dx + hy * dy, -hy * dx + hx * dy, c[2] - c0[2]];
+            std::array::from_fn(|a| local[a] - (m[a] - m0[a]))
+        })
+        .collect();
+    (u, rho)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth residual with the detail's own edge conditions on every axis but the end
+    /// offsets (0.02, −0.01, 0.015) m.
+    fn wiggle(u: f64) -> V3 {
+        let s = (std::f64::consts::PI * u).sin().powi(2);
+        [
+            0.02 * u * u * (3.0 - 2.0 * u) + 0.01 * s,
+            -0.01 * u * u * (3.0 - 2.0 * u),
+            0.015 * u + 0.005 * s,
+        ]
+    }
+
+    fn sampled(n: usize, f: impl Fn(f64) -> V3) -> StanceDetail {
+        let u: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).collect();
+        let r: Vec<V3> = u.iter().map(|&x| f(x)).collect();
+        StanceDetail::from_samples(&u, &r).unwrap()
+    }
+
+    #[test]
+    fn detail_joins_the_plan_with_zero_offset_and_velocity_at_touchdown() {
+        let d = sampled(30, wiggle);
+        let (p0, v0) = d.at(0.0);
+        let (_, v1) = d.at(1.0);
+        for a in 0..3 {
+            // Closed-form shape functions on spline values: roundoff only.
+            assert!(p0[a].abs() < 1e-15, "d(0) = {p0:?}");
+            assert!(
+                v0[a].abs() < 1e-12 && v1[a].abs() < 1e-12,
+                "d'(0) = {v0:?}, d'(1) = {v1:?}"
+            );
+        }
+        // Heights end where the model ends; the horizontal offsets are kept.
+        let end = d.end_offset();
+        assert!(end[2].abs() < 1e-15);
+        assert!((end[0] - 0.02).abs() < 1e-12 && (end[1] + 0.01).abs() < 1e-12);
+        assert_eq!(d.at(1.0).0, end);
+        assert_eq!(d.at(1.7), (end, [0.0; 3]));
+    }
+
+    #[test]
+    fn a_residual_that_already_joins_is_reproduced() {
+        // ρ with ρ'(0) = ρ'(1) = 0 and ρ_v(1) = 0 needs no correction: d = ρ to the
+        // spline's error. Second derivatives vanish at the ends too (the natural spline's
+        // end conditions): inside, h⁴ max|ρ⁗|/384 ≈ 1e-7 m at 30 knots; the end slopes the
+        // spline estimates are off by O(h³ max|ρ⁗|/24) ≈ 4e-5 per unit u (ρ⁗ ≈ 23 m),
+        // moving d by up to 4/27 of that (max of a(u)): about 3e-6 m near u = 0.4; bound
+        // 1e-5 m, four orders below the centimetre detail it carries.
+        let f = |u: f64| -> V3 {
+            let s = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
+            let b = (std::f64::consts::PI * u).sin().powi(4);
+            [0.02 * s, -0.01 * s + 0.004 * b, 0.006 * b]
+        };
+        let d = sampled(30, f);
+        for i in 0..=100 {
+            let u = i as f64 / 100.0;
+            let (p, _) = d.at(u);
+            let want = f(u);
+            for a in 0..3 {
+                assert!(
+                    (p[a] - want[a]).abs() < 1e-5,
+                    "u = {u}, axis {a}: {} vs {}",
+                    p[a],
+                    want[a]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn velocity_is_the_derivative_of_the_position() {
+        let d = sampled(17, wiggle);
+        let h = 1e-6;
+        for &u in &[0.1, 0.33, 0.5, 0.8, 0.97] {
+            let (p1, _) = d.at(u + h);
+            let (p0, _) = d.at(u - h);
+            let (_, v) = d.at(u);
+            for a in 0..3 {
+                // Central difference of a cubic: O(h²·|d'''|) ≈ 1e-12, plus roundoff 1e-10.
+                assert!(((p1[a] - p0[a]) / (2.0 * h) - v[a]).abs() < 1e-7);
+            }
+        }
+    }
+
+    #[test]
+    fn balanced_travel_offsets_sum_to_zero_and_keep_the_sideways_ones() {
+        let mut ds = vec![
+            Some(sampled(20, wiggle)),
+            Some(sampled(20, |u| wiggle(u).map(|x| -0.5 * x))),
+            None,
+        ];
+        balance_travel(&mut ds);
+        let ends: Vec<V3> = ds.iter().flatten().map(StanceDetail::end_offset).collect();
+        assert!((ends[0][0] + ends[1][0]).abs() < 1e-15);
+        assert!((ends[0][1] + 0.01).abs() < 1e-12 && (ends[1][1] - 0.005).abs() < 1e-12);
+        let (_, v) = ds[0].as_ref().unwrap().at(1.0);
+        assert!(v.iter().all(|x| x.abs() < 1e-12));
+    }
+
+    #[test]
+    fn residual_of_a_recording_that_is_the_model_is_zero() {
+        // The recording is the model's own path, placed and turned in the world: ρ ≡ 0.
+        let model = |s: f64| -> V3 { [3.0 * s + 0.2 * s * s, 0.1 * s * s, 1.0 - 0.5 * s * s] };
+        let heading = [0.6, -0.8];
+        let (td, model_td) = (2.0, 0.05);
+        let rec = |t: f64| -> V3 {
+            let l = model(t - td + model_td);
+            [
+                5.0 + 0.6 * l[0] + 0.8 * l[1],
+                -1.0 - 0.8 * l[0] + 0.6 * l[1],
+                l[2],
+            ]
+        };
+        let (u, rho) = recorded_residual(
+            rec,
+            model,
+            heading,
+            (td, td + 0.25),
+            1.0 / 120.0,
+            (model_td, model_td + 0.25),
+        );
+        assert_eq!(u.first(), Some(&0.0));
+        assert_eq!(u.last(), Some(&1.0));
+        assert!(u.windows(2).all(|w| w[1] > w[0]));
+        assert_eq!(
+            u.len(),
+            31,
+            "29 frames inside a 0.25 s stance at 120 Hz, and the edges"
+        );
+        assert!(rho.iter().flatten().all(|x| x.abs() < 1e-12), "{rho:?}");
+    }
+
+    #[test]
+    fn odd_timings_give_bounded_samples_and_no_detail_when_unusable() {
+        let zero = |_: f64| [0.0; 3];
+        let (u, _) = recorded_residual(zero, zero, [1.0, 0.0], (f64::NAN, 1.0), 0.01, (0.0, 1.0));
+        assert_eq!(u, [0.0, 1.0]);
+        let (u, rho) = recorded_residual(zero, zero, [1.0, 0.0], (0.0, 1e6), 1e-3, (0.0, 1.0));
+        assert_eq!(u.len(), MAX_DETAIL_SAMPLES + 1);
+        assert!(StanceDetail::from_samples(&u, &rho).is_some());
+    }
+
+    #[test]
+    fn too_few_or_bad_samples_give_no_detail() {
+        let r = [[0.0; 3]; 3];
+        assert!(StanceDetail::from_samples(&[0.0, 1.0], &r[..2]).is_none());
+        assert!(StanceDetail::from_samples(&[0.0, 0.5, 0.9], &r).is_none());
+        assert!(StanceDetail::from_samples(&[0.0, 0.6, 0.5, 1.0], &[[0.0; 3]; 4]).is_none());
+        let nan = [[0.0; 3], [f64::NAN, 0.0, 0.0], [0.0; 3]];
+        assert!(StanceDetail::from_samples(&[0.0, 0.5, 1.0], &nan).is_none());
+    }
+}
