@@ -66,7 +66,8 @@ impl EditStance {
 ///
 /// The height shift `δ`: `cmu_09_01_run_mb`'s first cycle ends 1.2 cm higher than it
 /// starts; with the whole mismatch at the end (δ = 0) the recorded-speed edit's COM was
-/// 1.7 cm from the recording in the second stance, with `δ` 1.2 cm at most.
+/// 1.7 cm from the recording in the second stance; with `δ` that distance is 1.2 cm at
+/// most (`docs/edited-motion.md`).
 pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
     let (p1, p2) = (&s[0].params, &s[1].params);
     let dz0 = s[0].z_c - s[1].z_c;
