@@ -307,3 +307,58 @@ pub fn place(
         sources,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::query::testkit::{bell_model, pool_stance};
+    use crate::stances::segment::Boundary;
+    use crate::testkit::Rng;
+
+    /// Two running stances of one cycle, the second on ground `z_c2` and ending at `ze2`.
+    fn cycle(z_c2: f64, ze2: f64) -> [PoolStance; 2] {
+        let mut rng = Rng::new(0x5eed_1406);
+        let b = (Boundary::Flight, Boundary::Flight);
+        let s1 = pool_stance(
+            "c:R:1",
+            bell_model(&mut rng),
+            [3.5, 0.0, -0.6],
+            0.9,
+            b,
+            "R",
+            [0.1, 0.0],
+        );
+        let mut s2 = pool_stance(
+            "c:L:40",
+            bell_model(&mut rng),
+            [3.5, 0.0, -0.6],
+            0.9,
+            b,
+            "L",
+            [0.1, 0.0],
+        );
+        s2.z_c = z_c2;
+        s2.params.ze = ze2;
+        [s1, s2]
+    }
+
+    #[test]
+    fn run_requests_close_the_cycle_and_split_its_recorded_height_change() {
+        for (z_c2, rise) in [(0.0, 0.012), (0.03, -0.02), (-0.01, 0.0)] {
+            let s = cycle(0.0, 0.0);
+            let (p1, z_c1) = (s[0].params, s[0].z_c);
+            // The recorded cycle ends `rise` above its start (world heights).
+            let s = cycle(z_c2, p1.zs + z_c1 + rise - z_c2);
+            for k in [0.8, 1.0, 1.3] {
+                let [r1, r2] = run_requests([&s[0], &s[1]], k);
+                // World heights: S1's end apex is S2's start, S2's end is S1's start.
+                assert!((r1.ze + z_c1 - (r2.zs + z_c2)).abs() < 1e-12);
+                assert!((r2.ze + z_c2 - (r1.zs + z_c1)).abs() < 1e-12);
+                // Half the recorded change on every apex; none for a periodic recording.
+                assert!((r1.zs - p1.zs - 0.5 * rise).abs() < 1e-12, "rise {rise}");
+                assert!((r1.ze - p1.ze - 0.5 * rise).abs() < 1e-12);
+                assert_eq!(r1.vs, k * p1.vs);
+            }
+        }
+    }
+}
