@@ -5,7 +5,7 @@
 
 use super::edit_motion::{
     assert_bounds_except, cycle_of, edit_cycle, first_cycle_against_source, fixture, library,
-    measure,
+    measure, recorded_jump_against_source,
 };
 use super::util::{ok, shared_or_skip};
 
@@ -90,5 +90,43 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
             assert!(rms <= 3.0, "joint-angle RMS {rms}° > 3°");
             assert!(root <= 0.02, "root path {root} m > 0.02 m");
         }
+    }
+}
+
+// See: issue 14 checks — "a request for the recorded speed (or the recorded jump)
+// reproduces the recorded motion: joint-angle RMS ≤ 3° and root path ≤ 2 cm", on the shared
+// real clips. Only the 120 Hz fixture jump was checked until 2026-12-06. Measured then over
+// the whole edit (root path before → after the recording's COM detail, `edit::detail`):
+// cmu_01_01 1.33 → 1.25 cm; cmu_13_32 8.8 → 5.3 cm and cmu_02_04 (a vertical jump with
+// long rest stances) 30 → 30 cm: KNOWN MISSES with ceilings. The jump query plays the
+// recorded jump at β ≠ 1 on these (the perpendicular force dropped, a near-vertical
+// heading force kept), while the detail is measured against the model at β = 1, so the
+// identity edit does not give the recording back (issue 14 stays open).
+#[test]
+fn recorded_real_jumps_against_their_recordings() {
+    let Some(data) = shared_or_skip("recorded_real_jumps_against_their_recordings") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for (clip, ceiling) in [
+        ("cmu_01_01_forward_jumps_mb", 0.02),
+        ("cmu_13_32_forward_jump_daz", 0.07),
+        ("cmu_02_04_vertical_jump_mb", 0.33),
+    ] {
+        let src = data.join(format!("bvh/jump/{clip}.bvh"));
+        let sub = dir.path().join(clip);
+        let lib = library(&sub, std::slice::from_ref(&src));
+        let out = sub.join("jump.bvh");
+        let (rms, root) = recorded_jump_against_source(&lib, &src, &out);
+        eprintln!("{clip}: recorded jump, joint-angle RMS {rms:.3}°, root path {root:.4} m");
+        let status = if ceiling > 0.02 {
+            "KNOWN MISS"
+        } else {
+            "bound"
+        };
+        assert!(
+            root <= ceiling,
+            "{clip}: root path {root} m above its {status} {ceiling} m"
+        );
     }
 }

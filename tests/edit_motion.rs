@@ -368,7 +368,7 @@ fn stance_index(lib: &Path, id: &str) -> usize {
 
 /// Joint-angle RMS (degrees) and largest root distance (m) of the first `span_s` of an
 /// edited clip against the source clip from `src_t0` on (identity requests).
-fn against_source(
+pub(super) fn against_source(
     out: &Path,
     source: &Path,
     unit_m: f64,
@@ -413,7 +413,7 @@ fn against_source(
 }
 
 /// The first planned stance window of an edit (output time).
-fn first_window(out: &Path) -> (f64, f64, String) {
+pub(super) fn first_window(out: &Path) -> (f64, f64, String) {
     let plan = read_plan(out);
     let i = plan.window.iter().position(Option::is_some).unwrap();
     let w = plan.window[i].unwrap();
@@ -736,4 +736,28 @@ pub(super) fn first_cycle_against_source(out: &Path, source: &Path, lib: &Path) 
     let clip = first.split(':').next().unwrap();
     let unit_m = clips[clip].unit_scale.expect("unit scale");
     against_source(out, source, unit_m, 0.0, td_clip - td, end)
+}
+
+/// Joint-angle RMS (degrees) and largest root distance (m) of the edit of a library's
+/// recorded jump (its own height and distance) against its source clip, over the edit.
+pub(super) fn recorded_jump_against_source(lib: &Path, source: &Path, out: &Path) -> (f64, f64) {
+    edit(&[
+        "edit",
+        "jump",
+        "--lib",
+        lib.to_str().unwrap(),
+        "--source",
+        source.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--allow-infeasible",
+    ]);
+    let (td, _, first) = first_window(out);
+    let t = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+    let td_clip = t[stance_index(lib, &first)].td_clip_s;
+    let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
+    let unit_m = clips[first.split(':').next().unwrap()]
+        .unit_scale
+        .expect("unit scale");
+    against_source(out, source, unit_m, 0.0, td_clip - td, 10.0)
 }
