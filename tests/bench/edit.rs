@@ -11,6 +11,7 @@
 //!   (`edit::detail`) and the split cycle height: 3.81 then 3.46 ms, against 3.37 then
 //!   3.57 ms for the code before them (f251a39), runs interleaved at load about 2: no
 //!   difference beyond the machine's noise.
+//!
 //! `cargo bench --profile dev --bench edit -- --warm-up-time 1 --measurement-time 5` (the
 //! test profile, this crate at opt-level 1: the `profiling` release build did not fit the
 //! session, so these are upper bounds of the release figure), shared 2-core x86_64 sandbox:
