@@ -98,10 +98,11 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
 // real clips. Only the 120 Hz fixture jump was checked until 2026-12-06. Measured then over
 // the whole edit (root path before → after the recording's COM detail, `edit::detail`):
 // cmu_01_01 1.33 → 1.25 cm; cmu_13_32 8.8 → 5.3 cm and cmu_02_04 (a vertical jump with
-// long rest stances) 30 → 30 cm: KNOWN MISSES with ceilings. The jump query plays the
-// recorded jump at β ≠ 1 on these (the perpendicular force dropped, a near-vertical
-// heading force kept), while the detail is measured against the model at β = 1, so the
-// identity edit does not give the recording back (issue 14 stays open).
+// long rest stances) 30 → 30 cm: KNOWN MISSES with ceilings. The vertical jump's landing
+// is chained along its apex velocity, about 50° from its recorded heading (0.08 m/s
+// forward, 0.10 m/s of kept sideways drift), and the jumps' recorded distances are the
+// model's, not the measured ones (`docs/edited-motion.md`, "Known miss: the recorded real
+// jumps"; issue 14 stays open).
 #[test]
 fn recorded_real_jumps_against_their_recordings() {
     let Some(data) = shared_or_skip("recorded_real_jumps_against_their_recordings") else {

@@ -8,9 +8,9 @@
 //! # Results
 //! - `cargo bench --bench edit -- --warm-up-time 1 --measurement-time 5` (the `bench`
 //!   profile, release settings), 2026-12-06, with the recording's COM detail
-//!   (`edit::detail`) and the split cycle height: 3.81 then 3.46 ms, against 3.37 then
-//!   3.57 ms for the code before them (f251a39), runs interleaved at load about 2: no
-//!   difference beyond the machine's noise.
+//!   (`edit::detail`) and the split cycle height: 3.94 ms (criterion 3.91–3.96) against
+//!   3.37 ms (3.36–3.38) for the code before them (f251a39), run one after the other at
+//!   load about 1–2: +17 %, still under the 5 ms target.
 //!
 //! `cargo bench --profile dev --bench edit -- --warm-up-time 1 --measurement-time 5` (the
 //! test profile, this crate at opt-level 1: the `profiling` release build did not fit the
