@@ -368,7 +368,7 @@ fn stance_index(lib: &Path, id: &str) -> usize {
 
 /// Joint-angle RMS (degrees) and largest root distance (m) of the first `span_s` of an
 /// edited clip against the source clip from `src_t0` on (identity requests).
-pub(super) fn against_source(
+fn against_source(
     out: &Path,
     source: &Path,
     unit_m: f64,
@@ -413,7 +413,7 @@ pub(super) fn against_source(
 }
 
 /// The first planned stance window of an edit (output time).
-pub(super) fn first_window(out: &Path) -> (f64, f64, String) {
+fn first_window(out: &Path) -> (f64, f64, String) {
     let plan = read_plan(out);
     let i = plan.window.iter().position(Option::is_some).unwrap();
     let w = plan.window[i].unwrap();
@@ -729,13 +729,24 @@ pub(super) fn first_cycle_against_source(out: &Path, source: &Path, lib: &Path) 
     }
     assert!(windows.len() >= 2, "two planned stances: {windows:?}");
     let (td, _, first) = &windows[0];
-    let end = windows[1].1;
+    against_source_from(out, source, lib, (first, *td), windows[1].1)
+}
+
+/// [`against_source`] of an edit whose first planned stance `first` touches down at output
+/// time `td`, aligned with that stance's touchdown in its source clip, over `span_s`.
+fn against_source_from(
+    out: &Path,
+    source: &Path,
+    lib: &Path,
+    (first, td): (&str, f64),
+    span_s: f64,
+) -> (f64, f64) {
     let t = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
     let td_clip = t[stance_index(lib, first)].td_clip_s;
     let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
     let clip = first.split(':').next().unwrap();
     let unit_m = clips[clip].unit_scale.expect("unit scale");
-    against_source(out, source, unit_m, 0.0, td_clip - td, end)
+    against_source(out, source, unit_m, 0.0, td_clip - td, span_s)
 }
 
 /// Joint-angle RMS (degrees) and largest root distance (m) of the edit of a library's
@@ -753,11 +764,5 @@ pub(super) fn recorded_jump_against_source(lib: &Path, source: &Path, out: &Path
         "--allow-infeasible",
     ]);
     let (td, _, first) = first_window(out);
-    let t = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
-    let td_clip = t[stance_index(lib, &first)].td_clip_s;
-    let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
-    let unit_m = clips[first.split(':').next().unwrap()]
-        .unit_scale
-        .expect("unit scale");
-    against_source(out, source, unit_m, 0.0, td_clip - td, 10.0)
+    against_source_from(out, source, lib, (&first, td), 10.0)
 }

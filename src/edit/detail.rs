@@ -26,8 +26,9 @@
 //! (`d'' = 0` there). Inside the stance it implies a force `m·d̈` that the query's exact
 //! check (which judges the scaled model) does not see. A request for the
 //! recorded motion then gives back the recorded stance paths instead of the model's: the
-//! CMU run's model path drifts 2.2 cm sideways and 1.6 cm along the travel from the
-//! recording over one stance, which no soft position target in the fit removed without
+//! CMU run's model path drifts 2.2 cm sideways and 1.2 cm along the travel from the
+//! recording by the end of its first stance's flight (1.6 cm along the travel in the
+//! second stance), which no soft position target in the fit removed without
 //! spoiling the friction demand against the force plates (`docs/edited-motion.md`).
 //!
 //! # Frames and units

@@ -22,8 +22,9 @@
 //!   stance taking all of it.
 //! - Each planned stance carries its recording's COM detail, the part of the recorded path
 //!   its force model does not carry, time-warped ([`detail`]; displacement mapping): it
-//!   starts at 0 with zero velocity, ends with zero velocity, at the model's height, with
-//!   the travel offsets balanced over the edit's stances and the sideways one kept. The
+//!   starts at 0 with zero velocity and acceleration, ends with zero velocity and
+//!   acceleration, at the model's height, with the travel offsets balanced over the
+//!   edit's stances and the sideways one kept. The
 //!   flights stay the query's parabolas, shifted by a constant. With it and the height
 //!   split, a recorded-speed edit of the CMU run follows its recording's root within
 //!   1.6 cm (3.0 cm with the model's path). The force checks judge the scaled model.

@@ -65,9 +65,10 @@ impl EditStance {
 /// The periodic requests of a run cycle at `k` (see the module docs).
 ///
 /// The height shift `δ`: `cmu_09_01_run_mb`'s first cycle ends 1.2 cm higher than it
-/// starts; with the whole mismatch at the end (δ = 0) the recorded-speed edit's COM was
-/// 1.7 cm from the recording in the second stance; with `δ` that distance is 1.2 cm at
-/// most (`docs/edited-motion.md`).
+/// starts; with the whole mismatch at the end (δ = 0) the recorded-speed edit's COM ran
+/// 1.5–1.7 cm below the recording through the second stance. With `δ` and the recording's
+/// detail (`edit::detail`) it is within 1.28 cm of the recording over the first cycle;
+/// `δ` alone takes the largest distance from 2.81 to 2.63 cm (`docs/edited-motion.md`).
 pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
     let (p1, p2) = (&s[0].params, &s[1].params);
     let dz0 = s[0].z_c - s[1].z_c;
