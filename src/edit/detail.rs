@@ -5,7 +5,8 @@
 //! ```text
 //! source stance, u = (t − t_TD)/(t_LO − t_TD) ∈ [0, 1], axes (h, p, v) of its heading:
 //!   ρ(u) = [c_rec(u) − c_rec(0)] − [M(u) − M(0)]            recorded minus model displacement
-//!   M: the stance's own force model at β = 1 from its own start apex (zs, vs, vps, t_TD)
+//!   M: the force model the edit plays, at β = (1, β_p played, 1) from the stance's own
+//!      start apex (zs, vs, vps, t_TD)
 //! ρ through the source frames (natural cubic spline in u: ρ'' = 0 at both ends), then
 //! made to join the plan with quintic shapes whose second derivatives vanish at both ends:
 //!   d(u) = ρ(u) − ρ'(0) a(u) − ρ'(1) b(u) − q c(u)

@@ -173,6 +173,23 @@ impl PlannedStance {
     }
 }
 
+impl PlannedStance {
+    /// Places the next stance of a jump at this one's end apex in this stance's heading:
+    /// its `t0` and origin, and its start `vps` the perpendicular velocity there (the jump
+    /// query shares one apex speed `u_apex` along the liftoff's heading between both
+    /// stances; a start drift it keeps, `vps1` with `β_p1 = 0`, is still there at the
+    /// apex). Returns the heading speed there.
+    pub fn chain_straight(&self, next: &mut PlannedStance) -> f64 {
+        let (c, v) = self.com(self.end());
+        let [hx, hy] = self.heading;
+        next.t0 = self.end();
+        next.origin = [c[0], c[1]];
+        next.heading = self.heading;
+        next.vps = -hy * v[0] + hx * v[1];
+        hx * v[0] + hy * v[1]
+    }
+}
+
 /// Which part of the plan a time falls in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Phase {
@@ -329,6 +346,36 @@ mod tests {
         }
         // Heights end where the model's do.
         assert!(end[2].abs() < 1e-15 && (end[0] - 0.02).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_straight_chain_keeps_the_heading_and_carries_the_sideways_velocity() {
+        // A liftoff that ends its apex with a sideways drift (vp ≠ 0): the next stance
+        // keeps its heading, starts with vs = the heading speed and vps = the drift, and
+        // the plan is continuous in position and velocity at the apex.
+        let mut a = stance(20.0, 1400.0);
+        a.vps = 0.1;
+        let mut b = PlannedStance {
+            heading: [0.0, 1.0],
+            ..stance(-20.0, 1400.0)
+        };
+        let speed = a.chain_straight(&mut b);
+        b.vs = speed;
+        let t = a.end();
+        let (pa, va) = a.com(t);
+        b.zs = pa[2] - b.z_c;
+        let (pb, vb) = b.com(t);
+        assert_eq!(b.heading, a.heading);
+        assert!((b.vps - 0.1).abs() < 1e-12, "vps {}", b.vps);
+        // Horizontal position and velocity, and height (the fixture's end is not a true
+        // apex, so its vertical velocity is not b's 0).
+        for i in 0..2 {
+            assert!(
+                (pa[i] - pb[i]).abs() < 1e-12 && (va[i] - vb[i]).abs() < 1e-12,
+                "axis {i}"
+            );
+        }
+        assert!((pa[2] - pb[2]).abs() < 1e-12);
     }
 
     #[test]

@@ -16,7 +16,9 @@
 //!   does not carry added as a constant friction-ratio offset
 //! jump: the requests of `query::jump` (they chain by construction: ve1 = vs2 = u_apex)
 //! placement: the first stance keeps its recorded heading, and its COM at touchdown is the
-//!   recorded one; every later stance is chained at the apex (`path`)
+//!   recorded one; every later stance is chained at the apex (`path`): a run's along the
+//!   apex velocity, a jump's landing in the liftoff's heading with the apex's sideways
+//!   velocity as its `vps` (the jump query shares one apex speed along that heading)
 //! detail: each stance carries its recording's residual from the model it plays, heights
 //!   ending at 0 and travel offsets balanced over the edit's stances (`detail`)
 //! ```
@@ -168,14 +170,16 @@ pub fn feet_of(label: &str) -> [bool; 2] {
     [feet.contains('L'), feet.contains('R')]
 }
 
-/// The model a stance plays, at β = 1 from its own recorded start apex and times (no
-/// detail): what its recording is compared with.
+/// The model a stance plays, at `β = (1, β_p, 1)` from its own recorded start apex and
+/// times (no detail): what its recording is compared with. `β_p` is the played one: the
+/// perpendicular scale is the query's policy (1 for a run, dropped or drift-cancelling for
+/// a jump's liftoff), not a request, so the recorded request plays it too.
 fn own_path(e: &EditStance) -> PlannedStance {
     let (st, p) = (&e.prepared.stance, &e.prepared.stance.params);
     PlannedStance {
         source: 0,
         model: st.model.clone(),
-        beta: [1.0; 3],
+        beta: [1.0, e.scaled.solution.beta[1], 1.0],
         zs: p.zs,
         vs: p.vs,
         vps: p.vps,
@@ -215,8 +219,9 @@ pub fn details(stances: &[EditStance], reference: &Reference) -> Vec<Option<Stan
 }
 
 /// Places the sequence `order` of solved stances in the world: the first keeps its recorded
-/// heading and touchdown COM (from `reference`), the rest chain at their apexes; each
-/// carries its recording's detail ([`details`]). With
+/// heading and touchdown COM (from `reference`), the rest chain at their apexes (a jump,
+/// `from_touchdown`, by [`PlannedStance::chain_straight`], a run by
+/// [`PlannedStance::chain`]); each carries its recording's detail ([`details`]). With
 /// `from_touchdown` the path starts at the first touchdown (a jump from rest), else at the
 /// first start apex; with `to_liftoff` it ends at the last liftoff, else at the last apex.
 pub fn place(
@@ -256,6 +261,9 @@ pub fn place(
                 if from_touchdown {
                     p.t0 = -p.t_td;
                 }
+            }
+            Some(prev) if from_touchdown => {
+                prev.chain_straight(&mut p);
             }
             Some(prev) => {
                 prev.chain(&mut p);
