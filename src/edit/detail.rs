@@ -162,7 +162,7 @@ pub fn balance_travel(details: &mut [Option<StanceDetail>]) {
 /// The samples `(u_i, ρ(u_i))` of a recorded stance: `u` at touchdown, at every source
 /// frame strictly inside the stance and at liftoff, with the recorded COM `rec(t)` (world,
 /// clip time `t`) and the model's own path `model(s)` (stance axes, time `s` from its start
-/// apex) expressed in the stance axes of `heading`.
+/// apex); `to_stance` turns a world displacement into the source stance's axes.
 ///
 /// `td, lo`: recorded touchdown and liftoff (clip time, s); `frame_time_s`: the source's
 /// frame time; `model_td, model_lo`: the model's touchdown and liftoff (s from its apex).
@@ -170,7 +170,7 @@ pub fn balance_travel(details: &mut [Option<StanceDetail>]) {
 pub fn recorded_residual(
     rec: impl Fn(f64) -> V3,
     model: impl Fn(f64) -> V3,
-    heading: [f64; 2],
+    to_stance: impl Fn(V3) -> V3,
     (td, lo): (f64, f64),
     frame_time_s: f64,
     (model_td, model_lo): (f64, f64),
@@ -192,15 +192,13 @@ pub fn recorded_residual(
         u.extend((1..MAX_DETAIL_SAMPLES).map(|i| i as f64 / MAX_DETAIL_SAMPLES as f64));
     }
     u.push(1.0);
-    let [hx, hy] = heading;
     let (c0, m0) = (rec(td), model(model_td));
     let rho = u
         .iter()
         .map(|&x| {
             let c = rec(td + x * span);
             let m = model(model_td + x * (model_lo - model_td));
-            let (dx, dy) = (c[0] - c0[0], c[1] - c0[1]);
-            let local = [hx * dx + hy * dy, -hy * dx + hx * dy, c[2] - c0[2]];
+            let local = to_stance(std::array::from_fn(|a| c[a] - c0[a]));
             std::array::from_fn(|a| local[a] - (m[a] - m0[a]))
         })
         .collect();
@@ -370,7 +368,8 @@ mod tests {
         // The recording is the model's own path, placed and turned in the world: ρ ≡ 0.
         // The model's stance lasts 0.3 s, the recording's 0.25 s: compared at the same u.
         let model = |s: f64| -> V3 { [3.0 * s + 0.2 * s * s, 0.1 * s * s, 1.0 - 0.5 * s * s] };
-        let heading = [0.6, -0.8];
+        let (hx, hy) = (0.6, -0.8);
+        let to_stance = |w: V3| [hx * w[0] + hy * w[1], -hy * w[0] + hx * w[1], w[2]];
         let (td, model_td) = (2.0, 0.05);
         let rec = |t: f64| -> V3 {
             let l = model(model_td + (t - td) * 0.3 / 0.25);
@@ -383,7 +382,7 @@ mod tests {
         let (u, rho) = recorded_residual(
             rec,
             model,
-            heading,
+            to_stance,
             (td, td + 0.25),
             1.0 / 120.0,
             (model_td, model_td + 0.3),
@@ -402,9 +401,9 @@ mod tests {
     #[test]
     fn odd_timings_give_bounded_samples_and_no_detail_when_unusable() {
         let zero = |_: f64| [0.0; 3];
-        let (u, _) = recorded_residual(zero, zero, [1.0, 0.0], (f64::NAN, 1.0), 0.01, (0.0, 1.0));
+        let (u, _) = recorded_residual(zero, zero, |w: V3| w, (f64::NAN, 1.0), 0.01, (0.0, 1.0));
         assert_eq!(u, [0.0, 1.0]);
-        let (u, rho) = recorded_residual(zero, zero, [1.0, 0.0], (0.0, 1e6), 1e-3, (0.0, 1.0));
+        let (u, rho) = recorded_residual(zero, zero, |w: V3| w, (0.0, 1e6), 1e-3, (0.0, 1.0));
         assert_eq!(u.len(), MAX_DETAIL_SAMPLES + 1);
         assert!(StanceDetail::from_samples(&u, &rho).is_some());
     }

@@ -126,6 +126,12 @@ impl PlannedStance {
         [hx * l[0] - hy * l[1], hy * l[0] + hx * l[1], l[2]]
     }
 
+    /// A world vector in stance axes `(h, p, v)` (the inverse of [`Self::to_world`]).
+    pub fn to_local(&self, w: V3) -> V3 {
+        let [hx, hy] = self.heading;
+        [hx * w[0] + hy * w[1], -hy * w[0] + hx * w[1], w[2]]
+    }
+
     /// World COM position and velocity at world time `t` (m, m/s).
     pub fn com(&self, t: f64) -> (V3, V3) {
         let (p, v) = self.local(t - self.t0);
@@ -160,10 +166,8 @@ impl PlannedStance {
     /// Places the next stance at this one's end apex: its `t0`, origin and heading
     /// (the horizontal velocity there); returns the start speed `|ċ_h|` it must request.
     pub fn chain(&self, next: &mut PlannedStance) -> f64 {
-        let (c, v) = self.com(self.end());
+        let v = self.start_next(next);
         let speed = v[0].hypot(v[1]);
-        next.t0 = self.end();
-        next.origin = [c[0], c[1]];
         next.heading = if speed > 0.0 {
             [v[0] / speed, v[1] / speed]
         } else {
@@ -171,22 +175,26 @@ impl PlannedStance {
         };
         speed
     }
-}
 
-impl PlannedStance {
+    /// Starts `next` at this stance's end apex (its `t0` and horizontal origin); returns the
+    /// world COM velocity there.
+    fn start_next(&self, next: &mut PlannedStance) -> V3 {
+        let (c, v) = self.com(self.end());
+        next.t0 = self.end();
+        next.origin = [c[0], c[1]];
+        v
+    }
+
     /// Places the next stance of a jump at this one's end apex in this stance's heading:
     /// its `t0` and origin, and its start `vps` the perpendicular velocity there (the jump
     /// query shares one apex speed `u_apex` along the liftoff's heading between both
     /// stances; a start drift it keeps, `vps1` with `β_p1 = 0`, is still there at the
     /// apex). Returns the heading speed there.
     pub fn chain_straight(&self, next: &mut PlannedStance) -> f64 {
-        let (c, v) = self.com(self.end());
-        let [hx, hy] = self.heading;
-        next.t0 = self.end();
-        next.origin = [c[0], c[1]];
+        let v = self.to_local(self.start_next(next));
         next.heading = self.heading;
-        next.vps = -hy * v[0] + hx * v[1];
-        hx * v[0] + hy * v[1]
+        next.vps = v[1];
+        v[0]
     }
 }
 

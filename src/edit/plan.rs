@@ -206,7 +206,7 @@ pub fn details(stances: &[EditStance], reference: &Reference) -> Vec<Option<Stan
             let (u, rho) = recorded_residual(
                 |c| reference.com_at(c),
                 |s| own.local(s).0,
-                t.heading,
+                |w| own.to_local(w),
                 (t.td_clip_s, t.lo_clip_s),
                 reference.motion.frame_time_s,
                 (own.t_td, own.t_lo),
@@ -218,19 +218,27 @@ pub fn details(stances: &[EditStance], reference: &Reference) -> Vec<Option<Stan
     out
 }
 
+/// What an edit plays: its path's ends and how its stances chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlanKind {
+    /// Run cycles: apex to apex, each stance chained along the apex velocity
+    /// ([`PlannedStance::chain`]).
+    Run,
+    /// A jump from rest: first touchdown to last liftoff, the landing in the liftoff's
+    /// heading ([`PlannedStance::chain_straight`]).
+    Jump,
+}
+
 /// Places the sequence `order` of solved stances in the world: the first keeps its recorded
-/// heading and touchdown COM (from `reference`), the rest chain at their apexes (a jump,
-/// `from_touchdown`, by [`PlannedStance::chain_straight`], a run by
-/// [`PlannedStance::chain`]); each carries its recording's detail ([`details`]). With
-/// `from_touchdown` the path starts at the first touchdown (a jump from rest), else at the
-/// first start apex; with `to_liftoff` it ends at the last liftoff, else at the last apex.
+/// heading and touchdown COM (from `reference`), the rest chain at their apexes as `kind`
+/// says; each carries its recording's detail ([`details`]).
 pub fn place(
     stances: &[EditStance],
     order: &[usize],
     reference: &Reference,
-    from_touchdown: bool,
-    to_liftoff: bool,
+    kind: PlanKind,
 ) -> (ComPath, Vec<StanceSource>) {
+    let jump = kind == PlanKind::Jump;
     let detail = details(stances, reference);
     let planned_of = |e: &EditStance, source: usize| PlannedStance {
         source,
@@ -258,11 +266,11 @@ pub fn place(
                 let (l, _) = p.local(p.t_td);
                 let w = p.to_world(l);
                 p.origin = [c_td[0] - w[0], c_td[1] - w[1]];
-                if from_touchdown {
+                if jump {
                     p.t0 = -p.t_td;
                 }
             }
-            Some(prev) if from_touchdown => {
+            Some(prev) if jump => {
                 prev.chain_straight(&mut p);
             }
             Some(prev) => {
@@ -272,12 +280,12 @@ pub fn place(
         planned.push(p);
     }
     let (first, last) = (&planned[0], &planned[planned.len() - 1]);
-    let t_start = if from_touchdown {
+    let t_start = if jump {
         first.t0 + first.t_td
     } else {
         first.t0
     };
-    let t_end = if to_liftoff {
+    let t_end = if jump {
         last.t0 + last.t_lo
     } else {
         last.end()

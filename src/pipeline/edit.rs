@@ -10,7 +10,7 @@ use anyhow::Context;
 use super::edit_outputs::{plan_table, plot_of, sidecars, EditOutputs};
 use super::queries::{load_pool, query_kv, write_table, LimitOptions};
 use crate::bvh::{parse_file, write_file, Bvh};
-use crate::edit::plan::{place, EditStance, StanceTiming};
+use crate::edit::plan::{place, EditStance, PlanKind, StanceTiming};
 use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
     choose_jump, choose_run, jump_stances, EditLimits, JumpTarget, RunTarget,
@@ -255,7 +255,8 @@ fn compute(
     let frame_time_s = t.fps.map_or(bvh.motion.frame_time_s, |f| 1.0 / f);
     let reference =
         Reference::new(body, bvh.motion.clone()).with_context(|| format!("clip {clip}"))?;
-    let (path, sources) = place(&stances, &order, &reference, jump, jump);
+    let kind = if jump { PlanKind::Jump } else { PlanKind::Run };
+    let (path, sources) = place(&stances, &order, &reference, kind);
     let edited = pose_motion(
         &reference,
         &path,

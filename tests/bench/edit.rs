@@ -31,7 +31,7 @@ use std::path::Path;
 use criterion::{criterion_group, criterion_main, Criterion};
 use stancelib::bvh::parse_file;
 use stancelib::edit::lean::leaned;
-use stancelib::edit::plan::{place, run_requests, solve_stance};
+use stancelib::edit::plan::{place, run_requests, solve_stance, PlanKind};
 use stancelib::edit::pose::{pose_motion, Reference};
 use stancelib::edit::EditOptions;
 use stancelib::ingest::body::BodyModel;
@@ -107,7 +107,7 @@ fn edit_one_second(c: &mut Criterion) {
     assert_eq!(body.skeleton.n_joints(), 31, "the CMU mb skeleton");
     let reference = Reference::new(body, bvh.motion.clone()).expect("reference");
     let order: Vec<usize> = (0..4).flat_map(|_| [0, 1]).collect();
-    let (mut path, sources) = place(&stances, &order, &reference, false, false);
+    let (mut path, sources) = place(&stances, &order, &reference, PlanKind::Run);
     path.t_end = path.t_start + 1.0;
     let opts = EditOptions::default();
     let mut g = c.benchmark_group("edit");
