@@ -101,9 +101,12 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
 // long rest stances) 30 → 30 cm; then 12.9 cm for the vertical jump with its landing
 // chained in the liftoff's heading (it was chained along its apex velocity, about 50° off:
 // 0.08 m/s forward, 0.10 m/s of kept sideways drift) and the detail measured at the played
-// β_p. KNOWN MISSES with ceilings: the jumps' recorded distances are the model's, not the
-// measured ones (`docs/edited-motion.md`, "Known miss: the recorded real jumps"; issue 14
-// stays open).
+// β_p; then (2026-12-06, second session) 0.96 / 1.42 / 2.36 cm with a jump's outer edges
+// left free (its first touchdown and last liftoff join no planned flight), its travel
+// offsets kept instead of balanced, the landing chained in its own recorded heading (3.5°
+// off the liftoff's on the vertical jump, which turned the whole landing pose) and the edge
+// corrections over at most 0.2 s (`edit::detail::EDGE_WINDOW_S`). KNOWN MISS with a
+// ceiling: the vertical jump's left foot shuffles 15 cm inside its recorded landing stance.
 #[test]
 fn recorded_real_jumps_against_their_recordings() {
     let Some(data) = shared_or_skip("recorded_real_jumps_against_their_recordings") else {
@@ -112,8 +115,8 @@ fn recorded_real_jumps_against_their_recordings() {
     let dir = tempfile::tempdir().unwrap();
     for (clip, ceiling) in [
         ("cmu_01_01_forward_jumps_mb", 0.02),
-        ("cmu_13_32_forward_jump_daz", 0.07),
-        ("cmu_02_04_vertical_jump_mb", 0.14),
+        ("cmu_13_32_forward_jump_daz", 0.02),
+        ("cmu_02_04_vertical_jump_mb", 0.025),
     ] {
         let src = data.join(format!("bvh/jump/{clip}.bvh"));
         let sub = dir.path().join(clip);

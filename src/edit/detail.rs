@@ -9,15 +9,21 @@
 //!      start apex (zs, vs, vps, t_TD)
 //! ρ through the source frames (natural cubic spline in u: ρ'' = 0 at both ends), then
 //! made to join the plan with quintic shapes whose second derivatives vanish at both ends:
-//!   d(u) = ρ(u) − ρ'(0) a(u) − ρ'(1) b(u) − q c(u)
+//!   d(u) = ρ(u) − ρ'(0) a_w(u) − ρ'(1) b_w(u) − q c(u)
 //!   a(u) = u − 6u³ + 8u⁴ − 3u⁵,  b(u) = −4u³ + 7u⁴ − 3u⁵,  c(u) = 10u³ − 15u⁴ + 6u⁵
-//!   ⇒ d(0) = 0, d'(0) = d'(1) = 0, d''(0) = d''(1) = 0, d(1) = ρ(1) − q
+//!   a_w(u) = w·a(u/w) for u < w,  b_w(u) = w·b((u − 1 + w)/w) for u > 1 − w, else 0
+//!   w = min(1, W/Δt), W = EDGE_WINDOW_S: each edge's slope correction acts over at most
+//!     the stance's first or last 0.2 s (the whole of a running stance)
+//!   ⇒ d(0) = 0, d'(0) = d'(1) = 0, d''(0) = d''(1) = 0, d(1) = ρ(1) − q, C² everywhere
 //!   q_v = ρ_v(1)                         heights: the requested apexes are met exactly
-//!   q_h = mean over the edit's stances of ρ_h(1)    travel: the offsets along each
-//!                                        stance's heading sum to 0 (a run's mean speed
-//!                                        and a jump's whole distance hold; each stance's
-//!                                        own x moves by d_h(1))
+//!   q_h = mean over a run's stances of ρ_h(1)    travel: the offsets along each
+//!                                        stance's heading sum to 0 (the cycle's mean
+//!                                        speed holds; each stance's own x moves by d_h(1))
 //!   q_p = 0                              sideways: the recorded offset is kept (not requested)
+//! a jump (from rest, to rest): its first touchdown and its last liftoff join no planned
+//!   flight, so no correction there (ρ'(0) of the liftoff and ρ'(1), q of the landing
+//!   are kept), and q_h = 0: the recorded offsets from the model are kept, as the
+//!   recording has them (the library's jump distance is its model's, `x_m`)
 //! planned stance at its own times: c(t) = c_model(t) + d(u(t)) in its axes, and the end
 //!   offset d(1) carried by the flight after it (constant: the flight stays ballistic)
 //! ```
@@ -63,6 +69,33 @@ pub struct StanceDetail {
     slope1: V3,
     /// The end offset removed, `q` per axis (m).
     removed: V3,
+    /// The share `w ∈ (0, 1]` of the stance over which each edge's slope correction acts
+    /// (module docs: `a_w`, `b_w`).
+    window: f64,
+}
+
+/// How long each edge's slope correction acts at most, s: over `w = min(1, W/Δt_stance)` of
+/// the stance (module docs). A running stance (0.15–0.27 s on the CMU run) is corrected
+/// over nearly its whole length; the 0.9 s push of the real vertical jump only over its
+/// last 0.2 s, so the recorded shape survives before it. That push's recorded COM leaves
+/// 0.23 m/s faster along the heading than its flight goes on, a slope the plan must not
+/// carry into the flight; spread over the whole push it moved the edit's root up to
+/// 6.3 cm from the recording, over its last 0.5 / 0.3 / 0.2 s 3.8 / 2.5 / 2.4 cm (the CMU
+/// run: 1.61 cm at 0.3 s and more, 1.60 at 0.2 s, 1.85 at 0.1 s; `docs/edited-motion.md`).
+pub const EDGE_WINDOW_S: f64 = 0.2;
+
+/// `(a_w, b_w, c)` of the module docs and their derivatives at `u`: the edge shapes act
+/// over the first and the last share `w` of the stance (zero beyond, C² where they stop).
+fn windowed_shapes(u: f64, w: f64) -> ([f64; 3], [f64; 3]) {
+    let (full, dfull) = shapes(u);
+    let (mut s, mut ds) = (full, dfull);
+    if w < 1.0 {
+        let (a, da) = shapes((u / w).min(1.0));
+        let (b, db) = shapes(((u - 1.0 + w) / w).max(0.0));
+        (s[0], ds[0]) = (w * a[0], da[0]);
+        (s[1], ds[1]) = (w * b[1], db[1]);
+    }
+    (s, ds)
 }
 
 /// `(a, b, c)` of the module docs and their derivatives at `u`.
@@ -105,9 +138,30 @@ impl StanceDetail {
             slope0,
             slope1,
             removed: [0.0; 3],
+            window: 1.0,
         };
         d.removed[2] = d.end_offset()[2];
         Some(d)
+    }
+
+    /// The same detail joined to the plan as `join` says (module docs): a free edge keeps
+    /// the recording's slope there (and, at the end, its height offset); the edge slope
+    /// corrections act over the share `window` of the stance (clamped to `(0, 1]`; 1 when
+    /// not finite).
+    pub fn joined(mut self, join: Join) -> StanceDetail {
+        if !join.start {
+            self.slope0 = [0.0; 3];
+        }
+        if !join.end {
+            self.slope1 = [0.0; 3];
+            self.removed = [0.0; 3];
+        }
+        self.window = if join.window.is_finite() && join.window > 0.0 {
+            join.window.min(1.0)
+        } else {
+            1.0
+        };
+        self
     }
 
     /// `d(1)`: the offset the stance ends with (m, stance axes).
@@ -125,7 +179,7 @@ impl StanceDetail {
     pub fn at(&self, u: f64) -> (V3, V3) {
         let inside = (0.0..=1.0).contains(&u);
         let u = u.clamp(0.0, 1.0);
-        let (s, ds) = shapes(u);
+        let (s, ds) = windowed_shapes(u, self.window);
         let mut p = [0.0; 3];
         let mut dp = [0.0; 3];
         for a in 0..3 {
@@ -138,6 +192,31 @@ impl StanceDetail {
                 - self.removed[a] * ds[2];
         }
         (p, if inside { dp } else { [0.0; 3] })
+    }
+}
+
+/// How a stance's detail meets the plan at its edges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Join {
+    /// Touchdown follows a planned flight: the detail starts with zero slope.
+    pub start: bool,
+    /// Liftoff starts a planned flight: the detail ends with zero slope and its height
+    /// offset removed.
+    pub end: bool,
+    /// The share of the stance the edge corrections act over, `min(1, W/Δt)`
+    /// ([`EDGE_WINDOW_S`]).
+    pub window: f64,
+}
+
+impl Join {
+    /// Both edges joined, the corrections over at most [`EDGE_WINDOW_S`] of a stance of
+    /// `span_s` seconds.
+    pub fn both(span_s: f64) -> Join {
+        Join {
+            start: true,
+            end: true,
+            window: EDGE_WINDOW_S / span_s,
+        }
     }
 }
 
@@ -346,6 +425,64 @@ mod tests {
                 assert!(((p1[a] - p0[a]) / (2.0 * h) - v[a]).abs() < 1e-7);
             }
         }
+    }
+
+    #[test]
+    fn windowed_corrections_act_only_near_the_edges_and_keep_the_joins() {
+        let join = |start, end, window| Join { start, end, window };
+        let free = sampled(40, wiggle).joined(join(false, false, 1.0));
+        let w = 0.25;
+        let d = sampled(40, wiggle).joined(join(true, true, w));
+        let (p0, v0) = d.at(0.0);
+        let (_, v1) = d.at(1.0);
+        assert!(p0.iter().chain(&v0).chain(&v1).all(|x| x.abs() < 1e-12));
+        // Between the windows only the height offset's removal is left: q_v c(u).
+        let q = free.end_offset()[2];
+        for u in [0.25, 0.4, 0.6, 0.75] {
+            let (p, pf) = (d.at(u).0, free.at(u).0);
+            let c = shapes(u).0[2];
+            assert!((p[0] - pf[0]).abs() < 1e-15 && (p[1] - pf[1]).abs() < 1e-15);
+            assert!((p[2] - (pf[2] - q * c)).abs() < 1e-15, "u = {u}");
+        }
+        // C² where each window stops: the slope's one-sided rates of change agree
+        // (step 1e-5: error ~1e-5 of the quintic's third derivative over w², about 1e-3).
+        let h = 1e-5;
+        for edge in [w, 1.0 - w] {
+            let rate = |a: f64, b: f64| -> V3 {
+                let (va, vb) = (d.at(a).1, d.at(b).1);
+                std::array::from_fn(|i| (vb[i] - va[i]) / (b - a))
+            };
+            let (left, right) = (
+                rate(edge - 2.0 * h, edge - h),
+                rate(edge + h, edge + 2.0 * h),
+            );
+            for i in 0..3 {
+                assert!(
+                    (left[i] - right[i]).abs() < 1e-2,
+                    "d'' at {edge}: {left:?} {right:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn free_edges_keep_the_recorded_slopes_and_offsets() {
+        // A jump's first touchdown and last liftoff: d = ρ, its end height offset included.
+        let d = sampled(20, wiggle).joined(Join {
+            start: false,
+            end: false,
+            window: 1.0,
+        });
+        for i in 0..=20 {
+            let u = i as f64 / 20.0;
+            let (p, want) = (d.at(u).0, wiggle(u));
+            assert!((0..3).all(|a| (p[a] - want[a]).abs() < 1e-15), "u = {u}");
+        }
+        assert!((d.end_offset()[2] - 0.015).abs() < 1e-15);
+        // ρ'_v(0) = 0.015 per unit u; the natural spline's end condition (ρ'' = 0 where the
+        // wiggle's is 0.1) moves its estimate by about h·ρ''/3 ≈ 1.6e-3.
+        let slope = d.at(0.0).1[2];
+        assert!((slope - 0.015).abs() < 2.5e-3, "ρ'(0) kept: {slope}");
     }
 
     #[test]

@@ -185,16 +185,18 @@ impl PlannedStance {
         v
     }
 
-    /// Places the next stance of a jump at this one's end apex in this stance's heading:
-    /// its `t0` and origin, and its start `vps` the perpendicular velocity there (the jump
-    /// query shares one apex speed `u_apex` along the liftoff's heading between both
-    /// stances; a start drift it keeps, `vps1` with `β_p1 = 0`, is still there at the
-    /// apex). Returns the heading speed there.
-    pub fn chain_straight(&self, next: &mut PlannedStance) -> f64 {
-        let v = self.to_local(self.start_next(next));
-        next.heading = self.heading;
+    /// Places the next stance of a jump at this one's end apex in its own heading (the
+    /// landing keeps the heading it was recorded with, as the liftoff does, so the body
+    /// turns between them as it did in the recording): its `t0` and origin, and its start
+    /// velocities `(vs, vps)` the flight's velocity there in its axes, so the join is C¹.
+    /// The jump query shares one apex speed `u_apex` along the liftoff's heading; a
+    /// landing recorded a few degrees off that heading starts with those components of it
+    /// (and of a start drift the liftoff keeps, `vps1` with `β_p1 = 0`).
+    pub fn chain_in_own_heading(&self, next: &mut PlannedStance) {
+        let w = self.start_next(next);
+        let v = next.to_local(w);
+        next.vs = v[0];
         next.vps = v[1];
-        v[0]
     }
 }
 
@@ -357,24 +359,26 @@ mod tests {
     }
 
     #[test]
-    fn a_straight_chain_keeps_the_heading_and_carries_the_sideways_velocity() {
-        // A liftoff that ends its apex with a sideways drift (vp ≠ 0): the next stance
-        // keeps its heading, starts with vs = the heading speed and vps = the drift, and
-        // the plan is continuous in position and velocity at the apex.
+    fn a_jump_chain_keeps_the_next_heading_and_carries_the_flight_velocity() {
+        // A liftoff that ends its apex with a sideways drift (vp ≠ 0), a landing recorded
+        // 90° off its heading: the landing keeps its heading, starts with the flight's
+        // velocity in its axes, and the plan is continuous in position and velocity at
+        // the apex.
         let mut a = stance(20.0, 1400.0);
         a.vps = 0.1;
         let mut b = PlannedStance {
             heading: [0.0, 1.0],
             ..stance(-20.0, 1400.0)
         };
-        let speed = a.chain_straight(&mut b);
-        b.vs = speed;
+        a.chain_in_own_heading(&mut b);
         let t = a.end();
         let (pa, va) = a.com(t);
         b.zs = pa[2] - b.z_c;
         let (pb, vb) = b.com(t);
-        assert_eq!(b.heading, a.heading);
-        assert!((b.vps - 0.1).abs() < 1e-12, "vps {}", b.vps);
+        assert_eq!(b.heading, [0.0, 1.0]);
+        // a's heading is +x: its end velocity (vx, 0.1) is (0.1, −vx) in b's axes.
+        assert!((b.vs - 0.1).abs() < 1e-12, "vs {}", b.vs);
+        assert!((b.vps + va[0]).abs() < 1e-12, "vps {}", b.vps);
         // Horizontal position and velocity, and height (the fixture's end is not a true
         // apex, so its vertical velocity is not b's 0).
         for i in 0..2 {

@@ -26,7 +26,7 @@
 //! the stance the edit plays (the leaned one for a run, `lean`), against the recorded
 //! stance's limits.
 
-use super::detail::{balance_travel, recorded_residual, StanceDetail};
+use super::detail::{balance_travel, recorded_residual, Join, StanceDetail};
 use super::path::{ComPath, PlannedStance};
 use super::pose::{Reference, StanceSource};
 use crate::query::feasibility::Limits;
@@ -195,12 +195,27 @@ fn own_path(e: &EditStance) -> PlannedStance {
     }
 }
 
-/// The recording's detail of every solved stance (`detail`), travel offsets balanced over
-/// them; `None` for a stance with too few recorded frames.
-pub fn details(stances: &[EditStance], reference: &Reference) -> Vec<Option<StanceDetail>> {
+/// The recording's detail of every solved stance (`detail`), joined to the plan as `kind`
+/// plays them in `order`; `None` for a stance with too few recorded frames.
+///
+/// A run's stances join flights at both edges and their travel offsets are balanced over
+/// them (the cycle's mean speed holds). A jump starts at its first touchdown and ends at
+/// its last liftoff: those two edges join no flight and keep the recording's slopes (and
+/// the last its offsets), and the travel offsets are kept, so the recorded jump edits back
+/// to its recording (the library's distance is the model's; the edit travels it plus the
+/// recording's offsets from its model, as the recording does).
+pub fn details(
+    stances: &[EditStance],
+    order: &[usize],
+    reference: &Reference,
+    kind: PlanKind,
+) -> Vec<Option<StanceDetail>> {
+    let jump = kind == PlanKind::Jump;
+    let (first, last) = (order.first().copied(), order.last().copied());
     let mut out: Vec<Option<StanceDetail>> = stances
         .iter()
-        .map(|e| {
+        .enumerate()
+        .map(|(i, e)| {
             let own = own_path(e);
             let t = &e.timing;
             let (u, rho) = recorded_residual(
@@ -211,10 +226,16 @@ pub fn details(stances: &[EditStance], reference: &Reference) -> Vec<Option<Stan
                 reference.motion.frame_time_s,
                 (own.t_td, own.t_lo),
             );
-            StanceDetail::from_samples(&u, &rho)
+            let sol = &e.scaled.solution;
+            let mut join = Join::both(sol.t_lo - sol.t_td);
+            join.start = !(jump && first == Some(i));
+            join.end = !(jump && last == Some(i));
+            StanceDetail::from_samples(&u, &rho).map(|d| d.joined(join))
         })
         .collect();
-    balance_travel(&mut out);
+    if !jump {
+        balance_travel(&mut out);
+    }
     out
 }
 
@@ -225,7 +246,7 @@ pub enum PlanKind {
     /// ([`PlannedStance::chain`]).
     Run,
     /// A jump from rest: first touchdown to last liftoff, the landing in the liftoff's
-    /// heading ([`PlannedStance::chain_straight`]).
+    /// heading ([`PlannedStance::chain_in_own_heading`]).
     Jump,
 }
 
@@ -239,7 +260,7 @@ pub fn place(
     kind: PlanKind,
 ) -> (ComPath, Vec<StanceSource>) {
     let jump = kind == PlanKind::Jump;
-    let detail = details(stances, reference);
+    let detail = details(stances, order, reference, kind);
     let planned_of = |e: &EditStance, source: usize| PlannedStance {
         source,
         model: e.prepared.stance.model.clone(),
@@ -271,7 +292,7 @@ pub fn place(
                 }
             }
             Some(prev) if jump => {
-                prev.chain_straight(&mut p);
+                prev.chain_in_own_heading(&mut p);
             }
             Some(prev) => {
                 prev.chain(&mut p);
