@@ -105,18 +105,19 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
 // left free (its first touchdown and last liftoff join no planned flight), its travel
 // offsets kept instead of balanced, the landing chained in its own recorded heading (3.5°
 // off the liftoff's on the vertical jump, which turned the whole landing pose) and the edge
-// corrections over at most 0.2 s (`edit::detail::EDGE_WINDOW_S`). KNOWN MISS with a
-// ceiling: the vertical jump's left foot shuffles 15 cm inside its recorded landing stance.
+// corrections over at most 0.2 s (`edit::detail::EDGE_WINDOW_S`); the vertical jump's
+// 2.36 cm was its left foot shuffling 15 cm inside its recorded landing stance, held in
+// place as a slide: kept as a step (`edit::FOOT_STEP_M`), 1.97 cm and 2.1°.
 #[test]
 fn recorded_real_jumps_against_their_recordings() {
     let Some(data) = shared_or_skip("recorded_real_jumps_against_their_recordings") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    for (clip, ceiling) in [
-        ("cmu_01_01_forward_jumps_mb", 0.02),
-        ("cmu_13_32_forward_jump_daz", 0.02),
-        ("cmu_02_04_vertical_jump_mb", 0.025),
+    for clip in [
+        "cmu_01_01_forward_jumps_mb",
+        "cmu_13_32_forward_jump_daz",
+        "cmu_02_04_vertical_jump_mb",
     ] {
         let src = data.join(format!("bvh/jump/{clip}.bvh"));
         let sub = dir.path().join(clip);
@@ -124,14 +125,7 @@ fn recorded_real_jumps_against_their_recordings() {
         let out = sub.join("jump.bvh");
         let (rms, root) = recorded_jump_against_source(&lib, &src, &out);
         eprintln!("{clip}: recorded jump, joint-angle RMS {rms:.3}°, root path {root:.4} m");
-        let status = if ceiling > 0.02 {
-            "KNOWN MISS"
-        } else {
-            "bound"
-        };
-        assert!(
-            root <= ceiling,
-            "{clip}: root path {root} m above its {status} {ceiling} m"
-        );
+        assert!(rms <= 3.0, "{clip}: joint-angle RMS {rms}° > 3°");
+        assert!(root <= 0.02, "{clip}: root path {root} m > 0.02 m");
     }
 }

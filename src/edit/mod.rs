@@ -39,7 +39,8 @@
 //!   the ankle or toe tip rests (within [`FOOT_REST_BAND_M`] of its lowest height in the
 //!   stance), its horizontal motion is removed from the planted foot, so the heel holds
 //!   while the foot lands and the toe tip while it rolls off (the CMU run's markers slid
-//!   1–2.6 cm while resting; the edits slid 17 mm with them).
+//!   1–2.6 cm while resting; the edits slid 17 mm with them). A point that leaves the
+//!   band and rests again more than [`FOOT_STEP_M`] away has stepped: that move is kept.
 //! - A foot whose ankle is beyond the leg's reach turns about its toe tip (heel up, at most
 //!   [`DEFAULT_MAX_TOE_PIVOT_DEG`]) instead of leaving the floor: a jump higher than
 //!   recorded plans the COM farther from the contact point than the recorded push reaches
@@ -122,6 +123,14 @@ pub const DEFAULT_POSTURE_RAMP_S: f64 = 0.1;
 /// output frames fall between source frames, and a toe that rests twice (flat, then again
 /// at toe-off, as the CMU run's does) must be held across the rise between.
 pub const FOOT_REST_BAND_M: f64 = 0.01;
+/// A planted foot point that leaves its resting band and comes back to it farther than
+/// this (horizontally, m) has stepped inside its stance: the move is the recording's, not
+/// the capture's slide, and is kept (`pose::Reference::foot_drift`). The slides and toe
+/// rolls between two rests of one stance measure 0.1–3.4 cm on the shared CMU run and
+/// jumps; the vertical jump's left foot shuffles 15 cm (ankle) and 17 cm (toe tip), lifted
+/// 5 cm, inside a landing stance the contacts do not split, and a forward jump's foot
+/// steps 37 cm inside another.
+pub const FOOT_STEP_M: f64 = 0.05;
 /// Default number of steady run cycles.
 pub const DEFAULT_CYCLES: usize = 4;
 /// Most run cycles of one edit (each a second or so of motion: a cap on the output).

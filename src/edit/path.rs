@@ -16,8 +16,10 @@
 //! With that request the joint is exact: the flight between two stances is one parabola of
 //! curvature −g, its position and velocity continuous at the apex where the stances meet.
 //! A stance may carry the recording's detail `d(u)` (`edit::detail`): added to `(h, p, v)`
-//! in stance, `d(1)` after liftoff; it is 0 with zero velocity at touchdown and has zero
-//! velocity at liftoff, so the joins above stay exact and the flights ballistic.
+//! in stance, `d(1)` after liftoff; where it joins a planned flight it is 0 with zero
+//! velocity (touchdown) or has zero velocity (liftoff), so the joins above stay exact and
+//! the flights ballistic. A jump's landing is chained in its own heading instead
+//! ([`PlannedStance::chain_in_own_heading`]), starting with the flight's velocity.
 //!
 //! # Frames and units
 //! World: metres, seconds, internal Z-up frame. Stance axes `h, p, v` (index 0, 1, 2).

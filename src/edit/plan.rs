@@ -17,10 +17,11 @@
 //! jump: the requests of `query::jump` (they chain by construction: ve1 = vs2 = u_apex)
 //! placement: the first stance keeps its recorded heading, and its COM at touchdown is the
 //!   recorded one; every later stance is chained at the apex (`path`): a run's along the
-//!   apex velocity, a jump's landing in the liftoff's heading with the apex's sideways
-//!   velocity as its `vps` (the jump query shares one apex speed along that heading)
-//! detail: each stance carries its recording's residual from the model it plays, heights
-//!   ending at 0 and travel offsets balanced over the edit's stances (`detail`)
+//!   apex velocity, a jump's landing in its own recorded heading with the flight's
+//!   velocity there as its (vs, vps)
+//! detail: each stance carries its recording's residual from the model it plays, joined to
+//!   every planned flight (heights ending at 0); a run's travel offsets balanced over its
+//!   stances, a jump's first touchdown and last liftoff free (`detail`)
 //! ```
 //! Each request is solved and checked by the query code (`query::run::scale_and_check`) on
 //! the stance the edit plays (the leaned one for a run, `lean`), against the recorded

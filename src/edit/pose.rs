@@ -216,14 +216,16 @@ impl Reference {
     /// ```text
     /// h_p(f) = z_p(f) − min over the stance of z_p,    p ∈ {ankle, toe tip}
     /// I_p = [first, last frame with h_p ≤ b],           b = FOOT_REST_BAND_M
-    /// D(f) = D(f−1) + Σ_{p: f−1, f ∈ I_p} Δx_p(f) / #{p: f−1, f ∈ I_p}   (0 when none),  D(first) = 0
+    /// S_p: the frames of a run off the band (h_p > b) inside I_p whose rests before and
+    ///      after lie more than FOOT_STEP_M apart horizontally (a step, not a slide)
+    /// D(f) = D(f−1) + Σ_{p: f−1, f ∈ I_p \ S_p} Δx_p(f) / #{p: …}   (0 when none),  D(first) = 0
     /// ```
     /// (`Δx_p`: the point's horizontal step.) Between the first and the last frame where a
     /// foot point rests on the floor (within `b` of its lowest height) its horizontal motion
     /// is the capture's slide, so removing `D` holds it in place: the heel while the foot
     /// lands and rests, the toe tip until it rolls off (heel up), their mean while both
-    /// rest. A point on its way down or up does not count; `D` is a sum of steps, so the
-    /// foot's position stays continuous.
+    /// rest. A point on its way down or up does not count, nor one stepping to a new rest
+    /// inside the stance; `D` is a sum of steps, so the foot's position stays continuous.
     pub fn foot_drift(&self, td: f64, lo: f64) -> [Vec<[f64; 2]>; 2] {
         let n = self.motion.n_frames();
         let dt = self.motion.frame_time_s;
@@ -234,22 +236,14 @@ impl Reference {
                 (f0..=f1).map(|f| self.feet[f][side].0).collect(),
                 (f0..=f1).map(|f| self.toe_tips[f][side]).collect(),
             ];
-            let b = super::FOOT_REST_BAND_M;
-            let rests: Vec<(usize, usize)> = tracks
-                .iter()
-                .map(|p| {
-                    let zmin = p.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
-                    let on = |v: &V3| v[2] - zmin <= b;
-                    let first = p.iter().position(on).unwrap_or(0);
-                    let last = p.iter().rposition(on).unwrap_or(0);
-                    (first, last)
-                })
-                .collect();
+            let slides = tracks
+                .clone()
+                .map(|p| sliding_frames(&p, super::FOOT_REST_BAND_M, super::FOOT_STEP_M));
             let mut d = vec![[0.0; 2]];
             for i in 1..tracks[0].len() {
                 let (mut step, mut count) = ([0.0; 2], 0.0);
-                for (p, &(first, last)) in tracks.iter().zip(&rests) {
-                    if first < i && i <= last {
+                for (p, slide) in tracks.iter().zip(&slides) {
+                    if slide[i - 1] && slide[i] {
                         count += 1.0;
                         for (a, st) in step.iter_mut().enumerate() {
                             *st += p[i][a] - p[i - 1][a];
@@ -466,6 +460,35 @@ pub struct EditedMotion {
 fn smooth(u: f64) -> f64 {
     let u = u.clamp(0.0, 1.0);
     u * u * (3.0 - 2.0 * u)
+}
+
+/// The frames of one foot point's track whose horizontal motion is the capture's slide
+/// ([`Reference::foot_drift`]): from the first to the last frame within `band` of the
+/// track's lowest height, except the runs off the band whose rests before and after lie
+/// more than `step` apart horizontally (m).
+fn sliding_frames(p: &[V3], band: f64, step: f64) -> Vec<bool> {
+    let zmin = p.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
+    let on: Vec<bool> = p.iter().map(|v| v[2] - zmin <= band).collect();
+    let (Some(first), Some(last)) = (on.iter().position(|&x| x), on.iter().rposition(|&x| x))
+    else {
+        return vec![false; p.len()];
+    };
+    let mut slide: Vec<bool> = (0..p.len()).map(|i| first <= i && i <= last).collect();
+    let mut i = first;
+    while i < last {
+        if on[i + 1] {
+            i += 1;
+            continue;
+        }
+        // Frames i+1 ..= j−1 are off the band, i and j rest.
+        let j = (i + 1..=last).find(|&j| on[j]).unwrap_or(last);
+        let moved = (p[j][0] - p[i][0]).hypot(p[j][1] - p[i][1]);
+        if moved > step {
+            slide[i + 1..j].iter_mut().for_each(|s| *s = false);
+        }
+        i = j;
+    }
+    slide
 }
 
 fn heading_of(path: &ComPath, k: usize) -> f64 {
@@ -1180,6 +1203,41 @@ mod tests {
 
     fn ankle_at(phi: f64) -> V3 {
         add(TOE, rot::rotate(rot::axis_angle(AXIS, phi), U))
+    }
+
+    /// A foot point resting at `x = 0`, lifted by `rise` while it moves to `x = moved`, and
+    /// resting there: 5 + 6 + 5 frames, 2 mm of slide on each rest.
+    fn rest_lift_rest(rise: f64, moved: f64) -> Vec<V3> {
+        let mut p: Vec<V3> = (0..5).map(|i| [0.002 * i as f64 / 4.0, 0.0, 0.0]).collect();
+        p.extend((1..=6).map(|i| {
+            let u = i as f64 / 7.0;
+            [
+                0.002 + moved * u,
+                0.0,
+                rise * (std::f64::consts::PI * u).sin(),
+            ]
+        }));
+        p.extend((0..5).map(|i| [0.002 + moved + 0.002 * i as f64 / 4.0, 0.0, 0.0]));
+        p
+    }
+
+    #[test]
+    fn a_rise_between_two_rests_is_held_unless_the_point_steps() {
+        let (band, step) = (crate::edit::FOOT_REST_BAND_M, crate::edit::FOOT_STEP_M);
+        // The CMU run's toe: flat, up 2.9 cm, rests again 0.5 cm on: all slide (held).
+        let held = sliding_frames(&rest_lift_rest(0.029, 0.005), band, step);
+        assert!(held.iter().all(|&s| s), "{held:?}");
+        // The vertical jump's shuffle: up 5 cm, rests again 15 cm on: the lift is kept.
+        let shuffle = sliding_frames(&rest_lift_rest(0.05, 0.15), band, step);
+        let want: Vec<bool> = (0..16).map(|i| !(5..11).contains(&i)).collect();
+        assert_eq!(shuffle, want);
+        // Before the first and after the last rest: the foot is on its way down or up.
+        let mut p = rest_lift_rest(0.029, 0.005);
+        p.insert(0, [0.0, 0.0, 0.05]);
+        p.push([0.0, 0.0, 0.05]);
+        let s = sliding_frames(&p, band, step);
+        assert!(!s[0] && !s[p.len() - 1] && s[1..p.len() - 1].iter().all(|&x| x));
+        assert!(sliding_frames(&[], band, step).is_empty());
     }
 
     #[test]
