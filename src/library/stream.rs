@@ -67,6 +67,13 @@ pub struct TableWriter {
 /// tens of MB, for the whole build.
 const PENDING_SPILL_BYTES: usize = 1 << 20;
 
+/// Pending pushes (chunks) beyond this many go to a scratch file as well, whatever their
+/// estimated size ([`TableWriter::with_pending_spill`]): every push is a chunk whose string
+/// columns each hold a buffer of at least polars' 8 kB block however few their bytes, which
+/// `estimated_size` does not count. The clips table of the 25× replica (one row a clip,
+/// eight clips a batch) held 7.1 MB at the build's peak for 1 MB estimated.
+const PENDING_SPILL_CHUNKS: usize = 16;
+
 /// Page compression of every table: zstd at its default level.
 const COMPRESSION: ParquetCompression = ParquetCompression::Zstd(None);
 
@@ -245,7 +252,7 @@ impl TableWriter {
             // The rows wait as one chunk per push: copying them into one buffer at every
             // push would copy a small table's rows once per batch and leave the heap with
             // a trail of freed buffers of growing sizes.
-            if self.spill && self.pending.estimated_size() > PENDING_SPILL_BYTES {
+            if self.pending_too_large() {
                 self.spill_pending()?;
             }
             return Ok(());
@@ -261,10 +268,18 @@ impl TableWriter {
         }
         // Free the buffers of the rows just written (the remainder is copied once).
         self.pending.rechunk_mut();
-        if self.spill && self.pending.estimated_size() > PENDING_SPILL_BYTES {
+        if self.pending_too_large() {
             self.spill_pending()?;
         }
         Ok(())
+    }
+
+    /// Pending rows that go to a scratch file: more than [`PENDING_SPILL_BYTES`] or
+    /// [`PENDING_SPILL_CHUNKS`] pushes (only with [`TableWriter::with_pending_spill`]).
+    fn pending_too_large(&self) -> bool {
+        self.spill
+            && (self.pending.estimated_size() > PENDING_SPILL_BYTES
+                || self.pending.first_col_n_chunks() > PENDING_SPILL_CHUNKS)
     }
 
     /// `df`'s columns of the table, cast to its types.
@@ -521,6 +536,39 @@ mod tests {
             drop(w);
             assert!(par == serial, "{threads} threads: the bytes differ");
         }
+    }
+
+    /// Many pushes of a few rows (far below the pending bytes) wait in scratch files once
+    /// they are more than `PENDING_SPILL_CHUNKS` chunks, and give the bytes of one push.
+    #[test]
+    fn many_small_pushes_spill_by_count_and_give_the_same_bytes() {
+        let df = table(3 * (PENDING_SPILL_CHUNKS + 1) * 4);
+        assert!(df.estimated_size() < PENDING_SPILL_BYTES);
+        let d = tempfile::tempdir().unwrap();
+        let write = |name: &str, pieces: &[DataFrame]| -> (Vec<u8>, usize) {
+            let mut w = TableWriter::create(d.path(), name, &df.clear())
+                .unwrap()
+                .with_pending_spill();
+            let mut most_spilled = 0;
+            for p in pieces {
+                w.push(p).unwrap();
+                most_spilled = most_spilled.max(w.spilled.len());
+                assert!(w.pending.first_col_n_chunks() <= PENDING_SPILL_CHUNKS + 1);
+            }
+            w.finish(&[]).unwrap();
+            (std::fs::read(d.path().join(name)).unwrap(), most_spilled)
+        };
+        let (whole, none) = write("whole.parquet", std::slice::from_ref(&df));
+        assert_eq!(none, 0);
+        let pieces: Vec<DataFrame> = (0..df.height())
+            .step_by(3)
+            .map(|at| df.slice(at as i64, 3))
+            .collect();
+        let (pieced, spilled) = write("pieced.parquet", &pieces);
+        assert!(spilled >= 3, "{spilled} scratch files");
+        assert!(pieced == whole, "the bytes differ");
+        let left = std::fs::read_dir(d.path()).unwrap().count();
+        assert_eq!(left, 2, "scratch files left");
     }
 
     /// Rows pushed in small pieces, past the pending limit so that they wait in scratch

@@ -16,7 +16,7 @@ use super::names::clip_names;
 use crate::error::{Error, ErrorKind, Result};
 use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions};
 use crate::library::write::FramesWriter;
-use crate::library::{ClipRecord, Status};
+use crate::library::{ClipRecord, ClipStatus, Status};
 
 /// A reader that hashes and counts what passes through it (one pass over a large file).
 struct HashingReader<R> {
@@ -242,7 +242,7 @@ pub fn frames_into(
     out: &Path,
     opts: &IngestOptions,
     threads: usize,
-) -> anyhow::Result<Vec<ClipRecord>> {
+) -> anyhow::Result<Vec<ClipStatus>> {
     use anyhow::Context;
     let pool = worker_pool(files, threads)?;
     pool.install(|| stream_frames(files, out, opts))
@@ -311,13 +311,13 @@ pub fn default_batch_bounds() -> (usize, u64) {
 /// batch of every clip, byte for byte ([`FramesWriter`]); batches are as a build's
 /// ([`default_batch_bounds`]). Records come back without their
 /// frames, contact runs and summaries (those are in the tables).
-fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<Vec<ClipRecord>> {
+fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<Vec<ClipStatus>> {
     let mut named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
     named.sort_by(|a, b| a.1.cmp(&b.1));
     let (max_clips, max_bytes) = default_batch_bounds();
     let bar = progress(files.len(), "clips ingested");
     let mut w = FramesWriter::create(out, opts.joints)?;
-    let mut records: Vec<ClipRecord> = Vec::with_capacity(files.len());
+    let mut records: Vec<ClipStatus> = Vec::with_capacity(files.len());
     let mut write = |recs: Vec<ClipRecord>| -> Result<()> {
         w.push(&recs)?;
         records.extend(recs.into_iter().map(ClipRecord::written));

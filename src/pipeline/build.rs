@@ -51,7 +51,7 @@ use crate::library::schema::{
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, joints_table};
-use crate::library::{ClipRecord, Status};
+use crate::library::{ClipRecord, ClipStatus, Status};
 use crate::stances::build::StanceNote;
 use crate::stances::{build_clip, Stance, StanceOptions};
 
@@ -112,10 +112,10 @@ pub struct BuildReport {
 /// What a written build did.
 #[derive(Debug)]
 pub struct BuildSummary {
-    /// One record per rebuilt input file, sorted by clip, without its frames, contact runs
-    /// and summary (those are in the library; the flights and warnings of a large build's
-    /// summaries grew its memory by about 10 kB a clip).
-    pub records: Vec<ClipRecord>,
+    /// The outcome of every rebuilt input file, sorted by clip (the rest of its record is
+    /// in the library; the flights and warnings of a large build's summaries grew its
+    /// memory by about 10 kB a clip, the records without them by about 2 kB).
+    pub records: Vec<ClipStatus>,
     /// Stances of the rebuilt clips.
     pub stances: usize,
     /// Clips whose rows came from the previous library (`incremental`).

@@ -4,7 +4,8 @@
 //!
 //! # What is kept until the end
 //! ```text
-//! limits:      per stance  (clip, character_id, mass_kg, f_peak, ext_min, ext_max, unsupported)
+//! limits:      per clip, mass and support (clip, character_id, mass_kg, largest f_peak and
+//!              ext_max, smallest ext_min, unsupported, stance count)  [`group_facts`]
 //!              per clip    (s_eff, leg_length_m)
 //! kinematics:  per contact frame (frame, x, y, z) in a scratch file, indexed per
 //!              (character_id, effector, clip)                          [samples, on disk]
@@ -45,7 +46,7 @@ use crate::library::stream::{read_rows, TableWriter};
 use crate::library::write::{
     clips_table, contacts_table, frames_table, joints_table, write_atomic, ROW_GROUP_ROWS,
 };
-use crate::stances::limits::{limits, ClipFacts, StanceFacts};
+use crate::stances::limits::{group_facts, limits, ClipFacts, StanceFacts};
 use crate::twopac::hull::{HullOptions, StreamedHull};
 use crate::twopac::kinematic::OutlierRule;
 
@@ -160,6 +161,7 @@ fn stance_facts(s: &DataFrame) -> Vec<StanceFacts> {
             ext_min: e0[i].unwrap_or(f64::INFINITY),
             ext_max: e1[i].unwrap_or(0.0),
             unsupported: b0[i] == "unsupported" || b1[i] == "unsupported",
+            count: 1,
         })
         .collect()
 }
@@ -230,7 +232,8 @@ impl LibrarySink {
             self.samples.add(&s)?;
         }
         add_character_legs(&mut self.legs, &t.clips).map_err(|e| pe(CLIPS_FILE, e))?;
-        self.stance_facts.extend(stance_facts(&t.stances));
+        self.stance_facts
+            .extend(group_facts(stance_facts(&t.stances)));
         let c = &t.clips;
         for (k, (s_eff, leg)) in strings(c, clips::CLIP).into_iter().zip(
             floats(c, clips::S_EFF)

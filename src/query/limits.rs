@@ -39,6 +39,7 @@ pub fn absolute_limits(lib: &StanceLibrary) -> BTreeMap<String, Limits> {
             ext_min: s.coef.ext_min,
             ext_max: s.coef.ext_max,
             unsupported: [s.boundary_start, s.boundary_end].contains(&Boundary::Unsupported),
+            count: 1,
         })
         .collect();
     let clips: BTreeMap<String, ClipFacts> = lib

@@ -33,6 +33,43 @@ pub struct StanceFacts {
     pub ext_max: f64,
     /// An `unsupported` boundary on either side.
     pub unsupported: bool,
+    /// Stances these facts stand for: 1 for one stance; [`group_facts`] folds a clip's
+    /// stances of one mass and support into one entry (largest `f_peak` and `ext_max`,
+    /// smallest `ext_min`).
+    pub count: usize,
+}
+
+/// `facts` with the stances of one clip, character, mass and support folded into one
+/// entry each, in the order of their first stance: the limits of [`limits`] are the same,
+/// bit for bit (each is a largest or smallest value times a factor that depends only on
+/// the clip and the mass, and rounding keeps the order of products by one positive
+/// factor), and a build keeps one entry a clip instead of one a stance.
+pub fn group_facts(facts: Vec<StanceFacts>) -> Vec<StanceFacts> {
+    let mut out: Vec<StanceFacts> = Vec::new();
+    let mut at: std::collections::HashMap<(String, String, u64, bool), usize> =
+        std::collections::HashMap::new();
+    for f in facts {
+        let key = (
+            f.clip.clone(),
+            f.character_id.clone(),
+            f.mass_kg.to_bits(),
+            f.unsupported,
+        );
+        match at.get(&key) {
+            Some(&i) => {
+                let g = &mut out[i];
+                g.f_peak = g.f_peak.max(f.f_peak);
+                g.ext_max = g.ext_max.max(f.ext_max);
+                g.ext_min = g.ext_min.min(f.ext_min);
+                g.count += f.count;
+            }
+            None => {
+                at.insert(key, out.len());
+                out.push(f);
+            }
+        }
+    }
+    out
 }
 
 impl From<&Stance> for StanceFacts {
@@ -46,6 +83,7 @@ impl From<&Stance> for StanceFacts {
             ext_max: s.coef.ext_max,
             unsupported: s.boundary_start == Boundary::Unsupported
                 || s.boundary_end == Boundary::Unsupported,
+            count: 1,
         }
     }
 }
@@ -119,7 +157,8 @@ pub fn limits(
                 .filter(|s| s.character_id == id)
                 .collect();
             // Library-wide values are scaled to the character: force by M, lengths by L.
-            let (pool, scale, source) = if own.len() >= MIN_CHARACTER_STANCES {
+            let n_own: usize = own.iter().map(|s| s.count).sum();
+            let (pool, scale, source) = if n_own >= MIN_CHARACTER_STANCES {
                 (&own, None, "character")
             } else {
                 (&ok, Some((mass, leg_c)), "library")
@@ -147,10 +186,78 @@ pub fn limits(
                     0.0
                 },
                 chi_max_m: MARGIN * ext_max,
-                n_stances: own.len(),
+                n_stances: n_own,
                 source: source.to_string(),
             };
             (id, lim)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testkit::Rng;
+
+    /// Stances of `clips` clips of three characters (one with fewer than 20 stances), some
+    /// unsupported, masses per clip, values in any order.
+    fn facts(rng: &mut Rng, clips: usize) -> (Vec<StanceFacts>, BTreeMap<String, ClipFacts>) {
+        let mut f = Vec::new();
+        let mut c = BTreeMap::new();
+        for k in 0..clips {
+            let clip = format!("clip_{k}");
+            let character = ["a", "b", "c"][k % 3].to_string();
+            let mass = rng.uniform(50.0, 90.0);
+            let n = if character == "c" {
+                2
+            } else {
+                rng.int(3, 12) as usize
+            };
+            for _ in 0..n {
+                f.push(StanceFacts {
+                    clip: clip.clone(),
+                    character_id: character.clone(),
+                    mass_kg: mass,
+                    f_peak: rng.uniform(600.0, 2500.0),
+                    ext_min: rng.uniform(0.6, 0.9),
+                    ext_max: rng.uniform(0.9, 1.2),
+                    unsupported: rng.next_f64() < 0.2,
+                    count: 1,
+                });
+            }
+            let s_eff = [None, Some(1.0), Some(1.3)][rng.int(0, 2) as usize];
+            let leg_m = rng.uniform(0.8, 1.0);
+            c.insert(clip, ClipFacts { s_eff, leg_m });
+        }
+        (f, c)
+    }
+
+    #[test]
+    fn limits_of_grouped_facts_are_those_of_every_stance_bit_for_bit() {
+        let mut rng = Rng::new(0x0001_157a);
+        for clips in [1, 4, 9, 30] {
+            let (f, c) = facts(&mut rng, clips);
+            let n = f.len();
+            let grouped = group_facts(f.clone());
+            assert!(
+                grouped.len() <= 2 * clips && grouped.len() < n,
+                "{clips} clips"
+            );
+            assert_eq!(grouped.iter().map(|g| g.count).sum::<usize>(), n);
+            let (a, b) = (limits(&f, &c), limits(&grouped, &c));
+            assert_eq!(a.len(), b.len());
+            for ((ka, la), (kb, lb)) in a.iter().zip(&b) {
+                assert_eq!(ka, kb);
+                assert_eq!(la.n_stances, lb.n_stances);
+                assert_eq!(la.source, lb.source);
+                for (x, y) in [
+                    (la.f_max_n, lb.f_max_n),
+                    (la.chi_min_m, lb.chi_min_m),
+                    (la.chi_max_m, lb.chi_max_m),
+                ] {
+                    assert_eq!(x.to_bits(), y.to_bits(), "{ka}: {la:?} vs {lb:?}");
+                }
+            }
+        }
+    }
 }

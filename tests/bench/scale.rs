@@ -15,6 +15,20 @@
 //! the figures are printed for the record.
 //!
 //! # Results
+//! 2026-12-06, 2-core sandbox, nothing else running, `SCALE_ROUNDS=3`, after the per-clip
+//! limit summaries (`stances::limits::group_facts`), the count-bounded waiting rows
+//! (`PENDING_SPILL_CHUNKS`) and the compact per-clip outcomes (`library::ClipStatus`):
+//!
+//! ```text
+//! scale: 93 clips and a 25× replica, build --threads 2, 3 rounds (medians)
+//! set      wall   0.553 s  peak    80.9 MiB
+//! replica  wall  13.299 s  peak   101.1 MiB
+//! replica / set: peak 1.25× (target ≤ 1.3×, ≤ 1024 MiB), wall 0.96× of linear (target ≤ 1.10)
+//! ```
+//! Targets met. `farm-bench` on the same commands, each against the binary before the
+//! three changes (A/B, medians): set 7 runs 84.2 / 81.4 MiB, replica 3 runs 100.8 /
+//! 117.8 MiB (1.20× and 1.45× of their sets).
+//!
 //! 2026-12-03, 2-core sandbox, nothing else running, `SCALE_ROUNDS=1`:
 //!
 //! ```text

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use super::super::args::FramesArgs;
 use super::super::Outcome;
 use crate::ingest::IngestOptions;
-use crate::library::{ClipRecord, Status};
+use crate::library::{ClipStatus, Status};
 use crate::pipeline::batch::{discover, frames_into};
 use crate::pipeline::spec::{load_body, resolve};
 
@@ -38,7 +38,7 @@ pub fn execute(
 }
 
 /// The `--json` summary of a batch: `command`, `clips`, `ok`, `skipped`, `failed`, `out`.
-pub fn summary(records: &[ClipRecord], out: &Path, command: &str) -> serde_json::Value {
+pub fn summary(records: &[ClipStatus], out: &Path, command: &str) -> serde_json::Value {
     let count = |s: Status| records.iter().filter(|r| r.status == s).count();
     serde_json::json!({
         "command": command,
@@ -51,7 +51,7 @@ pub fn summary(records: &[ClipRecord], out: &Path, command: &str) -> serde_json:
 }
 
 /// Print the per-clip failures and a one-line summary; the outcome for the exit code.
-pub fn report(records: &[ClipRecord], out: &Path) -> Outcome {
+pub fn report(records: &[ClipStatus], out: &Path) -> Outcome {
     let count = |s: Status| records.iter().filter(|r| r.status == s).count();
     for r in records.iter().filter(|r| r.status == Status::Error) {
         eprintln!("error: {}", r.message.as_deref().unwrap_or("unknown error"));
