@@ -7,7 +7,7 @@ use super::edit_motion::{
     assert_bounds_except, cycle_of, edit_cycle, first_cycle_against_source, fixture, library,
     measure, recorded_jump_against_source,
 };
-use super::util::{ok, shared_or_skip};
+use super::util::{ok, refused, shared_or_skip};
 
 // See: issue 14 item 3 — "iterate root correction and leg IK until the COM error is below
 // 1 mm; report frames that do not converge": at 1.2 × the recorded apex 11 frames at the
@@ -125,7 +125,106 @@ fn recorded_real_jumps_against_their_recordings() {
         let out = sub.join("jump.bvh");
         let (rms, root) = recorded_jump_against_source(&lib, &src, &out);
         eprintln!("{clip}: recorded jump, joint-angle RMS {rms:.3}°, root path {root:.4} m");
+        // And the round trip's bounds, every one of them (the issue asks them of every
+        // written BVH; the real jumps were first measured on 2026-12-06).
+        assert_bounds_except(&measure(&out), &[]);
         assert!(rms <= 3.0, "{clip}: joint-angle RMS {rms}° > 3°");
         assert!(root <= 0.02, "{clip}: root path {root} m > 0.02 m");
     }
+}
+
+// See: issue 14, `edit jump --pair LIFTOFF_ID:LANDING_ID`. A liftoff and a landing of two
+// different recorded jumps of CMU 01_01, recorded 180° apart (the subject turns around
+// between them): chained in the landing's own recorded heading, its braking force pushed
+// along the travel and the edit ended at 2.1 m/s with 14 frames not converged (found by
+// review, 2026-12-06); turned onto the liftoff's heading it comes to rest and every frame
+// converges.
+#[test]
+fn a_paired_jump_lands_in_the_liftoffs_heading() {
+    let Some(data) = shared_or_skip("a_paired_jump_lands_in_the_liftoffs_heading") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let src = data.join("bvh/jump/cmu_01_01_forward_jumps_mb.bvh");
+    let lib = library(dir.path(), std::slice::from_ref(&src));
+    let l = stancelib::library::read::open_library(&lib).unwrap();
+    let timing =
+        stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+    let id = |frame: &str| {
+        let i = l
+            .stances
+            .iter()
+            .position(|s| s.stance_id.ends_with(frame))
+            .unwrap_or_else(|| panic!("stance {frame}"));
+        (l.stances[i].stance_id.clone(), timing[i].heading)
+    };
+    let ((up, h_up), (down, h_down)) = (id(":LR:150"), id(":LR:1335"));
+    let dot = h_up[0] * h_down[0] + h_up[1] * h_down[1];
+    assert!(
+        dot < -0.9,
+        "recorded headings {h_up:?} and {h_down:?} are opposite"
+    );
+    let out = dir.path().join("paired.bvh");
+    // Exit 0: every frame converged (the request fails friction, so it is allowed).
+    ok(&[
+        "edit",
+        "jump",
+        "--lib",
+        lib.to_str().unwrap(),
+        "--pair",
+        &format!("{up}:{down}"),
+        "--allow-infeasible",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let plan = stancelib::library::read::read_parquet(&out.with_extension("plan.parquet")).unwrap();
+    let col = |n: &str| -> Vec<f64> {
+        plan.column(n)
+            .unwrap()
+            .f64()
+            .unwrap()
+            .into_no_null_iter()
+            .collect()
+    };
+    let (t, x, y) = (col("time_clip_s"), col("com_x_m"), col("com_y_m"));
+    let n = t.len();
+    let speed = (x[n - 1] - x[n - 2]).hypot(y[n - 1] - y[n - 2]) / (t[n - 1] - t[n - 2]);
+    assert!(speed < 0.3, "the landing ends at {speed} m/s");
+    assert_bounds_except(&measure(&out), &[]);
+}
+
+// See: issue 14 — `--pair` names a liftoff and a landing; the edit poses both from one
+// source clip, so stances of two clips are refused, naming both.
+#[test]
+fn a_pair_of_two_clips_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = library(
+        dir.path(),
+        &[fixture("jump_120hz_cmu_yup"), fixture("jump_100hz_m_zup")],
+    );
+    let l = stancelib::library::read::open_library(&lib).unwrap();
+    let s = &l.stances;
+    let up = s
+        .iter()
+        .find(|x| x.clip == "jump_120hz_cmu_yup" && stancelib::query::jump::is_liftoff(x))
+        .expect("a liftoff");
+    let down = s
+        .iter()
+        .find(|x| x.clip == "jump_100hz_m_zup" && stancelib::query::jump::is_landing(x))
+        .expect("a landing");
+    let out = dir.path().join("cross.bvh");
+    refused(
+        &[
+            "edit",
+            "jump",
+            "--lib",
+            lib.to_str().unwrap(),
+            "--pair",
+            &format!("{}:{}", up.stance_id, down.stance_id),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["different clips", &up.stance_id, &down.stance_id],
+    );
+    assert!(!out.exists(), "nothing written");
 }

@@ -27,7 +27,7 @@
 //! the stance the edit plays (the leaned one for a run, `lean`), against the recorded
 //! stance's limits.
 
-use super::detail::{balance_travel, recorded_residual, Join, StanceDetail};
+use super::detail::{balance_travel, recorded_residual, Join, StanceDetail, EDGE_WINDOW_S};
 use super::path::{ComPath, PlannedStance};
 use super::pose::{Reference, StanceSource};
 use crate::query::feasibility::Limits;
@@ -211,7 +211,7 @@ pub fn details(
     reference: &Reference,
     kind: PlanKind,
 ) -> Vec<Option<StanceDetail>> {
-    let jump = kind == PlanKind::Jump;
+    let jump = kind.is_jump();
     let (first, last) = (order.first().copied(), order.last().copied());
     let mut out: Vec<Option<StanceDetail>> = stances
         .iter()
@@ -228,7 +228,8 @@ pub fn details(
                 (own.t_td, own.t_lo),
             );
             let sol = &e.scaled.solution;
-            let mut join = Join::both(sol.t_lo - sol.t_td);
+            let window_s = EDGE_WINDOW_S * reference.length_scale.sqrt();
+            let mut join = Join::both(window_s, sol.t_lo - sol.t_td);
             join.start = !(jump && first == Some(i));
             join.end = !(jump && last == Some(i));
             StanceDetail::from_samples(&u, &rho).map(|d| d.joined(join))
@@ -246,9 +247,22 @@ pub enum PlanKind {
     /// Run cycles: apex to apex, each stance chained along the apex velocity
     /// ([`PlannedStance::chain`]).
     Run,
-    /// A jump from rest: first touchdown to last liftoff, the landing in the liftoff's
-    /// heading ([`PlannedStance::chain_in_own_heading`]).
+    /// A recorded jump from rest (the landing follows the liftoff in its clip): first
+    /// touchdown to last liftoff, the landing in its own recorded heading, so the body
+    /// turns between them as it did in the recording
+    /// ([`PlannedStance::chain_in_own_heading`]).
     Jump,
+    /// A liftoff and a landing of different recorded jumps: as [`PlanKind::Jump`], but the
+    /// landing is turned onto the liftoff's heading (their recorded headings are
+    /// unrelated: a clip may turn around between its jumps).
+    PairedJump,
+}
+
+impl PlanKind {
+    /// A jump, recorded or paired.
+    pub fn is_jump(self) -> bool {
+        matches!(self, PlanKind::Jump | PlanKind::PairedJump)
+    }
 }
 
 /// Places the sequence `order` of solved stances in the world: the first keeps its recorded
@@ -260,7 +274,7 @@ pub fn place(
     reference: &Reference,
     kind: PlanKind,
 ) -> (ComPath, Vec<StanceSource>) {
-    let jump = kind == PlanKind::Jump;
+    let jump = kind.is_jump();
     let detail = details(stances, order, reference, kind);
     let planned_of = |e: &EditStance, source: usize| PlannedStance {
         source,
@@ -293,6 +307,9 @@ pub fn place(
                 }
             }
             Some(prev) if jump => {
+                if kind == PlanKind::PairedJump {
+                    p.heading = prev.heading;
+                }
                 prev.chain_in_own_heading(&mut p);
             }
             Some(prev) => {

@@ -9,7 +9,8 @@
 //!            flight before k': t_B = td_k' − (TD_k' − t)·a_k'/A_k'  a, A: apex → touchdown;
 //!            lower case source, upper case plan)
 //!            q_j = slerp(q_j(t_A), q_j(t_B), w),  w = 3u² − 2u³,  u = (t − LO_k)/(TD_k' − LO_k)
-//! heading    q_root ← yaw(Δψ)·q_root,  Δψ = ψ_plan − ψ_source (blended by w in flight)
+//! heading    q_root ← yaw(Δψ)·q_root,  Δψ = ψ_plan − ψ_source (in flight each edge's root
+//!            turned by its own Δψ, then slerped)
 //! feet       ankle* = c_plan + yaw(Δψ)(ankle_src − c_src − D),  foot orientation = yaw(Δψ)·src
 //!            D: the source foot's slide while resting (Reference::foot_drift)
 //!            beyond reach (|ankle* − H| > reach): turn the foot about its toe tip T,
@@ -112,6 +113,9 @@ pub struct Reference {
     pub feet: Vec<[(V3, Quat); 2]>,
     /// Source toe tips per frame (left, right; m, Z up), as the ingest places them.
     pub toe_tips: Vec<[V3; 2]>,
+    /// The character's length scale `L` against its source (1 for the recorded character;
+    /// [`Reference::with_length_scale`]): body-size thresholds scale by it.
+    pub length_scale: f64,
 }
 
 impl Reference {
@@ -208,7 +212,19 @@ impl Reference {
             com,
             feet,
             toe_tips,
+            length_scale: 1.0,
         })
+    }
+
+    /// The same reference for a character `L` times the source's size (its motion already
+    /// scaled by `L`): a step inside a stance is then `L ·` [`super::FOOT_STEP_M`], and a
+    /// detail's edge window `√L ·` [`super::detail::EDGE_WINDOW_S`] (times scale by √L under
+    /// dynamic similarity). A scale that is not finite and positive is ignored.
+    pub fn with_length_scale(mut self, l: f64) -> Reference {
+        if l.is_finite() && l > 0.0 {
+            self.length_scale = l;
+        }
+        self
     }
 
     /// Horizontal drift of the source feet over a stance from clip time `td` to `lo` (s),
@@ -217,7 +233,7 @@ impl Reference {
     /// h_p(f) = z_p(f) − min over the stance of z_p,    p ∈ {ankle, toe tip}
     /// I_p = [first, last frame with h_p ≤ b],           b = FOOT_REST_BAND_M
     /// S_p: the frames of a run off the band (h_p > b) inside I_p whose rests before and
-    ///      after lie more than FOOT_STEP_M apart horizontally (a step, not a slide)
+    ///      after lie more than L · FOOT_STEP_M apart horizontally (a step, not a slide)
     /// D(f) = D(f−1) + Σ_{p: f−1, f ∈ I_p \ S_p} Δx_p(f) / #{p: …}   (0 when none),  D(first) = 0
     /// ```
     /// (`Δx_p`: the point's horizontal step.) Between the first and the last frame where a
@@ -634,7 +650,8 @@ fn foot_goal(
 /// Step 1 of [`pose_frame`]: the reference pose of output time `t` into `ws.pose` (the
 /// source stance's pose at the same fraction of its contact, or in a flight the source
 /// flight edges' poses, blended across a flight between two stances) and the yaw that
-/// turns it onto the planned heading. Returns the yaw and the stance `t` lies in.
+/// turns it onto the planned heading (0 in a flight between two stances: the edges' roots
+/// are turned before the blend). Returns the yaw and the stance `t` lies in.
 fn reference_pose(
     r: &Reference,
     path: &ComPath,
@@ -672,17 +689,23 @@ fn reference_pose(
     match (side_a, side_b, before, after) {
         (Some((lo, ta)), Some((td, tb)), Some(b), Some(a)) => {
             let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
-            let (ya, yb) = (yaw_of(b), yaw_of(a));
+            let up = up_file(&r.body);
             r.sample(tb, &mut ws.pose);
+            ws.pose.q[r.root] = rot::mul(rot::axis_angle(up, yaw_of(a)), ws.pose.q[r.root]);
             std::mem::swap(&mut ws.pose, &mut ws.other);
             r.sample(ta, &mut ws.pose);
+            ws.pose.q[r.root] = rot::mul(rot::axis_angle(up, yaw_of(b)), ws.pose.q[r.root]);
+            // Both roots already turned onto their planned headings: the slerp takes the
+            // shortest way between the orientations the body has at either edge. Blending
+            // the source roots and the yaws apart spun a landing recorded 180° from its
+            // liftoff (a paired jump) a full turn in the flight.
             for (qa, qb) in ws.pose.q.iter_mut().zip(&ws.other.q) {
                 *qa = rot::slerp(*qa, *qb, w);
             }
             for (va, vb) in ws.pose.row.iter_mut().zip(&ws.other.row) {
                 *va += w * (vb - *va);
             }
-            (ya + w * wrap_pi(yb - ya), None)
+            (0.0, None)
         }
         (Some((_, ta)), _, Some(b), _) => {
             r.sample(ta, &mut ws.pose);
@@ -1238,6 +1261,11 @@ mod tests {
         let s = sliding_frames(&p, band, step);
         assert!(!s[0] && !s[p.len() - 1] && s[1..p.len() - 1].iter().all(|&x| x));
         assert!(sliding_frames(&[], band, step).is_empty());
+        // The threshold itself: a rest 4.9 cm on is held, 5.1 cm on is a step; a character
+        // twice the size (the caller passes 2 · FOOT_STEP_M) holds the 5.1 cm one.
+        let kept =
+            |moved: f64, step: f64| !sliding_frames(&rest_lift_rest(0.04, moved), band, step)[7];
+        assert!(!kept(0.049, step) && kept(0.051, step) && !kept(0.051, 2.0 * step));
     }
 
     #[test]

@@ -273,6 +273,12 @@ pub fn given_pair(lib: &StanceLibrary, p: &str) -> Result<(usize, usize)> {
             lib.stances[j].stance_id
         )));
     }
+    if lib.stances[i].clip != lib.stances[j].clip {
+        return Err(bad(format!(
+            "{} and {} are of different clips: the edit poses both stances from one source clip",
+            lib.stances[i].stance_id, lib.stances[j].stance_id
+        )));
+    }
     Ok((i, j))
 }
 

@@ -134,7 +134,7 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
         .with_context(|| format!("library {}", t.lib.display()))?;
     let first = chosen.stances[0].source.stance_id.clone();
     let order: Vec<usize> = (0..e.cycles).flat_map(|_| [0, 1]).collect();
-    let edit = compute(t, e.run.length_scale, chosen.stances, order, false)?;
+    let edit = compute(t, e.run.length_scale, chosen.stances, order, PlanKind::Run)?;
     let kv = query_kv(
         &t.lib,
         serde_json::json!({
@@ -179,7 +179,13 @@ pub fn edit_jump(e: &JumpEdit) -> anyhow::Result<EditReport> {
         lib.stances[i].stance_id, lib.stances[j].stance_id
     );
     let stances = jump_stances(&lib, &pool, &times, &chosen);
-    let edit = compute(t, 1.0, stances, vec![0, 1], true)?;
+    // The landing right after the liftoff in their clip keeps its recorded turn.
+    let kind = if j == i + 1 && lib.stances[i].clip == lib.stances[j].clip {
+        PlanKind::Jump
+    } else {
+        PlanKind::PairedJump
+    };
+    let edit = compute(t, 1.0, stances, vec![0, 1], kind)?;
     let (h, d) = (chosen.height_m, chosen.distance_m);
     let kv = query_kv(
         &t.lib,
@@ -244,7 +250,7 @@ fn compute(
     length: f64,
     stances: Vec<EditStance>,
     order: Vec<usize>,
-    jump: bool,
+    kind: PlanKind,
 ) -> anyhow::Result<EditOutputs> {
     let clip = stances[0].source.clip.clone();
     let (bvh, unit, up) = source_clip(&t.lib, &clip, t.source.as_deref())?;
@@ -253,9 +259,9 @@ fn compute(
     let body =
         BodyModel::new(&bvh, unit, up, sex, &landmarks).with_context(|| format!("clip {clip}"))?;
     let frame_time_s = t.fps.map_or(bvh.motion.frame_time_s, |f| 1.0 / f);
-    let reference =
-        Reference::new(body, bvh.motion.clone()).with_context(|| format!("clip {clip}"))?;
-    let kind = if jump { PlanKind::Jump } else { PlanKind::Run };
+    let reference = Reference::new(body, bvh.motion.clone())
+        .with_context(|| format!("clip {clip}"))?
+        .with_length_scale(length);
     let (path, sources) = place(&stances, &order, &reference, kind);
     let edited = pose_motion(
         &reference,

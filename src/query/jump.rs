@@ -31,7 +31,9 @@
 //! perpendicular force pushes along the start drift and no `β_p ≥ 0` stops it: the spec's
 //! straight jump is then unreachable, so the perpendicular force is dropped and the small
 //! drift `vps1` kept (a stance from rest has `|vps1| < 0.2` m/s). The landing keeps its own
-//! perpendicular force (`β_p2 = 1`): it starts in the liftoff's heading with `vps2 = 0`.
+//! perpendicular force (`β_p2 = 1`): it starts in the liftoff's heading with `vps2 = 0`
+//! (the editor plays a landing recorded a few degrees off that heading in its own, with
+//! the flight's velocity there, `edit::path::PlannedStance::chain_in_own_heading`).
 //! Heights are above each stance's contact height `z_c`.
 //!
 //! # References
