@@ -4,8 +4,8 @@
 //! capture's slide of a resting foot point is removed).
 
 use super::edit_motion::{
-    assert_bounds_except, cycle_of, edit_cycle, first_cycle_against_source, fixture, library,
-    measure, recorded_jump_against_source,
+    assert_bounds_except, cycle_of, edit, edit_cycle, first_cycle_against_source, first_jump,
+    fixture, library, measure, recorded_jump_against_source,
 };
 use super::util::{ok, refused, shared_or_skip};
 
@@ -227,4 +227,68 @@ fn a_pair_of_two_clips_is_refused() {
         &["different clips", &up.stance_id, &down.stance_id],
     );
     assert!(!out.exists(), "nothing written");
+}
+
+// See: issue 14 checks — "the rebuilt stances reproduce the request: apex height and
+// distance within 2 cm (jumps)", on a real forward jump asked a new distance, and a new
+// height and distance (the fixture jump is vertical: its distance is fixed). Measured
+// 2026-12-06 (first measured then): at the recorded height, 0.9 / 1.0 / 1.1 × the
+// recorded distance rebuild 1.8 / 1.5 / 1.2 cm short; 3 cm higher, 4.3 / 3.9 / 3.6 cm
+// short (the code before that day's jump changes: 3.3 cm long at 1.1 ×). KNOWN MISS with a
+// ceiling: the distance of a jump asked a new height too (issue 14 stays open;
+// docs/edited-motion.md, "Known miss: a new height moves the rebuilt distance").
+#[test]
+fn a_real_forward_jump_at_a_new_height_and_distance_round_trips() {
+    let Some(data) = shared_or_skip("a_real_forward_jump_at_a_new_height_and_distance_round_trips")
+    else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let src = data.join("bvh/jump/cmu_13_32_forward_jump_daz.bvh");
+    let lib = library(dir.path(), std::slice::from_ref(&src));
+    let l = stancelib::library::read::open_library(&lib).unwrap();
+    let (i, j) = first_jump(&l.stances).expect("a recorded jump");
+    let (h0, d0) = stancelib::query::jump::recorded_jump(&l.stances[i], &l.stances[j]);
+    let pair = format!("{}:{}", l.stances[i].stance_id, l.stances[j].stance_id);
+    for (name, h, d, distance_ceiling) in [
+        ("new distance", h0, 1.1 * d0, 0.02),
+        ("new height and distance", h0 + 0.03, 1.1 * d0, 0.045),
+    ] {
+        let out = dir.path().join(format!("{}.bvh", name.replace(' ', "_")));
+        edit(&[
+            "edit",
+            "jump",
+            "--lib",
+            lib.to_str().unwrap(),
+            "--pair",
+            &pair,
+            "--height",
+            &h.to_string(),
+            "--distance",
+            &d.to_string(),
+            "--allow-infeasible",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_bounds_except(&measure(&out), &[]);
+        let sub = dir.path().join(format!("rebuilt {name}"));
+        let rl = library(&sub, std::slice::from_ref(&out));
+        let r = stancelib::library::read::open_library(&rl).unwrap();
+        let (a, b) = first_jump(&r.stances).expect("the rebuilt clip has a jump");
+        let (hr, dr) = stancelib::query::jump::recorded_jump(&r.stances[a], &r.stances[b]);
+        let status = if distance_ceiling > 0.02 {
+            "KNOWN MISS"
+        } else {
+            "bound"
+        };
+        eprintln!(
+            "{name}: apex {hr:.4} m (asked {h:.4}), distance {dr:.4} m (asked {d:.4}, {status} \
+             {distance_ceiling})"
+        );
+        assert!((hr - h).abs() <= 0.02, "{name}: apex {hr} vs {h}");
+        assert!(
+            (dr - d).abs() <= distance_ceiling,
+            "{name}: distance {dr} vs {d} ({status} {distance_ceiling})"
+        );
+    }
 }
