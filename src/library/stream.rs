@@ -538,37 +538,43 @@ mod tests {
         }
     }
 
+    /// `pieces` pushed one by one through a spilling writer of `template`'s columns into a
+    /// fresh folder: the file's bytes, the most scratch files and the most pending chunks
+    /// seen; asserts that no scratch file is left.
+    fn write_pieces(template: &DataFrame, pieces: &[DataFrame]) -> (Vec<u8>, usize, usize) {
+        let d = tempfile::tempdir().unwrap();
+        let mut w = TableWriter::create(d.path(), "t.parquet", &template.clear())
+            .unwrap()
+            .with_pending_spill();
+        let (mut most_spilled, mut most_chunks) = (0, 0);
+        for p in pieces {
+            w.push(p).unwrap();
+            most_spilled = most_spilled.max(w.spilled.len());
+            most_chunks = most_chunks.max(w.pending.first_col_n_chunks());
+        }
+        w.finish(&[]).unwrap();
+        let bytes = std::fs::read(d.path().join("t.parquet")).unwrap();
+        let left: Vec<_> = std::fs::read_dir(d.path()).unwrap().collect();
+        assert_eq!(left.len(), 1, "scratch files left: {left:?}");
+        (bytes, most_spilled, most_chunks)
+    }
+
     /// Many pushes of a few rows (far below the pending bytes) wait in scratch files once
     /// they are more than `PENDING_SPILL_CHUNKS` chunks, and give the bytes of one push.
     #[test]
     fn many_small_pushes_spill_by_count_and_give_the_same_bytes() {
         let df = table(3 * (PENDING_SPILL_CHUNKS + 1) * 4);
         assert!(df.estimated_size() < PENDING_SPILL_BYTES);
-        let d = tempfile::tempdir().unwrap();
-        let write = |name: &str, pieces: &[DataFrame]| -> (Vec<u8>, usize) {
-            let mut w = TableWriter::create(d.path(), name, &df.clear())
-                .unwrap()
-                .with_pending_spill();
-            let mut most_spilled = 0;
-            for p in pieces {
-                w.push(p).unwrap();
-                most_spilled = most_spilled.max(w.spilled.len());
-                assert!(w.pending.first_col_n_chunks() <= PENDING_SPILL_CHUNKS + 1);
-            }
-            w.finish(&[]).unwrap();
-            (std::fs::read(d.path().join(name)).unwrap(), most_spilled)
-        };
-        let (whole, none) = write("whole.parquet", std::slice::from_ref(&df));
+        let (whole, none, _) = write_pieces(&df, std::slice::from_ref(&df));
         assert_eq!(none, 0);
         let pieces: Vec<DataFrame> = (0..df.height())
             .step_by(3)
             .map(|at| df.slice(at as i64, 3))
             .collect();
-        let (pieced, spilled) = write("pieced.parquet", &pieces);
+        let (pieced, spilled, chunks) = write_pieces(&df, &pieces);
         assert!(spilled >= 3, "{spilled} scratch files");
+        assert!(chunks <= PENDING_SPILL_CHUNKS + 1, "{chunks} chunks waited");
         assert!(pieced == whole, "the bytes differ");
-        let left = std::fs::read_dir(d.path()).unwrap().count();
-        assert_eq!(left, 2, "scratch files left");
     }
 
     /// Rows pushed in small pieces, past the pending limit so that they wait in scratch
@@ -580,35 +586,18 @@ mod tests {
             df.estimated_size() > 2 * PENDING_SPILL_BYTES,
             "the test must spill"
         );
-        let write = |pieces: &[DataFrame]| -> (Vec<u8>, usize) {
-            let d = tempfile::tempdir().unwrap();
-            let dir = d.path().to_path_buf();
-            let mut w = TableWriter::create(&dir, "t.parquet", &df.clear())
-                .unwrap()
-                .with_pending_spill();
-            let mut most_spilled = 0;
-            for p in pieces {
-                w.push(p).unwrap();
-                most_spilled = most_spilled.max(w.spilled.len());
-            }
-            w.finish(&[]).unwrap();
-            let bytes = std::fs::read(dir.join("t.parquet")).unwrap();
-            let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
-            assert_eq!(left.len(), 1, "scratch files left: {left:?}");
-            (bytes, most_spilled)
-        };
-        let (whole, _) = write(std::slice::from_ref(&df));
+        let (whole, _, _) = write_pieces(&df, std::slice::from_ref(&df));
         let pieces: Vec<DataFrame> = (0..df.height())
             .step_by(5000)
             .map(|at| df.slice(at as i64, 5000))
             .collect();
-        let (pieced, spilled) = write(&pieces);
+        let (pieced, spilled, _) = write_pieces(&df, &pieces);
         assert!(spilled > 0, "no piece waited in a scratch file");
         assert!(pieced == whole, "the bytes differ");
         // Small pieces that wait in scratch files, then one push of two groups' rows that
         // meets them, the total ending exactly on a group boundary.
         let exact = table(3 * ROW_GROUP_ROWS);
-        let (whole, _) = write(std::slice::from_ref(&exact));
+        let (whole, _, _) = write_pieces(&exact, std::slice::from_ref(&exact));
         let small = 40 * 1000;
         let mut pieces: Vec<DataFrame> = (0..small)
             .step_by(1000)
@@ -616,7 +605,7 @@ mod tests {
             .collect();
         pieces.push(exact.slice(small as i64, 2 * ROW_GROUP_ROWS));
         pieces.push(exact.slice((small + 2 * ROW_GROUP_ROWS) as i64, usize::MAX));
-        let (pieced, spilled) = write(&pieces);
+        let (pieced, spilled, _) = write_pieces(&exact, &pieces);
         assert!(spilled > 0, "no piece waited in a scratch file");
         assert!(
             pieced == whole,
