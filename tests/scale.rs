@@ -538,3 +538,36 @@ fn an_incremental_shard_rebuilds_only_its_missing_clips() {
     build_cli(&inputs, &full, &["--shard", "1/2"]);
     assert_same_library(&full, &part);
 }
+
+// See: issue 16 item 1 — "the per-character reductions (limits …) run on compact
+// per-character summaries": a build folds each clip's stance facts into one entry per mass
+// and support (`stances::limits::group_facts`); the limits it writes in the manifest are
+// those recomputed from every stance of the library (`query::limits::absolute_limits`,
+// one fact a stance), bit for bit.
+#[test]
+fn the_manifest_limits_are_those_of_every_stance() {
+    let lib = super::util::fixture_library();
+    let library = stancelib::library::read::open_library(lib).unwrap();
+    let every = stancelib::query::limits::absolute_limits(&library);
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(lib.join("manifest.json")).unwrap()).unwrap();
+    let written = manifest["limits"].as_object().expect("manifest limits");
+    assert!(!written.is_empty());
+    assert_eq!(written.len(), every.len());
+    for (id, w) in written {
+        let e = &every[id];
+        for (key, value) in [
+            ("f_max_n", e.f_max),
+            ("chi_min_m", e.chi_min),
+            ("chi_max_m", e.chi_max),
+            ("mu", e.mu),
+        ] {
+            let got = w[key].as_f64().unwrap();
+            assert_eq!(
+                got.to_bits(),
+                value.to_bits(),
+                "{id} {key}: {got} vs {value}"
+            );
+        }
+    }
+}

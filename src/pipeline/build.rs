@@ -114,7 +114,7 @@ pub struct BuildReport {
 pub struct BuildSummary {
     /// The outcome of every rebuilt input file, sorted by clip (the rest of its record is
     /// in the library; the flights and warnings of a large build's summaries grew its
-    /// memory by about 10 kB a clip, the records without them by about 2 kB).
+    /// memory by about 10 kB a clip, the records without them by about 1.9 kB).
     pub records: Vec<ClipStatus>,
     /// Stances of the rebuilt clips.
     pub stances: usize,

@@ -43,12 +43,18 @@ pub struct StanceFacts {
 /// entry each, in the order of their first stance: the limits of [`limits`] are the same,
 /// bit for bit (each is a largest or smallest value times a factor that depends only on
 /// the clip and the mass, and rounding keeps the order of products by one positive
-/// factor), and a build keeps one entry a clip instead of one a stance.
+/// factor), and a build keeps one entry a clip instead of one a stance. That needs a
+/// positive mass and leg length, as the ingest gives them; a stance whose mass is not
+/// finite and positive keeps an entry of its own.
 pub fn group_facts(facts: Vec<StanceFacts>) -> Vec<StanceFacts> {
     let mut out: Vec<StanceFacts> = Vec::new();
     let mut at: std::collections::HashMap<(String, String, u64, bool), usize> =
         std::collections::HashMap::new();
     for f in facts {
+        if !(f.mass_kg.is_finite() && f.mass_kg > 0.0) {
+            out.push(f);
+            continue;
+        }
         let key = (
             f.clip.clone(),
             f.character_id.clone(),
