@@ -6,6 +6,10 @@
 //! with a message without it).
 //!
 //! # Results
+//! - `cargo bench --profile profiling --bench edit` (`make bench`), 2026-12-06, after the
+//!   jump changes (edge corrections within 0.2 s, the flight blend of turned roots, the
+//!   step kept inside a stance): 3.70 ms (criterion 3.67–3.75) at load about 1.3; 3.78 ms
+//!   on an idle machine before the flight blend. Under the 5 ms target.
 //! - `cargo bench --bench edit -- --warm-up-time 1 --measurement-time 5` (the `bench`
 //!   profile, release settings), 2026-12-06, with the recording's COM detail
 //!   (`edit::detail`) and the split cycle height: 3.94 ms (criterion 3.91–3.96) against
