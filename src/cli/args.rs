@@ -357,8 +357,10 @@ pub struct EditJumpArgs {
     /// Jump distance, m (default: the recorded pair's).
     #[arg(long, allow_hyphen_values = true)]
     pub distance: Option<f64>,
-    /// `LIFTOFF_ID:LANDING_ID`; default: the best feasible pair (with `--height` and
-    /// `--distance`), or the library's first recorded jump (without them).
+    /// `LIFTOFF_ID:LANDING_ID`, both of one clip; default: the best feasible pair of one
+    /// clip (with `--height` and `--distance`), or the library's first recorded jump
+    /// (without them). A landing that does not follow its liftoff in the clip is turned
+    /// onto the liftoff's heading.
     #[arg(long)]
     pub pair: Option<String>,
 }
