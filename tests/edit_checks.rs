@@ -5,7 +5,7 @@
 
 use super::edit_motion::{
     assert_bounds_except, cycle_of, edit, edit_cycle, first_cycle_against_source, first_jump,
-    fixture, library, measure, recorded_jump_against_source,
+    fixture, library, measure, read_plan, recorded_jump_against_source,
 };
 use super::util::{ok, refused, shared_or_skip};
 
@@ -177,18 +177,10 @@ fn a_paired_jump_lands_in_the_liftoffs_heading() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    let plan = stancelib::library::read::read_parquet(&out.with_extension("plan.parquet")).unwrap();
-    let col = |n: &str| -> Vec<f64> {
-        plan.column(n)
-            .unwrap()
-            .f64()
-            .unwrap()
-            .into_no_null_iter()
-            .collect()
-    };
-    let (t, x, y) = (col("time_clip_s"), col("com_x_m"), col("com_y_m"));
-    let n = t.len();
-    let speed = (x[n - 1] - x[n - 2]).hypot(y[n - 1] - y[n - 2]) / (t[n - 1] - t[n - 2]);
+    let plan = read_plan(&out);
+    let (t, c, n) = (&plan.time, &plan.com, plan.time.len());
+    let speed =
+        (c[n - 1][0] - c[n - 2][0]).hypot(c[n - 1][1] - c[n - 2][1]) / (t[n - 1] - t[n - 2]);
     assert!(speed < 0.3, "the landing ends at {speed} m/s");
     assert_bounds_except(&measure(&out), &[]);
 }

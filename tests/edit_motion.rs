@@ -53,16 +53,16 @@ fn fixture_run_cycle(dir: &Path) -> (PathBuf, PathBuf, String, f64) {
 }
 
 /// The plan sidecar, by column.
-struct Plan {
-    time: Vec<f64>,
-    com: Vec<[f64; 3]>,
+pub(super) struct Plan {
+    pub(super) time: Vec<f64>,
+    pub(super) com: Vec<[f64; 3]>,
     pose_com: Vec<[f64; 3]>,
     window: Vec<Option<(f64, f64)>>,
     stance: Vec<Option<String>>,
     converged: Vec<bool>,
 }
 
-fn read_plan(out: &Path) -> Plan {
+pub(super) fn read_plan(out: &Path) -> Plan {
     let df = read_parquet(&out.with_extension("plan.parquet")).unwrap();
     let f = |n: &str| -> Vec<Option<f64>> { df.column(n).unwrap().f64().unwrap().iter().collect() };
     let v3 = |p: &str| -> Vec<[f64; 3]> {
