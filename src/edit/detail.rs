@@ -92,8 +92,7 @@ pub const EDGE_WINDOW_S: f64 = 0.2;
 /// `(a_w, b_w, c)` of the module docs and their derivatives at `u`: the edge shapes act
 /// over the first and the last share `w` of the stance (zero beyond, C² where they stop).
 fn windowed_shapes(u: f64, w: f64) -> ([f64; 3], [f64; 3]) {
-    let (full, dfull) = shapes(u);
-    let (mut s, mut ds) = (full, dfull);
+    let (mut s, mut ds) = shapes(u);
     if w < 1.0 {
         let (a, da) = shapes((u / w).min(1.0));
         let (b, db) = shapes(((u - 1.0 + w) / w).max(0.0));
@@ -211,18 +210,6 @@ pub struct Join {
     /// The share of the stance the edge corrections act over, `min(1, W/Δt)`
     /// ([`EDGE_WINDOW_S`]).
     pub window: f64,
-}
-
-impl Join {
-    /// Both edges joined, the corrections over at most `window_s` seconds (for the
-    /// recorded character [`EDGE_WINDOW_S`]) of a stance of `span_s` seconds.
-    pub fn both(window_s: f64, span_s: f64) -> Join {
-        Join {
-            start: true,
-            end: true,
-            window: window_s / span_s,
-        }
-    }
 }
 
 /// Removes the mean travel offset of `details` from each (module docs: `q_h`), so that

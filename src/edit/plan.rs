@@ -228,10 +228,11 @@ pub fn details(
                 (own.t_td, own.t_lo),
             );
             let sol = &e.scaled.solution;
-            let window_s = EDGE_WINDOW_S * reference.length_scale.sqrt();
-            let mut join = Join::both(window_s, sol.t_lo - sol.t_td);
-            join.start = !(jump && first == Some(i));
-            join.end = !(jump && last == Some(i));
+            let join = Join {
+                start: !(jump && first == Some(i)),
+                end: !(jump && last == Some(i)),
+                window: EDGE_WINDOW_S * reference.length_scale.sqrt() / (sol.t_lo - sol.t_td),
+            };
             StanceDetail::from_samples(&u, &rho).map(|d| d.joined(join))
         })
         .collect();
