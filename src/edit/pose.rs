@@ -252,9 +252,10 @@ impl Reference {
                 (f0..=f1).map(|f| self.feet[f][side].0).collect(),
                 (f0..=f1).map(|f| self.toe_tips[f][side]).collect(),
             ];
+            let step = super::FOOT_STEP_M * self.length_scale;
             let slides = tracks
-                .clone()
-                .map(|p| sliding_frames(&p, super::FOOT_REST_BAND_M, super::FOOT_STEP_M));
+                .each_ref()
+                .map(|p| sliding_frames(p, super::FOOT_REST_BAND_M, step));
             let mut d = vec![[0.0; 2]];
             for i in 1..tracks[0].len() {
                 let (mut step, mut count) = ([0.0; 2], 0.0);
