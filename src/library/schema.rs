@@ -482,7 +482,8 @@ pub mod stances {
     pub const BOUNDARY_START: &str = "boundary_start";
     /// `boundary_end`: What follows the stance.
     pub const BOUNDARY_END: &str = "boundary_end";
-    /// `rest_at_edge`: The stance starts or ends at rest.
+    /// `rest_at_edge`: The stance starts or ends at a clip edge at rest (SG COM speed below
+    /// 0.15 m/s there; cut where a quiet stretch reaching the edge begins or ends).
     pub const REST_AT_EDGE: &str = "rest_at_edge";
     /// `flight_before`: The preceding flight (struct, [`super::flight_ref`]).
     pub const FLIGHT_BEFORE: &str = "flight_before";
@@ -705,7 +706,8 @@ pub mod edit_plan {
     pub const PLOT_EXTENSION: &str = "png";
     /// `time_clip_s`: Time of the frame in the written clip, s.
     pub const TIME: &str = "time_clip_s";
-    /// `phase`: `stance` or `flight`.
+    /// `phase`: `stance`, `flight`, or `rest` (a jump's lead-in: the recording's own frames
+    /// before its first touchdown).
     pub const PHASE: &str = "phase";
     /// `stance_id`: The source stance of a stance frame (null in flight).
     pub const STANCE_ID: &str = "stance_id";
