@@ -8,6 +8,7 @@ use super::edit_motion::{
     fixture, library, measure, read_plan, recorded_jump_against_source,
 };
 use super::util::{ok, refused, shared_or_skip};
+use stancelib::library::read::read_parquet;
 
 // See: issue 14 item 3 — "iterate root correction and leg IK until the COM error is below
 // 1 mm; report frames that do not converge": at 1.2 × the recorded apex 11 frames at the
@@ -222,65 +223,123 @@ fn a_pair_of_two_clips_is_refused() {
 }
 
 // See: issue 14 checks — "the rebuilt stances reproduce the request: apex height and
-// distance within 2 cm (jumps)", on a real forward jump asked a new distance, and a new
-// height and distance (the fixture jump is vertical: its distance is fixed). Measured
-// 2026-12-06 (first measured then): at the recorded height, 0.9 / 1.0 / 1.1 × the
-// recorded distance rebuild 1.8 / 1.5 / 1.2 cm short; 3 cm higher, 4.3 / 3.9 / 3.6 cm
-// short (the code before that day's jump changes: 3.3 cm long at 1.1 ×). KNOWN MISS with a
-// ceiling: the distance of a jump asked a new height too (issue 14 stays open;
-// docs/edited-motion.md, "Known miss: a new height moves the rebuilt distance").
+// distance within 2 cm (jumps)", on the real forward jumps asked a new distance, and a new
+// height and distance (the fixture jump is vertical: its distance is fixed). First measured
+// 2026-12-06 on `cmu_13_32`: at the recorded height, 0.9 / 1.0 / 1.1 × the recorded
+// distance rebuilt 1.8 / 1.5 / 1.2 cm short; 3 cm higher, 4.3 / 3.9 / 3.6 cm short. Both
+// edges of the rebuilt jump were cut where the edit began and ended, not where the
+// recording's were: with the recording's rest written before the liftoff
+// (`edit::LEAD_IN_S`) and a quiet stretch at the clip's end cutting a stance however
+// short (`stances::segment`, `settled_end`), they rebuild within −0.05 … +0.59 cm, and
+// three of `cmu_01_01`'s four jumps within 1.4 cm. The fourth, `LR:1003`, starts with
+// 2.4 s of shifting weight before its push: its model distance is ill-conditioned (its
+// identity edit rebuilds 2.2 cm long, and 6.8 cm long when started half a frame later,
+// while the travel is the recording's to 0.4 cm). KNOWN MISS with a ceiling; the
+// well-conditioned
+// figure, the change of the travel measured, is within the bound for every jump
+// (docs/edited-motion.md, "A new height and distance"). Second KNOWN MISS, found by this
+// test: a foot of `LR:1697`'s pair slides 1.16 cm at +3 cm and 1.1 × (bound 1 cm): the
+// recorded right ankle swivels 1.19 cm about its toe tip (which stays within 1.2 mm) in
+// that stance, and the check measures the ankle.
 #[test]
-fn a_real_forward_jump_at_a_new_height_and_distance_round_trips() {
-    let Some(data) = shared_or_skip("a_real_forward_jump_at_a_new_height_and_distance_round_trips")
+fn real_forward_jumps_at_a_new_height_and_distance_round_trip() {
+    let Some(data) = shared_or_skip("real_forward_jumps_at_a_new_height_and_distance_round_trip")
     else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let src = data.join("bvh/jump/cmu_13_32_forward_jump_daz.bvh");
-    let lib = library(dir.path(), std::slice::from_ref(&src));
-    let l = stancelib::library::read::open_library(&lib).unwrap();
-    let (i, j) = first_jump(&l.stances).expect("a recorded jump");
-    let (h0, d0) = stancelib::query::jump::recorded_jump(&l.stances[i], &l.stances[j]);
-    let pair = format!("{}:{}", l.stances[i].stance_id, l.stances[j].stance_id);
-    for (name, h, d, distance_ceiling) in [
-        ("new distance", h0, 1.1 * d0, 0.02),
-        ("new height and distance", h0 + 0.03, 1.1 * d0, 0.045),
-    ] {
-        let out = dir.path().join(format!("{}.bvh", name.replace(' ', "_")));
-        edit(&[
-            "edit",
-            "jump",
-            "--lib",
-            lib.to_str().unwrap(),
-            "--pair",
-            &pair,
-            "--height",
-            &h.to_string(),
-            "--distance",
-            &d.to_string(),
-            "--allow-infeasible",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_bounds_except(&measure(&out), &[]);
-        let sub = dir.path().join(format!("rebuilt {name}"));
-        let rl = library(&sub, std::slice::from_ref(&out));
-        let r = stancelib::library::read::open_library(&rl).unwrap();
-        let (a, b) = first_jump(&r.stances).expect("the rebuilt clip has a jump");
-        let (hr, dr) = stancelib::query::jump::recorded_jump(&r.stances[a], &r.stances[b]);
-        let status = if distance_ceiling > 0.02 {
-            "KNOWN MISS"
-        } else {
-            "bound"
-        };
-        eprintln!(
-            "{name}: apex {hr:.4} m (asked {h:.4}), distance {dr:.4} m (asked {d:.4}, {status} \
-             {distance_ceiling})"
-        );
-        assert!((hr - h).abs() <= 0.02, "{name}: apex {hr} vs {h}");
-        assert!(
-            (dr - d).abs() <= distance_ceiling,
-            "{name}: distance {dr} vs {d} ({status} {distance_ceiling})"
-        );
+    let mut cases = 0;
+    for clip in ["cmu_13_32_forward_jump_daz", "cmu_01_01_forward_jumps_mb"] {
+        let src = data.join(format!("bvh/jump/{clip}.bvh"));
+        let lib = library(&dir.path().join(clip), std::slice::from_ref(&src));
+        let l = stancelib::library::read::open_library(&lib).unwrap();
+        let travel = measured_travel(&lib);
+        let pairs: Vec<(usize, usize)> = (1..l.stances.len())
+            .filter(|&i| {
+                stancelib::query::jump::is_liftoff(&l.stances[i - 1])
+                    && stancelib::query::jump::is_landing(&l.stances[i])
+            })
+            .map(|i| (i - 1, i))
+            .collect();
+        assert!(!pairs.is_empty(), "{clip}: a recorded jump");
+        for (i, j) in pairs {
+            let (s1, s2) = (&l.stances[i], &l.stances[j]);
+            let (h0, d0) = stancelib::query::jump::recorded_jump(s1, s2);
+            let t0 = travel[&s1.stance_id] + travel[&s2.stance_id];
+            let pair = format!("{}:{}", s1.stance_id, s2.stance_id);
+            let requests: &[(f64, f64)] = if clip.starts_with("cmu_13") {
+                &[(0.0, 0.9), (0.0, 1.1), (0.03, 0.9), (0.03, 1.1)]
+            } else {
+                &[(0.03, 1.1)]
+            };
+            for &(dh, k) in requests {
+                let (h, d) = (h0 + dh, k * d0);
+                cases += 1;
+                let out = dir.path().join(format!("jump{cases}.bvh"));
+                edit(&[
+                    "edit",
+                    "jump",
+                    "--lib",
+                    lib.to_str().unwrap(),
+                    "--pair",
+                    &pair,
+                    "--height",
+                    &h.to_string(),
+                    "--distance",
+                    &d.to_string(),
+                    "--allow-infeasible",
+                    "--out",
+                    out.to_str().unwrap(),
+                ]);
+                // KNOWN MISS: the landing after `LR:1697` slides 1.16 cm at +3 cm, 1.1 ×.
+                let misses: &[(&str, f64)] = if s1.stance_id.ends_with(":LR:1697") {
+                    &[("slide_m", 0.0125)]
+                } else {
+                    &[]
+                };
+                assert_bounds_except(&measure(&out), misses);
+                let rl = library(&dir.path().join(format!("rebuilt{cases}")), &[out]);
+                let r = stancelib::library::read::open_library(&rl).unwrap();
+                let (a, b) = first_jump(&r.stances).expect("the rebuilt clip has a jump");
+                let (hr, dr) = stancelib::query::jump::recorded_jump(&r.stances[a], &r.stances[b]);
+                let rt = measured_travel(&rl);
+                let moved = rt[&r.stances[a].stance_id] + rt[&r.stances[b].stance_id] - t0;
+                let ceiling = if s1.stance_id.ends_with(":LR:1003") {
+                    0.035
+                } else {
+                    0.02
+                };
+                eprintln!(
+                    "{pair} +{dh} m, {k} ×: apex {:+.4} m, model distance {:+.4} m (bound \
+                     {ceiling}), travel change {:+.4} m against {:+.4} m asked",
+                    hr - h,
+                    dr - d,
+                    moved,
+                    d - d0
+                );
+                assert!((hr - h).abs() <= 0.02, "{pair}: apex {hr} vs {h}");
+                assert!((dr - d).abs() <= ceiling, "{pair}: distance {dr} vs {d}");
+                assert!(
+                    (moved - (d - d0)).abs() <= 0.02,
+                    "{pair}: travel change {moved}"
+                );
+            }
+        }
     }
+    assert_eq!(
+        cases, 8,
+        "four requests of cmu_13_32, one of each cmu_01_01 jump"
+    );
+}
+
+/// `x_measured_m` of every stance of a library, by stance id (the COM's travel along the
+/// heading from its touchdown apex to its liftoff apex, measured, not the model's).
+fn measured_travel(lib: &std::path::Path) -> std::collections::HashMap<String, f64> {
+    let df = read_parquet(&lib.join("stances.parquet")).unwrap();
+    let id = df.column("stance_id").unwrap().str().unwrap().clone();
+    let x = df.column("x_measured_m").unwrap().f64().unwrap().clone();
+    id.iter()
+        .zip(x.iter())
+        .map(|(i, x)| (i.unwrap().to_string(), x.unwrap()))
+        .collect()
 }

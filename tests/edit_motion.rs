@@ -59,6 +59,7 @@ pub(super) struct Plan {
     pose_com: Vec<[f64; 3]>,
     window: Vec<Option<(f64, f64)>>,
     stance: Vec<Option<String>>,
+    phase: Vec<String>,
     converged: Vec<bool>,
 }
 
@@ -91,6 +92,7 @@ pub(super) fn read_plan(out: &Path) -> Plan {
         pose_com: v3("pose_com"),
         window: td.iter().zip(&lo).map(|(a, b)| a.zip(*b)).collect(),
         stance: s("stance_id"),
+        phase: s("phase").into_iter().map(Option::unwrap).collect(),
         converged: df
             .column("converged")
             .unwrap()
@@ -199,6 +201,9 @@ pub(super) fn measure(out: &Path) -> Figures {
             // 5 mm of its lowest height in the stance) must not move; a point still landing
             // or already rolling off is not a contact point. Horizontal distance from the
             // point's median position over its resting frames; the better-resting point.
+            // A point that lifts and rests again more than `edit::FOOT_STEP_M` away has
+            // stepped inside the stance (as `cmu_01_01_forward_jumps_mb:LR:1003`'s foot does
+            // in the recording): each of its rests is measured on its own.
             let ankle = frames.effector_pos[k].as_ref().unwrap();
             let idx: Vec<usize> = (0..plan.time.len())
                 .filter(|&i| plan.time[i] >= *td && plan.time[i] <= *lo)
@@ -210,15 +215,41 @@ pub(super) fn measure(out: &Path) -> Figures {
                     .copied()
                     .filter(|&i| p[i][2] <= zmin + 0.005)
                     .collect();
-                let med = |a: usize| {
-                    let mut v: Vec<f64> = on.iter().map(|&i| p[i][a]).collect();
-                    v.sort_by(f64::total_cmp);
-                    v[v.len() / 2]
+                let med = |set: &[usize]| {
+                    let m = |a: usize| {
+                        let mut v: Vec<f64> = set.iter().map(|&i| p[i][a]).collect();
+                        v.sort_by(f64::total_cmp);
+                        v[v.len() / 2]
+                    };
+                    (m(0), m(1))
                 };
-                let (mx, my) = (med(0), med(1));
-                let slide = on
+                let mut rests: Vec<Vec<usize>> = Vec::new();
+                let mut run: Vec<usize> = Vec::new();
+                for (n, &i) in on.iter().enumerate() {
+                    run.push(i);
+                    if on.get(n + 1) != Some(&(i + 1)) {
+                        let (rx, ry) = med(&run);
+                        match rests.last_mut() {
+                            Some(last)
+                                if {
+                                    let (lx, ly) = med(last);
+                                    (rx - lx).hypot(ry - ly) <= stancelib::edit::FOOT_STEP_M
+                                } =>
+                            {
+                                last.append(&mut run)
+                            }
+                            _ => rests.push(std::mem::take(&mut run)),
+                        }
+                    }
+                }
+                let slide = rests
                     .iter()
-                    .map(|&i| (p[i][0] - mx).hypot(p[i][1] - my))
+                    .map(|set| {
+                        let (mx, my) = med(set);
+                        set.iter()
+                            .map(|&i| (p[i][0] - mx).hypot(p[i][1] - my))
+                            .fold(0.0, f64::max)
+                    })
                     .fold(0.0, f64::max);
                 (on.len(), slide)
             };
@@ -228,7 +259,11 @@ pub(super) fn measure(out: &Path) -> Figures {
             let slide = if na >= nt { sa } else { st };
             fig.slide_max_m = fig.slide_max_m.max(slide);
         }
-        if *td > dt && first_td.is_finite() {
+        // A stance that begins at rest (after a jump's lead-in, the recording's own frames)
+        // has no planned touchdown: its feet were already down.
+        let after_rest = (0..plan.time.len())
+            .any(|i| plan.phase[i] == "rest" && (plan.time[i] - td).abs() <= 1.5 * dt);
+        if *td > dt && first_td.is_finite() && !after_rest {
             fig.event_err_frames = fig.event_err_frames.max((first_td - td).abs() / dt);
         }
         if *lo < t_end - dt && last_lo.is_finite() {

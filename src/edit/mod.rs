@@ -133,6 +133,16 @@ pub const FOOT_REST_BAND_M: f64 = 0.01;
 /// 5 cm, inside a landing stance the contacts do not split, and a forward jump's foot
 /// steps 37 cm (its ankle up 9.6 cm) inside `cmu_01_01_forward_jumps_mb:LR:1003`.
 pub const FOOT_STEP_M: f64 = 0.05;
+/// Recording written before a jump's first touchdown, s (at most; less where the clip
+/// begins sooner). A jump's liftoff starts from rest: the library cuts it where a quiet
+/// period of at least `T_QUIET_S` (0.3 s) ends (`stances::segment`), and its fitted
+/// distance depends on how it begins. Written from its first touchdown, the CMU forward
+/// jump's rebuilt liftoff began at the clip's edge and its model distance came out 1.8 cm
+/// shorter than the recording's, although it travelled the same 0.681 m; with the
+/// recording's rest before it, the rebuilt stance begins where its source did. The
+/// quiet period plus the SG filter's half window (0.05 s) on each side of its edges, and
+/// some margin: 0.5 s.
+pub const LEAD_IN_S: f64 = 0.5;
 /// Default number of steady run cycles.
 pub const DEFAULT_CYCLES: usize = 4;
 /// Most run cycles of one edit (each a second or so of motion: a cap on the output).

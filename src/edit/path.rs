@@ -214,6 +214,9 @@ pub enum Phase {
         /// The stance whose touchdown ends it.
         after: Option<usize>,
     },
+    /// Before the first touchdown of a jump: the recording's own frames before its liftoff
+    /// stance (the rest it starts from, [`ComPath::lead_in_s`]).
+    Rest,
 }
 
 /// The whole planned path: stances in time order, chained.
@@ -221,10 +224,14 @@ pub enum Phase {
 pub struct ComPath {
     /// The stances, each placed by [`PlannedStance::chain`] from the one before.
     pub stances: Vec<PlannedStance>,
-    /// First output time (s).
+    /// First planned time (s): the first apex of a run, the first touchdown of a jump.
     pub t_start: f64,
     /// Last output time (s).
     pub t_end: f64,
+    /// The recording written before `t_start`, s (a jump's lead-in,
+    /// [`crate::edit::LEAD_IN_S`]; 0 for a run). Output starts at `t_start − lead_in_s`,
+    /// rounded to whole output frames.
+    pub lead_in_s: f64,
 }
 
 impl ComPath {
@@ -241,8 +248,11 @@ impl ComPath {
         self.stances[self.owner(t)].com(t)
     }
 
-    /// The phase of time `t`.
+    /// The phase of time `t` ([`Phase::Rest`] before `t_start`).
     pub fn phase(&self, t: f64) -> Phase {
+        if t < self.t_start {
+            return Phase::Rest;
+        }
         for (k, s) in self.stances.iter().enumerate() {
             let (td, lo) = s.contact_window();
             if t < td {

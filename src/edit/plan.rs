@@ -30,6 +30,7 @@
 use super::detail::{balance_travel, recorded_residual, Join, StanceDetail, EDGE_WINDOW_S};
 use super::path::{ComPath, PlannedStance};
 use super::pose::{Reference, StanceSource};
+use super::LEAD_IN_S;
 use crate::query::feasibility::Limits;
 use crate::query::pool::{PoolStance, Prepared};
 use crate::query::run::{scale_and_check, ScaledStance};
@@ -330,6 +331,15 @@ pub fn place(
     } else {
         last.end()
     };
+    // A jump's first stance starts from the recording's rest (or the clip's first frame):
+    // the recording before it is written too, so re-ingested, the stance begins as its
+    // source did (`LEAD_IN_S`).
+    let lead_in_s = if jump {
+        let td = stances[order[0]].timing.td_clip_s;
+        (td - reference.first_time_s()).clamp(0.0, LEAD_IN_S)
+    } else {
+        0.0
+    };
     let sources = stances
         .iter()
         .map(|e| {
@@ -360,6 +370,7 @@ pub fn place(
             stances: planned,
             t_start,
             t_end,
+            lead_in_s,
         },
         sources,
     )

@@ -285,6 +285,12 @@ impl Reference {
         )
     }
 
+    /// Clip time of the first kept frame (s): the reference holds no pose before it.
+    pub fn first_time_s(&self) -> f64 {
+        let n = self.motion.n_frames();
+        self.body.leadin.min(n.saturating_sub(1)) as f64 * self.motion.frame_time_s
+    }
+
     /// Frame position of clip time `t` (s): `(f0, f1, w)`, clamped to the kept frames.
     fn at(&self, t: f64) -> (usize, usize, f64) {
         let n = self.motion.n_frames();
@@ -440,7 +446,7 @@ fn turn_world(r: &Reference, pose: &mut Pose, wq: &[Quat], j: usize, delta: Quat
 /// One output frame's outcome.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FramePose {
-    /// Output time (s from the first output frame).
+    /// Output time (s from the first output frame; [`pose_frame`] gives the plan time).
     pub time_s: f64,
     /// The phase.
     pub phase: Phase,
@@ -450,7 +456,8 @@ pub struct FramePose {
     pub com_pose: V3,
     /// Planned contact point, in stance (m).
     pub contact: Option<V3>,
-    /// Planned touchdown and liftoff of the stance, in stance (s, output time).
+    /// Planned touchdown and liftoff of the stance, in stance (s, output time;
+    /// [`pose_frame`] gives plan times).
     pub window: Option<(f64, f64)>,
     /// Support ankle (left when both), in stance (m).
     pub foot: Option<V3>,
@@ -672,6 +679,7 @@ fn reference_pose(
             return (yaw_of(k), Some(k));
         }
         Phase::Flight { before, after } => (before, after),
+        Phase::Rest => (None, None),
     };
     let side_a = before.map(|b| {
         let (_, lo) = st[b].contact_window();
@@ -796,6 +804,9 @@ pub fn pose_frame(
     base: &Posture,
 ) -> FramePose {
     let phase = path.phase(t);
+    if phase == Phase::Rest {
+        return lead_in_frame(r, path, src, opts, t, ws, base);
+    }
     let st = &path.stances;
     let src_of = |k: usize| &src[st[k].source];
     // 1. Reference pose, foot anchors and yaw.
@@ -820,14 +831,58 @@ pub fn pose_frame(
         com_plan,
         com_pose: s.com_pose,
         contact,
-        window: stance.map(|k| {
-            let (td, lo) = st[k].contact_window();
-            (td - path.t_start, lo - path.t_start)
-        }),
+        window: stance.map(|k| st[k].contact_window()),
         foot,
         foot_error_m: s.foot_err,
         iterations: s.iterations,
         converged: s.err_m <= opts.com_tol_m && s.foot_err <= opts.com_tol_m,
+        posture: s.posture,
+    }
+}
+
+/// A lead-in frame ([`Phase::Rest`], plan time `t` before the first touchdown): the
+/// recording's own pose at the same time before the first stance's source touchdown, turned
+/// onto that stance's planned heading, with the root putting the COM on the recording's COM
+/// moved as the stance is placed. A jump's first stance keeps its recorded heading and
+/// touchdown COM, so the frame is the recording's. No foot is pulled.
+fn lead_in_frame(
+    r: &Reference,
+    path: &ComPath,
+    src: &[StanceSource],
+    opts: &EditOptions,
+    t: f64,
+    ws: &mut PoseWorkspace,
+    base: &Posture,
+) -> FramePose {
+    let s = &src[path.stances[0].source];
+    let (td, _) = path.stances[0].contact_window();
+    let clip_t = s.td_clip_s + (t - td);
+    r.sample(clip_t, &mut ws.pose);
+    let yaw = wrap_pi(heading_of(path, 0) - s.heading_rad);
+    ws.pose.q[r.root] = rot::mul(rot::axis_angle(up_file(&r.body), yaw), ws.pose.q[r.root]);
+    ws.free_q.clone_from(&ws.pose.q);
+    let moved = rot::rotate(
+        rot::axis_angle([0.0, 0.0, 1.0], yaw),
+        sub(r.com_at(clip_t), r.com_at(s.td_clip_s)),
+    );
+    let com_plan = add(path.com(td).0, moved);
+    let goal = FrameGoal {
+        com: com_plan,
+        pulls: [None, None],
+        planted: [false, false],
+    };
+    let s = solve_frame(r, opts, &goal, base, ws);
+    FramePose {
+        time_s: t,
+        phase: Phase::Rest,
+        com_plan,
+        com_pose: s.com_pose,
+        contact: None,
+        window: None,
+        foot: None,
+        foot_error_m: s.foot_err,
+        iterations: s.iterations,
+        converged: s.err_m <= opts.com_tol_m,
         posture: s.posture,
     }
 }
@@ -1161,8 +1216,9 @@ fn write_angles(r: &Reference, ws: &mut PoseWorkspace) {
     prev.copy_from_slice(&ws.pose.row);
 }
 
-/// Poses every output frame `t = t_start + i·Δt` of the plan (`frame_time_s` = Δt, s: the
-/// source clip's own value unless `--fps`, so that the written `Frame Time` is the source's).
+/// Poses every output frame `t = t_start + (i − n_lead)·Δt` of the plan (`frame_time_s` =
+/// Δt, s: the source clip's own value unless `--fps`, so that the written `Frame Time` is
+/// the source's; `n_lead = ⌊lead_in_s / Δt⌋` frames of lead-in: the recording before the first touchdown, [`Phase::Rest`]).
 /// Two passes: every frame from the reference's posture (the posture solved where a support
 /// leg falls short), then the frames whose solved posture, ramped in and out over
 /// `opts.posture_ramp_s` ([`posture::envelope`]), differs again from that base.
@@ -1174,10 +1230,12 @@ pub fn pose_motion(
     frame_time_s: f64,
 ) -> EditedMotion {
     let dt = frame_time_s;
-    let n = ((path.t_end - path.t_start) / dt + 1e-9).floor() as usize + 1;
+    let n_lead = (path.lead_in_s / dt + 1e-9).floor() as usize;
+    let n = n_lead + ((path.t_end - path.t_start) / dt + 1e-9).floor() as usize + 1;
     let nc = r.body.skeleton.n_channels;
     let mut ws = PoseWorkspace::new(r);
-    let time = |i: usize| path.t_start + i as f64 * dt;
+    let time = |i: usize| path.t_start + (i as f64 - n_lead as f64) * dt;
+    let t_first = time(0);
     let mut poses = Vec::with_capacity(n);
     let mut frames = Vec::with_capacity(n);
     for i in 0..n {
@@ -1201,6 +1259,7 @@ pub fn pose_motion(
     let mut values = Vec::with_capacity(n * nc);
     for (i, (f, p)) in frames.iter_mut().zip(&poses).enumerate() {
         f.time_s = i as f64 * dt;
+        f.window = f.window.map(|(td, lo)| (td - t_first, lo - t_first));
         ws.pose.clone_from(p);
         write_angles(r, &mut ws);
         values.extend_from_slice(&ws.pose.row);

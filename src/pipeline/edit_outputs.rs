@@ -62,12 +62,13 @@ pub fn plan_table(e: &EditOutputs) -> PolarsResult<DataFrame> {
     let f = &e.edited.frames;
     let stance = |p: &Phase| match p {
         Phase::Stance(k) => Some(&e.stances[e.order[*k]]),
-        Phase::Flight { .. } => None,
+        Phase::Flight { .. } | Phase::Rest => None,
     };
     let dt = e.edited.motion.frame_time_s;
     let phase = |p: &Phase| match p {
         Phase::Stance(_) => "stance",
         Phase::Flight { .. } => "flight",
+        Phase::Rest => "rest",
     };
     let mut cols = vec![
         Column::new(
