@@ -547,6 +547,85 @@ fn infeasible_run_is_refused_naming_the_constraint_and_writes_nothing() {
     assert!(v > 0, "violated column names the failing constraint");
 }
 
+// See: issue 14, review of the jump lead-in (2026-12-06) — a jump edit writes up to
+// `edit::LEAD_IN_S` of its recording before the first touchdown (so that re-ingested, the
+// liftoff begins at rest as its source did). Written with the recording's feet, the feet
+// jumped at the touchdown by as much as the solved contact point moved (1.04 cm on this
+// fixture at 0.7 × its apex, 5.4 cm on `cmu_13_32` at 0.4 ×); they now stand on the
+// planned footprints from the first frame.
+#[test]
+fn a_jump_edit_starts_with_its_recorded_rest_on_the_planned_footprints() {
+    let dir = tmp();
+    let src = fixture("jump_120hz_cmu_yup");
+    let lib = library(dir.path(), std::slice::from_ref(&src));
+    let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
+    let clip = &clips["jump_120hz_cmu_yup"];
+    let source = parse_file(&src).unwrap();
+    let dropped =
+        stancelib::skeleton::leadin::leadin_frames(&Skeleton::from_bvh(&source), &source.motion);
+    let first_kept_s = dropped as f64 * source.motion.frame_time_s;
+    let timing =
+        stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+    for (scale, fps) in [("1.0", None), ("0.7", None), ("0.7", Some("60"))] {
+        let out = dir
+            .path()
+            .join(format!("rest_{scale}_{}.bvh", fps.unwrap_or("src")));
+        let mut args = vec![
+            "edit",
+            "jump",
+            "--lib",
+            lib.to_str().unwrap(),
+            "--height-scale",
+            scale,
+            "--allow-infeasible",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if let Some(f) = fps {
+            args.extend(["--fps", f]);
+        }
+        edit(&args);
+        let plan = read_plan(&out);
+        let dt = plan.time[1] - plan.time[0];
+        let n_rest = plan.phase.iter().take_while(|p| *p == "rest").count();
+        assert!(
+            plan.phase[n_rest..].iter().all(|p| p != "rest"),
+            "rest rows only before the first touchdown"
+        );
+        let (td, _, first) = first_window(&out);
+        let td_clip = timing[stance_index(&lib, &first)].td_clip_s;
+        let lead = (td_clip - first_kept_s).min(stancelib::edit::LEAD_IN_S);
+        assert!(lead > 0.1, "the fixture's liftoff starts after some rest");
+        assert_eq!(n_rest, (lead / dt + 1e-9).floor() as usize, "×{scale}");
+        assert!(
+            (td - n_rest as f64 * dt).abs() < 1e-9,
+            "the touchdown follows the lead-in"
+        );
+        if scale == "1.0" {
+            // The recorded jump's lead-in is its recording.
+            let unit = clip.unit_scale.unwrap();
+            let (rms, root) = against_source(&out, &src, unit, 0.0, td_clip - td, td - dt / 2.0);
+            assert!(
+                rms < 0.01 && root < 1e-4,
+                "rest frames: {rms}° RMS, root {root} m"
+            );
+        }
+        // The ankles do not jump at the touchdown: the step onto the first stance frame is
+        // no larger than the steps of the standing lead-in (plus 1 mm).
+        let (_, frames, _) = reingest(&out);
+        for k in 0..2 {
+            let a = frames.effector_pos[k].as_ref().unwrap();
+            let step = |i: usize| (a[i][0] - a[i - 1][0]).hypot(a[i][1] - a[i - 1][1]);
+            let standing = (1..n_rest).map(step).fold(0.0, f64::max);
+            eprintln!(
+                "×{scale} {fps:?} foot {k}: step at the touchdown {:.5} m, lead-in steps ≤ {standing:.5} m",
+                step(n_rest)
+            );
+            assert!(step(n_rest) <= standing + 1e-3, "×{scale} foot {k}");
+        }
+    }
+}
+
 /// The first liftoff stance followed by a landing stance: their indices.
 pub(super) fn first_jump(s: &[stancelib::query::pool::PoolStance]) -> Option<(usize, usize)> {
     (1..s.len()).find_map(|i| {
@@ -789,7 +868,16 @@ fn against_source_from(
     let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
     let clip = first.split(':').next().unwrap();
     let unit_m = clips[clip].unit_scale.expect("unit scale");
-    against_source(out, source, unit_m, 0.0, td_clip - td, span_s)
+    // After a jump's lead-in (its `rest` rows, the recording's own frames, which would only
+    // dilute the figures); a run has none.
+    let plan = read_plan(out);
+    let t0 = plan
+        .phase
+        .iter()
+        .zip(&plan.time)
+        .find(|(p, _)| *p != "rest")
+        .map_or(0.0, |(_, t)| *t);
+    against_source(out, source, unit_m, t0, td_clip - td + t0, span_s)
 }
 
 /// Joint-angle RMS (degrees) and largest root distance (m) of the edit of a library's

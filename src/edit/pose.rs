@@ -843,8 +843,13 @@ pub fn pose_frame(
 /// A lead-in frame ([`Phase::Rest`], plan time `t` before the first touchdown): the
 /// recording's own pose at the same time before the first stance's source touchdown, turned
 /// onto that stance's planned heading, with the root putting the COM on the recording's COM
-/// moved as the stance is placed. A jump's first stance keeps its recorded heading and
-/// touchdown COM, so the frame is the recording's. No foot is pulled.
+/// moved as the stance is placed, and the feet of the first stance on its planned
+/// footprints ([`anchored`], as from its touchdown on). A jump's first stance keeps its
+/// recorded heading and touchdown COM, so the recorded jump's lead-in is its recording; a
+/// request whose solved contact point moved stands on the moved footprints from the first
+/// frame (written with the recording's feet, they jumped by that move, up to 5.4 cm, at the
+/// touchdown: found by review). The jump edits play the source's own size (`L = 1`): the
+/// clip times here are not scaled.
 fn lead_in_frame(
     r: &Reference,
     path: &ComPath,
@@ -866,10 +871,16 @@ fn lead_in_frame(
         sub(r.com_at(clip_t), r.com_at(s.td_clip_s)),
     );
     let com_plan = add(path.com(td).0, moved);
+    let planted = s.feet;
     let goal = FrameGoal {
         com: com_plan,
-        pulls: [None, None],
-        planted: [false, false],
+        pulls: [0, 1].map(|side| {
+            planted[side].then(|| {
+                let (p, q) = anchored(r, path, s, 0, yaw, clip_t, side);
+                (p, q, 1.0)
+            })
+        }),
+        planted,
     };
     let s = solve_frame(r, opts, &goal, base, ws);
     FramePose {
@@ -882,7 +893,7 @@ fn lead_in_frame(
         foot: None,
         foot_error_m: s.foot_err,
         iterations: s.iterations,
-        converged: s.err_m <= opts.com_tol_m,
+        converged: s.err_m <= opts.com_tol_m && s.foot_err <= opts.com_tol_m,
         posture: s.posture,
     }
 }

@@ -430,8 +430,10 @@ impl<'a> ClipData<'a> {
             .flatten()
     }
 
-    /// Touchdown and liftoff time of a stance, s: the clip's first (last) frame at a clip
-    /// edge, else the sub-frame event, else half a frame outside the stance's frames.
+    /// Touchdown and liftoff time of a stance, s: the clip's first (last) frame when the
+    /// stance starts (ends) on it, else the sub-frame event, else half a frame outside the
+    /// stance's frames (a `clip_edge` stance cut at a settled end, `segment::settled_end`,
+    /// ends half a frame after its last frame, as one cut at a rest does).
     fn stance_times(&self, seg: &Segment) -> (f64, f64) {
         let (fr, dt, n) = (self.fr, self.dt, self.fr.frame.len());
         let t_td = if seg.i0 == 0 {

@@ -129,7 +129,7 @@ pub fn segment(inp: &SegmentInput) -> (Vec<Segment>, Vec<String>) {
         } else {
             gap_kind(b + 1, next_gap_end(&support, b))
         };
-        let b = settled_end(inp, a, b, end);
+        let b = settled_end(inp, a, b, b + 1 == n);
         for part in quiet_split(inp, a, b, start, end) {
             for s in walking_split(inp, part) {
                 if s.i1 + 1 - s.i0 < MIN_STANCE_FRAMES {
@@ -162,9 +162,11 @@ fn next_gap_end(support: &[bool], b: usize) -> usize {
         .unwrap_or(b + 1)
 }
 
-/// The last frame of a support run `a..=b` that ends at a clip edge in a quiet stretch
-/// shorter than `T_quiet`: the stretch's first frame, where a quiet split would end it; the
-/// boundary stays `clip_edge` (with `rest_at_edge`). Any other run keeps `b`.
+/// The last frame of a support run `a..=b` that reaches the clip's last frame (`at_end`) in
+/// a quiet stretch shorter than `T_quiet`: the stretch's first frame, where a quiet split
+/// would end it; the boundary stays `clip_edge` (with `rest_at_edge`). Any other run keeps
+/// `b` (one followed by a gap, even a gap that reaches the clip's end: the body left the
+/// floor after it, the capture did not stop on it).
 ///
 /// A departure from the spec, which splits only at quiet stretches of at least `T_quiet`:
 /// how long the capture ran on after the body settled is the operator's choice, not the
@@ -179,9 +181,9 @@ fn next_gap_end(support: &[bool], b: usize) -> usize {
 /// force the jump query drops (`β_p = 0`), so its recorded-jump edit flew 9 cm/s off the
 /// recording. An edit writes its recording's lead-in (`edit::LEAD_IN_S`), so a rebuilt
 /// liftoff starts as its source did.
-fn settled_end(inp: &SegmentInput, a: usize, b: usize, end: Boundary) -> usize {
+fn settled_end(inp: &SegmentInput, a: usize, b: usize, at_end: bool) -> usize {
     let quiet = |k: usize| inp.speed[k] < V_QUIET;
-    if end != Boundary::ClipEdge || !quiet(b) {
+    if !at_end || !quiet(b) {
         return b;
     }
     let mut first = b;
@@ -391,14 +393,11 @@ mod tests {
         assert_eq!((s[1].i0, s[1].i1, s[1].start), (69, 99, Boundary::Rest));
     }
 
-    /// One support run over 100 frames at 100 Hz, slow over `slow`.
-    fn with_slow(slow: std::ops::Range<usize>) -> Vec<Segment> {
-        let contact = [
-            vec![true; 100],
-            vec![true; 100],
-            vec![false; 100],
-            vec![false; 100],
-        ];
+    /// 100 frames at 100 Hz, in support over `0..support_end` (in the air after it), slow
+    /// over `slow`.
+    fn with_slow_until(slow: std::ops::Range<usize>, support_end: usize) -> Vec<Segment> {
+        let feet: Vec<bool> = (0..100).map(|k| k < support_end).collect();
+        let contact = [feet.clone(), feet, vec![false; 100], vec![false; 100]];
         let speed: Vec<f64> = (0..100)
             .map(|k| if slow.contains(&k) { 0.05 } else { 1.0 })
             .collect();
@@ -410,6 +409,11 @@ mod tests {
             dt: 0.01,
         })
         .0
+    }
+
+    /// One support run over the whole 100 frames, slow over `slow`.
+    fn with_slow(slow: std::ops::Range<usize>) -> Vec<Segment> {
+        with_slow_until(slow, 100)
     }
 
     #[test]
@@ -430,5 +434,9 @@ mod tests {
         assert_eq!((s.len(), s[0].i0, s[0].i1), (1, 0, 99));
         let s = with_slow(99..100);
         assert_eq!((s.len(), s[0].i0, s[0].i1), (1, 0, 99));
+        // A run followed by a gap that reaches the clip's end: the body left the floor, the
+        // capture did not stop on the quiet stretch; the run stays whole.
+        let s = with_slow_until(71..90, 90);
+        assert_eq!((s.len(), s[0].i1, s[0].end), (1, 89, Boundary::ClipEdge));
     }
 }
