@@ -29,7 +29,7 @@
 //!   query's parabolas, shifted by a constant. With it and the height split, a
 //!   recorded-speed edit of the CMU run follows its recording's root within 1.6 cm
 //!   (3.0 cm with the model's path), the shared recorded jumps within 0.96, 1.42 and
-//!   1.97 cm. The force checks judge the scaled model.
+//!   1.98 cm. The force checks judge the scaled model.
 //! - The reference is the source stance's own frames; stance time is warped linearly
 //!   between touchdown and liftoff, flight time linearly on each side of the apex, and
 //!   a flight blends the pose after one stance into the pose before the next (quaternion

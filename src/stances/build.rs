@@ -251,9 +251,12 @@ fn edge_targets(h: &Heading, td: (V3, V3), lo: (V3, V3), dt: f64, m: f64) -> Edg
         m * (dv[a] + g) / dt
     });
     let dz = lo.0[2] - td.0[2];
+    let dp = h.to_stance(std::array::from_fn(|i| lo.0[i] - td.0[i]));
+    let v_td = h.to_stance(td.1);
     EdgeTargets {
         impulse,
         vertical_double: m * (dz - td.1[2] * dt + 0.5 * GRAVITY * dt * dt) / (dt * dt),
+        travel_double: [0, 1].map(|a| m * (dp[a] - v_td[a] * dt) / (dt * dt)),
     }
 }
 
