@@ -638,3 +638,41 @@ impl<'a> ClipData<'a> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stances::params::HeadingFrom;
+
+    #[test]
+    fn edge_targets_are_the_integrals_of_a_constant_force() {
+        // A constant world acceleration `a` over Δt from (p0, v0): every target is the
+        // closed form of a constant stance force `m (a − g⃗)` turned into the stance axes.
+        let (m, dt) = (70.0, 0.8);
+        let (p0, v0, a) = ([0.3, -0.2, 1.0], [1.2, 0.4, -0.5], [2.0, -1.5, 3.0]);
+        let lo = (
+            std::array::from_fn(|i| p0[i] + v0[i] * dt + 0.5 * a[i] * dt * dt),
+            std::array::from_fn(|i| v0[i] + a[i] * dt),
+        );
+        let (c, s) = (0.6f64, 0.8f64);
+        let h = Heading {
+            e_h: [c, s, 0.0],
+            from: HeadingFrom::Velocity,
+        };
+        let t = edge_targets(&h, (p0, v0), lo, dt, m);
+        let f = h.to_stance(std::array::from_fn(|i| {
+            m * (a[i] + if i == 2 { GRAVITY } else { 0.0 })
+        }));
+        // ∫₀¹ f dτ = f and ∫₀¹∫₀ˢ f = f / 2 for a constant force.
+        for (got, want) in t.impulse.iter().zip(f) {
+            assert!((got - want).abs() < 1e-9, "impulse {got} against {want}");
+        }
+        assert!((t.vertical_double - f[2] / 2.0).abs() < 1e-9);
+        for (got, want) in t.travel_double.iter().zip(f) {
+            assert!(
+                (got - want / 2.0).abs() < 1e-9,
+                "travel {got} against {want} / 2"
+            );
+        }
+    }
+}
