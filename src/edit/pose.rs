@@ -515,6 +515,11 @@ fn sliding_frames(p: &[V3], band: f64, step: f64) -> Vec<bool> {
     slide
 }
 
+/// The turn of planned stance `k` from its source's recorded heading, rad, in `(−π, π]`.
+fn yaw_of(path: &ComPath, src: &[StanceSource], k: usize) -> f64 {
+    wrap_pi(heading_of(path, k) - src[path.stances[k].source].heading_rad)
+}
+
 fn heading_of(path: &ComPath, k: usize) -> f64 {
     let h = path.stances[k].heading;
     h[1].atan2(h[0])
@@ -568,7 +573,7 @@ fn foot_goal(
 ) -> Option<(V3, Quat, f64)> {
     let st = &path.stances;
     let has = |k: usize| src[st[k].source].feet[side];
-    let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src[st[k].source].heading_rad);
+    let yaw_of = |k: usize| yaw_of(path, src, k);
     let rate = |k: usize| {
         let (td, lo) = st[k].contact_window();
         let s = &src[st[k].source];
@@ -669,7 +674,7 @@ fn reference_pose(
 ) -> (f64, Option<usize>) {
     let st = &path.stances;
     let src_of = |k: usize| &src[st[k].source];
-    let yaw_of = |k: usize| wrap_pi(heading_of(path, k) - src_of(k).heading_rad);
+    let yaw_of = |k: usize| yaw_of(path, src, k);
     let (before, after) = match path.phase(t) {
         Phase::Stance(k) => {
             let (td, lo) = st[k].contact_window();
@@ -863,7 +868,7 @@ fn lead_in_frame(
     let (td, _) = path.stances[0].contact_window();
     let clip_t = s.td_clip_s + (t - td);
     r.sample(clip_t, &mut ws.pose);
-    let yaw = wrap_pi(heading_of(path, 0) - s.heading_rad);
+    let yaw = yaw_of(path, src, 0);
     ws.pose.q[r.root] = rot::mul(rot::axis_angle(up_file(&r.body), yaw), ws.pose.q[r.root]);
     ws.free_q.clone_from(&ws.pose.q);
     let moved = rot::rotate(

@@ -38,8 +38,8 @@
 //! ∫₀¹∫₀ˢ f_v q_a = m (Δp_a − v_a,TD Δt)/Δt²,   w = r₀ / σ,   σ = m · TRAVEL_TOLERANCE_M / Δt²
 //! ```
 //! (`r₀`: RMS of the impulse-constrained fit's load-weighted residual, √N, the unit of the
-//! weighted data rows; missing the target by `σ` costs `r₀²`, one sample's typical misfit.)
-//! (`∫₀¹∫₀ˢ f_v τ^k = M_k − M_{k+1}`, `M_k = ∫₀¹ τ^k f_v`). The impulse alone left the
+//! weighted data rows; missing the target by `σ` costs `r₀²`, one sample's typical misfit;
+//! `∫₀¹∫₀ˢ f_v τ^k = M_k − M_{k+1}`, `M_k = ∫₀¹ τ^k f_v`.) The impulse alone left the
 //! model's travel free: beside a flight, the model distance `x_m` of the shared clips'
 //! stances was off their measured travel by median 0.82, p90 3.27, max 8.81 cm (bulk set
 //! 0.75 / 4.07 / 11.74), worst on stances longer than 0.6 s (median 2.55 cm), and
@@ -51,9 +51,10 @@
 //! deciding its shape and a multi-second stance's travel is held (asked to move, the
 //! shared and bulk stances of 0.2–0.3 s move a median 3 % of the shift, those over 0.9 s
 //! 93 %). The fit falls back to the impulse alone, silently, where the weight is not
-//! finite and positive (a residual of 0) or the constrained solve fails. The tolerance, on the plate run (|μ_req − plate|)
-//! and the round trip of the real forward jumps (`edit jump` rebuilt, worst
-//! |model distance − asked| over cmu_13_32's four requests and cmu_01_01's four jumps):
+//! finite and positive (a residual of 0) or the constrained solve fails. The tolerance, on
+//! the plate run (|μ_req − plate|) and the round trip of the real forward jumps (`edit
+//! jump` rebuilt, worst |model distance − asked| over cmu_13_32's four requests and
+//! cmu_01_01's four jumps):
 //!
 //! | travel tolerance | Δμ5 median | Δμ5 p90 | Δμ20 median | μ5 ≤ 0.7 (plates 93 %) | worst jump distance |
 //! |---|---|---|---|---|---|
@@ -334,7 +335,7 @@ fn vertical_fit(
     (mass_kg, dt_s): (f64, f64),
     tol_m: Option<f64>,
 ) -> Result<(Vec<f64>, usize)> {
-    let (n, d) = (basis.nrows(), basis.ncols() - 1);
+    let d = basis.ncols() - 1;
     let df = d as f64;
     // ∫₀¹ B_i^d = 1/(d+1);  ∫₀¹∫₀ˢ B_i^d = ∫₀¹ (1−τ) B_i^d = (d+1−i)/((d+1)(d+2)).
     let impulse = [(vec![1.0 / (df + 1.0); d + 1], t.impulse[2])];
@@ -342,29 +343,44 @@ fn vertical_fit(
     let Some(tol_m) = tol_m.filter(|_| met == 1) else {
         return Ok((b0, met));
     };
-    let fit0 = basis * DVector::from_column_slice(&b0);
-    let r0 = (fit0
-        .iter()
-        .zip(s)
-        .map(|(f, v)| (f - v).powi(2))
-        .sum::<f64>()
-        / n as f64)
-        .sqrt();
+    let double: Vec<f64> = (0..=d)
+        .map(|i| (df + 1.0 - i as f64) / ((df + 1.0) * (df + 2.0)))
+        .collect();
     let sigma = mass_kg * tol_m / (dt_s * dt_s);
-    let w = r0 / sigma;
-    if !(w.is_finite() && w > 0.0) {
+    let Some((rows, rhs)) = with_soft_row(basis, s, &b0, (&double, t.vertical_double, sigma))
+    else {
         return Ok((b0, 1));
-    }
-    let mut rows = basis.clone().insert_row(n, 0.0);
-    for i in 0..=d {
-        rows[(n, i)] = w * (df + 1.0 - i as f64) / ((df + 1.0) * (df + 2.0));
-    }
-    let mut rhs = s.to_vec();
-    rhs.push(w * t.vertical_double);
+    };
     match nnls(&rows, &rhs, &impulse)? {
         (b, 1) => Ok((b, 2)),
         _ => Ok((b0, 1)),
     }
+}
+
+/// The least-squares rows `x`, `s` with the soft row `w·(row·c) = w·target` appended, `w =
+/// r₀/σ` (`r₀`: RMS residual of the fit `c0` on the rows, in their unit; `σ`: the target's
+/// tolerance in the row's unit), so that missing the target by `σ` costs one sample's
+/// typical misfit (module docs). `None` where `w` is not finite and positive (a residual
+/// of 0: nothing to weigh the target against).
+fn with_soft_row(
+    x: &DMatrix<f64>,
+    s: &[f64],
+    c0: &[f64],
+    (row, target, sigma): (&[f64], f64, f64),
+) -> Option<(DMatrix<f64>, Vec<f64>)> {
+    let n = x.nrows();
+    let res = x * DVector::from_column_slice(c0) - DVector::from_column_slice(s);
+    let w = (res.norm_squared() / n as f64).sqrt() / sigma;
+    if !(w.is_finite() && w > 0.0) {
+        return None;
+    }
+    let mut rows = x.clone().insert_row(n, 0.0);
+    for (k, r) in row.iter().enumerate().take(x.ncols()) {
+        rows[(n, k)] = w * r;
+    }
+    let mut rhs = s.to_vec();
+    rhs.push(w * target);
+    Some((rows, rhs))
 }
 
 /// Weighted least squares `argmin_r Σ_j (f_v(τ_j) q(τ_j) − s_j)² / (f_v(τ_j) + ε)`, `q` of
@@ -401,19 +417,10 @@ fn ratio_fit(
             let Some((row, t2, sigma)) = travel else {
                 return r;
             };
-            let n = x.nrows();
-            let res = &x * DVector::from_column_slice(&r) - DVector::from_column_slice(s);
-            let w = (res.norm_squared() / n as f64).sqrt() / sigma;
-            if !(w.is_finite() && w > 0.0) {
-                return r;
-            }
-            let mut xa = x.clone().insert_row(n, 0.0);
-            for k in 0..=deg {
-                xa[(n, k)] = w * row[k];
-            }
-            let mut sa = s.to_vec();
-            sa.push(w * t2);
-            return solve(&xa, &sa).unwrap_or(r);
+            return match with_soft_row(&x, s, &r, (row, t2, sigma)) {
+                Some((xa, sa)) => solve(&xa, &sa).unwrap_or(r),
+                None => r,
+            };
         }
     }
     let Some(svd) = crate::math::svd::svd(x, true, true) else {
