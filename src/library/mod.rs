@@ -16,6 +16,7 @@ pub mod plates;
 pub mod provenance;
 #[doc(hidden)]
 pub mod read;
+pub mod row_groups;
 pub mod schema;
 pub mod scratch;
 pub mod spill;

@@ -88,6 +88,17 @@ pub fn sort_keys(file: &str) -> &'static [&'static str] {
     }
 }
 
+/// The column whose every change ends a row group of a table, if any: the per-frame
+/// tables are cut into one row group per clip (longer clips into groups of at most
+/// `ROW_GROUP_ROWS` rows), so that a merge copies a clip's groups from its shard without
+/// decoding them and still writes the bytes of a single build.
+pub fn group_column(file: &str) -> Option<&'static str> {
+    match file {
+        FRAMES_FILE | JOINTS_FILE => Some(frames::CLIP),
+        _ => None,
+    }
+}
+
 /// Sort keys of `kinematics_samples.parquet` (and the order of `kinematics_points.parquet`).
 pub const SAMPLES_SORT_KEYS: [&str; 4] = [
     kinematics::CHARACTER_ID,

@@ -4,12 +4,16 @@
 //!
 //! # Layout
 //! ```text
-//! row groups: ROW_GROUP_ROWS rows each, the last one shorter (never empty unless the table is)
+//! row groups: ROW_GROUP_ROWS rows each, the last one shorter (never empty unless the table is);
+//!             a per-frame table (`schema::group_column`): one group per clip, a clip of more
+//!             than ROW_GROUP_ROWS rows in groups of ROW_GROUP_ROWS and its shorter rest
 //! footer:     ARROW:schema (oldest compatibility level), then the caller's key-value pairs
 //! ```
 //! The layout depends only on the rows and their order, never on how they were cut into
 //! batches, so a streaming build, a one-batch build and a merge of shards write the same
-//! bytes for the same rows. The key-value metadata is given at [`TableWriter::finish`], once
+//! bytes for the same rows. A merge appends a clip's groups as its shard holds them
+//! ([`TableWriter::push_group`]): the file is assembled by [`super::row_groups`], which
+//! keeps no per-group state in memory. The key-value metadata is given at [`TableWriter::finish`], once
 //! everything it describes (the per-character limits) is known.
 //!
 //! # Parallel encoding
@@ -17,8 +21,8 @@
 //! rayon pool (the workers of `--threads`), then written in column order: the pages are
 //! those polars' serial `BatchedWriter::write_batch` makes (same encodings, options and
 //! compressor), so the bytes do not depend on the thread count (the test below compares).
-//! Each column is copied into one buffer on its own while it is encoded (never the whole
-//! group a second time), and a group whose rows wait in scratch files is read back one
+//! The groups of a per-frame table are encoded in parallel as well. Each column is copied
+//! into one buffer on its own while it is encoded (never the whole group a second time), and a group whose rows wait in scratch files is read back one
 //! column at a time ([`TableWriter::with_pending_spill`]); a row group's compressed pages
 //! are held until it is written (the build's peak memory on a 25× replica of the bulk set:
 //! `tests/bench/scale.rs`).
@@ -30,11 +34,12 @@ use polars::io::parquet::write::get_encodings;
 use polars::prelude::*;
 use polars_parquet::read::ParquetError;
 use polars_parquet::write::{
-    array_to_columns, CompressedPage, Compressor, Encoding, KeyValue, ParquetType, Version,
-    WriteOptions,
+    array_to_columns, to_parquet_schema, CompressedPage, Compressor, Encoding, KeyValue,
+    ParquetType, Version, WriteOptions,
 };
 use rayon::prelude::*;
 
+use super::row_groups::{encode, EncodedGroup, GroupFileWriter, GroupSchema};
 use super::scratch::{scratch_name, Scratch};
 use super::write::ROW_GROUP_ROWS;
 use crate::error::{Error, Result};
@@ -45,9 +50,13 @@ pub struct TableWriter {
     path: PathBuf,
     tmp: PathBuf,
     schema: Schema,
-    writer: Option<polars::io::parquet::write::BatchedWriter<File>>,
-    /// Per column: its Parquet type and encodings, as the writer derived them.
-    columns: Vec<(ParquetType, Vec<Encoding>)>,
+    writer: Option<GroupFileWriter>,
+    /// The Arrow and Parquet schemas and page options every group is encoded with.
+    group_schema: GroupSchema,
+    /// Per column: its Parquet type and encodings, as polars' writer derives them.
+    columns: Vec<LeafType>,
+    /// The column whose every change ends a row group (`schema::group_column`).
+    group_column: Option<&'static str>,
     pending: DataFrame,
     /// Older pending rows moved to scratch Parquet files in the table's folder, in order
     /// (`PENDING_SPILL_BYTES`, `PENDING_SPILL_CHUNKS`), with their row count.
@@ -79,7 +88,7 @@ const COMPRESSION: ParquetCompression = ParquetCompression::Zstd(None);
 
 /// The page options polars' `ParquetWriter` derives from [`COMPRESSION`] and full
 /// statistics (its `materialize_options`): the writer and the parallel encoder share them.
-fn write_options() -> WriteOptions {
+pub(super) fn write_options() -> WriteOptions {
     WriteOptions {
         statistics: StatisticsOptions::full(),
         compression: COMPRESSION.into(),
@@ -112,9 +121,9 @@ fn encode_column(
 /// The compressed pages of every column of one row group, in column order: each column is
 /// made one Arrow array ([`column_array`]) and encoded ([`encode_column`]) on its own, in
 /// parallel, so only the columns being encoded are copied into one buffer, never the group.
-fn encode_group(
+pub(super) fn encode_group(
     group: &[Column],
-    columns: &[(ParquetType, Vec<Encoding>)],
+    columns: &[LeafType],
 ) -> PolarsResult<Vec<Vec<CompressedPage>>> {
     let per_column: Vec<Vec<Vec<CompressedPage>>> = group
         .par_iter()
@@ -128,7 +137,7 @@ fn encode_group(
 
 /// The Arrow array `df.iter_chunks(CompatLevel::newest(), false)` makes of `column` (one
 /// chunk), so that a column encoded alone gives the pages of the same column encoded with
-/// its table ([`write_groups`]).
+/// its table ([`encode_rows`]).
 fn column_array(column: Column) -> PolarsResult<ArrayRef> {
     let mut df = DataFrame::new_infer_height(vec![column])?;
     df.rechunk_mut();
@@ -140,28 +149,93 @@ fn column_array(column: Column) -> PolarsResult<ArrayRef> {
     Ok(batch.columns()[0].clone())
 }
 
-/// Write `df` as one row group, as polars' `BatchedWriter::write_batch` writes a
-/// one-chunk frame, its columns encoded by [`encode_group`] (nothing for no rows).
-fn write_groups<W: std::io::Write>(
-    w: &mut polars::io::parquet::write::BatchedWriter<W>,
+/// `df` as one row group for a file of `schema` (nothing for no rows), its columns encoded
+/// by [`encode_group`]: the group polars' `BatchedWriter::write_batch` writes of a
+/// one-chunk frame.
+fn encode_rows(
     df: &DataFrame,
-    columns: &[(ParquetType, Vec<Encoding>)],
-) -> PolarsResult<()> {
+    schema: &GroupSchema,
+    columns: &[LeafType],
+) -> PolarsResult<Option<EncodedGroup>> {
     if df.height() == 0 {
-        return Ok(());
+        return Ok(None);
     }
     let pages = encode_group(df.columns(), columns)?;
-    w.write_row_group(df.height() as u64, &pages)
+    encode(schema, df.height() as u64, &pages)
+        .map(Some)
+        .map_err(PolarsError::from)
 }
 
-/// Per column of a writer: its Parquet type and encodings, as the writer derived them.
-fn column_types<W: std::io::Write>(
-    w: &mut polars::io::parquet::write::BatchedWriter<W>,
+/// A leaf column's Parquet type and encodings.
+type LeafType = (ParquetType, Vec<Encoding>);
+
+/// The schemas polars' batched writer derives from `schema`, and per column its Parquet
+/// type and encodings.
+fn group_schema(schema: &Schema) -> PolarsResult<(GroupSchema, Vec<LeafType>)> {
+    let arrow = schema.to_arrow(CompatLevel::newest());
+    let parquet = to_parquet_schema(&arrow)?;
+    let encodings = get_encodings(&arrow);
+    let columns = parquet
+        .fields()
+        .iter()
+        .cloned()
+        .zip(encodings.iter().cloned())
+        .collect();
+    Ok((GroupSchema::new(arrow, parquet, write_options()), columns))
+}
+
+/// Row counts of the groups `clips` (a string column) cuts into: one per run of equal
+/// values, a run of more than [`ROW_GROUP_ROWS`] in groups of that many. Without `all`, the
+/// last run (whose clip may go on in the next rows) gives only its full groups.
+fn clip_group_sizes(clips: &Column, all: bool) -> PolarsResult<Vec<usize>> {
+    let values = clips.str()?;
+    let mut runs: Vec<usize> = Vec::new();
+    let mut last: Option<Option<&str>> = None;
+    for v in values.iter() {
+        match runs.last_mut() {
+            Some(n) if last == Some(v) => *n += 1,
+            _ => runs.push(1),
+        }
+        last = Some(v);
+    }
+    let n_runs = runs.len();
+    let mut sizes = Vec::new();
+    for (k, mut left) in runs.into_iter().enumerate() {
+        let open = !all && k + 1 == n_runs;
+        while left >= ROW_GROUP_ROWS || (!open && left > 0) {
+            let n = left.min(ROW_GROUP_ROWS);
+            sizes.push(n);
+            left -= n;
+        }
+    }
+    Ok(sizes)
+}
+
+/// The footer's key-value entries of a table of `schema`: `ARROW:schema` (the oldest
+/// compatibility level, `string_hint`'s column typed `string`), then `kv`.
+fn footer_entries(
     schema: &Schema,
-) -> Vec<(ParquetType, Vec<Encoding>)> {
-    let encodings = get_encodings(&schema.to_arrow(CompatLevel::newest()));
-    let types = w.parquet_schema().fields().to_vec();
-    types.into_iter().zip(encodings.iter().cloned()).collect()
+    string_hint: Option<&PlSmallStr>,
+    kv: &[(String, String)],
+) -> Vec<KeyValue> {
+    let mut arrow = Schema::from_iter(schema.iter().map(|(n, d)| (n.clone(), d.clone())))
+        .to_arrow(CompatLevel::oldest());
+    if let Some(f) = string_hint.and_then(|c| arrow.get_mut(c)) {
+        if f.dtype == ArrowDataType::LargeUtf8 {
+            f.dtype = ArrowDataType::Utf8;
+        }
+    }
+    let (key, value) = super::write::arrow_schema_entry(&arrow, kv);
+    let mut meta: Vec<KeyValue> = Vec::with_capacity(kv.len() + 1);
+    meta.push(KeyValue {
+        key,
+        value: Some(value),
+    });
+    meta.extend(kv.iter().map(|(k, v)| KeyValue {
+        key: k.clone(),
+        value: Some(v.clone()),
+    }));
+    meta
 }
 
 impl std::fmt::Debug for TableWriter {
@@ -185,15 +259,11 @@ impl TableWriter {
     pub fn create(dir: &Path, name: &str, empty: &DataFrame) -> Result<TableWriter> {
         let path = dir.join(name);
         let tmp = dir.join(scratch_name(name, Scratch::Tmp));
-        let file = File::create(&tmp).map_err(|e| io(&tmp, "cannot create", e))?;
         let schema = empty.schema().as_ref().clone();
-        let mut writer = ParquetWriter::new(file)
-            .with_compression(COMPRESSION)
-            .with_statistics(write_options().statistics)
-            .set_parallel(false)
-            .batched(&schema)
-            .map_err(|e| io(&tmp, "cannot write parquet", e))?;
-        let columns = column_types(&mut writer, &schema);
+        let (group_schema, columns) =
+            group_schema(&schema).map_err(|e| io(&path, "cannot write parquet", e))?;
+        let writer = GroupFileWriter::create(&tmp, &group_schema)
+            .map_err(|e| io(&tmp, "cannot create", e))?;
         Ok(TableWriter {
             path,
             tmp,
@@ -203,7 +273,9 @@ impl TableWriter {
             spill: false,
             schema,
             writer: Some(writer),
+            group_schema,
             columns,
+            group_column: super::schema::group_column(name),
             rows: 0,
             string_hint: None,
         })
@@ -222,7 +294,12 @@ impl TableWriter {
     /// in memory, the older ones in scratch files beside the table: for a table of few, wide rows, which takes many
     /// batches to fill a row group. A long table (frames) fills one in a few batches and
     /// is better held than written twice.
+    /// Not for a per-frame table, whose rows wait for one clip at most.
     pub fn with_pending_spill(mut self) -> TableWriter {
+        debug_assert!(
+            self.group_column.is_none(),
+            "a per-clip table waits for one clip"
+        );
         self.spill = true;
         self
     }
@@ -248,6 +325,9 @@ impl TableWriter {
         self.pending
             .vstack_mut(&df)
             .map_err(|e| io(&self.path, "rows of another schema", e))?;
+        if self.group_column.is_some() {
+            return self.write_clip_groups(false);
+        }
         if self.spilled_rows + self.pending.height() < ROW_GROUP_ROWS {
             // The rows wait as one chunk per push: copying them into one buffer at every
             // push would copy a small table's rows once per batch and leave the heap with
@@ -351,7 +431,7 @@ impl TableWriter {
     /// rest pending. Each worker holds one column of the pending rows at a time; the
     /// compressed pages and the rows left over are kept until the group is written. A
     /// group of wide rows loaded whole (the stances of a large build) would be tens of MB.
-    /// The pages are those of [`write_groups`] on the same rows.
+    /// The pages are those of [`encode_rows`] on the same rows.
     fn write_pending_by_column(&mut self, group_rows: usize) -> Result<()> {
         let n = group_rows.min(self.spilled_rows + self.pending.height());
         let fields: Vec<(PlSmallStr, DataType)> = self
@@ -378,10 +458,9 @@ impl TableWriter {
         let rest = DataFrame::new_infer_height(rest)
             .map_err(|e| io(&self.path, "rows of another schema", e))?;
         if n > 0 {
-            if let Some(w) = self.writer.as_mut() {
-                w.write_row_group(n as u64, &pages)
-                    .map_err(|e| io(&self.tmp, "cannot write parquet", e))?;
-            }
+            let g = encode(&self.group_schema, n as u64, &pages)
+                .map_err(|e| io(&self.tmp, "cannot write parquet", e))?;
+            self.append(&g)?;
         }
         self.pending = rest;
         self.spilled_rows = 0;
@@ -392,10 +471,79 @@ impl TableWriter {
     }
 
     fn write_group(&mut self, group: DataFrame) -> Result<()> {
-        let Some(w) = self.writer.as_mut() else {
+        let encoded = encode_rows(&group, &self.group_schema, &self.columns)
+            .map_err(|e| io(&self.tmp, "cannot write parquet", e))?;
+        match encoded {
+            Some(g) => self.append(&g),
+            None => Ok(()),
+        }
+    }
+
+    fn append(&mut self, g: &EncodedGroup) -> Result<()> {
+        match self.writer.as_mut() {
+            Some(w) => w
+                .append(g)
+                .map_err(|e| io(&self.tmp, "cannot write parquet", e)),
+            None => Ok(()),
+        }
+    }
+
+    /// Write the pending rows' complete per-clip groups (all of them with `all`), encoded
+    /// in parallel and appended in order; the rest stays pending.
+    fn write_clip_groups(&mut self, all: bool) -> Result<()> {
+        let Some(name) = self.group_column else {
             return Ok(());
         };
-        write_groups(w, &group, &self.columns).map_err(|e| io(&self.tmp, "cannot write parquet", e))
+        let err = |e| io(&self.tmp, "cannot write parquet", e);
+        let clips = self.pending.column(name).map_err(err)?;
+        let sizes = clip_group_sizes(clips, all).map_err(err)?;
+        let starts: Vec<usize> = sizes
+            .iter()
+            .scan(0, |at, n| {
+                let s = *at;
+                *at += n;
+                Some(s)
+            })
+            .collect();
+        let groups: Vec<Option<EncodedGroup>> = starts
+            .par_iter()
+            .zip(sizes.par_iter())
+            .map(|(&at, &n)| {
+                encode_rows(
+                    &self.pending.slice(at as i64, n),
+                    &self.group_schema,
+                    &self.columns,
+                )
+            })
+            .collect::<PolarsResult<_>>()
+            .map_err(err)?;
+        for g in groups.iter().flatten() {
+            self.append(g)?;
+        }
+        let done: usize = sizes.iter().sum();
+        if done > 0 {
+            self.pending = self.pending.slice(done as i64, usize::MAX);
+            self.pending.rechunk_mut();
+        }
+        Ok(())
+    }
+
+    /// Append `g`, a row group of the same table (a shard's, read by
+    /// [`super::row_groups::GroupFileReader`]) after the rows pushed so far, as it is: its
+    /// pages are not decoded. Only when no rows wait for their group.
+    ///
+    /// # Errors
+    /// Rows are pending, or the write fails.
+    pub fn push_group(&mut self, g: &EncodedGroup) -> Result<()> {
+        if self.pending.height() > 0 || self.spilled_rows > 0 {
+            return Err(io(
+                &self.path,
+                "cannot append a row group",
+                std::io::Error::other("rows are waiting for their own group"),
+            ));
+        }
+        self.rows += g.rows();
+        self.append(g)
     }
 
     /// Write the last row group and the footer with `kv` (after an `ARROW:schema` entry of
@@ -408,46 +556,22 @@ impl TableWriter {
     /// # Errors
     /// A write or the rename fails (the temporary file is removed).
     pub fn finish(mut self, kv: &[(String, String)]) -> Result<()> {
-        if !self.spilled.is_empty() {
+        if self.group_column.is_some() {
+            self.write_clip_groups(true)?;
+        } else if !self.spilled.is_empty() {
             self.write_pending_by_column(usize::MAX)?;
         } else if self.pending.height() > 0 {
             let rest = std::mem::replace(&mut self.pending, DataFrame::empty());
             self.write_group(rest)?;
         }
-        let mut arrow = Schema::from_iter(self.schema.iter().map(|(n, d)| (n.clone(), d.clone())))
-            .to_arrow(CompatLevel::oldest());
-        if let Some(f) = self.string_hint.as_ref().and_then(|c| arrow.get_mut(c)) {
-            if f.dtype == ArrowDataType::LargeUtf8 {
-                f.dtype = ArrowDataType::Utf8;
-            }
-        }
-        let (key, value) = super::write::arrow_schema_entry(&arrow, kv);
-        let mut meta: Vec<KeyValue> = Vec::with_capacity(kv.len() + 1);
-        meta.push(KeyValue {
-            key,
-            value: Some(value),
-        });
-        meta.extend(kv.iter().map(|(k, v)| KeyValue {
-            key: k.clone(),
-            value: Some(v.clone()),
-        }));
+        let meta = footer_entries(&self.schema, self.string_hint.as_ref(), kv);
         let Some(w) = self.writer.take() else {
             return Ok(());
         };
         let ended = w
-            .get_writer()
-            .lock()
-            .map_err(|_| {
-                io(
-                    &self.tmp,
-                    "cannot write parquet",
-                    std::io::Error::other("writer poisoned"),
-                )
-            })?
-            .end(Some(meta))
+            .finish(meta)
             .map(|_| ())
             .map_err(|e| io(&self.tmp, "cannot write parquet", e));
-        drop(w);
         if let Err(e) = ended {
             let _ = std::fs::remove_file(&self.tmp);
             return Err(e);
@@ -497,6 +621,29 @@ mod tests {
         .unwrap()
     }
 
+    /// polars' own serial writer: one `write_batch` per group, the footer entries a
+    /// [`TableWriter`] writes.
+    fn serial_bytes(groups: &[DataFrame], kv: &[(String, String)]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let schema = groups[0].schema().as_ref().clone();
+        let mut w = ParquetWriter::new(&mut out)
+            .with_compression(COMPRESSION)
+            .with_statistics(write_options().statistics)
+            .set_parallel(false)
+            .batched(&schema)
+            .unwrap();
+        for g in groups {
+            w.write_batch(&g.clone()).unwrap();
+        }
+        w.get_writer()
+            .lock()
+            .unwrap()
+            .end(Some(footer_entries(&schema, None, kv)))
+            .unwrap();
+        drop(w);
+        out
+    }
+
     // See: issue 15 item 4 — Parquet written in parallel: the serial writer's bytes.
     #[test]
     fn parallel_encoding_gives_the_serial_writers_bytes() {
@@ -505,37 +652,111 @@ mod tests {
             df.slice(0, ROW_GROUP_ROWS),
             df.slice(ROW_GROUP_ROWS as i64, 1234),
         ];
-        fn writer<'a>(out: &'a mut Vec<u8>, df: &DataFrame) -> BatchedWriter<&'a mut Vec<u8>> {
-            ParquetWriter::new(out)
-                .with_compression(COMPRESSION)
-                .with_statistics(write_options().statistics)
-                .set_parallel(false)
-                .batched(df.schema())
-                .unwrap()
-        }
-        let mut serial = Vec::new();
-        let mut w = writer(&mut serial, &df);
-        for g in &groups {
-            w.write_batch(&g.clone()).unwrap();
-        }
-        w.finish().unwrap();
-        drop(w);
+        let kv = [("k".to_string(), "v".to_string())];
+        let serial = serial_bytes(&groups, &kv);
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let mut par = Vec::new();
-            let mut w = writer(&mut par, &df);
-            let columns = column_types(&mut w, df.schema());
-            for g in &groups {
-                pool.install(|| write_groups(&mut w, &g.clone(), &columns))
-                    .unwrap();
-            }
-            w.finish().unwrap();
-            drop(w);
+            let d = tempfile::tempdir().unwrap();
+            pool.install(|| {
+                let mut w = TableWriter::create(d.path(), "t.parquet", &df.clear()).unwrap();
+                w.push(&df).unwrap();
+                w.finish(&kv).unwrap();
+            });
+            let par = std::fs::read(d.path().join("t.parquet")).unwrap();
             assert!(par == serial, "{threads} threads: the bytes differ");
         }
+    }
+
+    /// A per-frame table is cut into one row group per clip (a long clip into groups of
+    /// `ROW_GROUP_ROWS`), whatever the pushes: polars' serial writer's bytes for those
+    /// groups.
+    #[test]
+    fn per_frame_tables_have_a_row_group_per_clip() {
+        let clip = |name: &str, n: usize| {
+            df! {
+                "clip" => vec![name.to_string(); n],
+                "frame" => (0..n as i64).collect::<Vec<_>>(),
+                "x" => (0..n).map(|i| (i as f64 * 0.11).cos()).collect::<Vec<_>>(),
+            }
+            .unwrap()
+        };
+        let parts = [
+            clip("a", 10),
+            clip("b", ROW_GROUP_ROWS + 5),
+            clip("c", 1),
+            clip("d", 300),
+        ];
+        let mut all = parts[0].clone();
+        for p in &parts[1..] {
+            all.vstack_mut(p).unwrap();
+        }
+        let groups = [
+            parts[0].clone(),
+            parts[1].slice(0, ROW_GROUP_ROWS),
+            parts[1].slice(ROW_GROUP_ROWS as i64, 5),
+            parts[2].clone(),
+            parts[3].clone(),
+        ];
+        let serial = serial_bytes(&groups, &[]);
+        let name = super::super::schema::FRAMES_FILE;
+        for cut in [usize::MAX, 7, 4000] {
+            let d = tempfile::tempdir().unwrap();
+            let mut w = TableWriter::create(d.path(), name, &all.clear()).unwrap();
+            let mut at = 0;
+            while at < all.height() {
+                w.push(&all.slice(at as i64, cut)).unwrap();
+                at = at.saturating_add(cut);
+            }
+            w.finish(&[]).unwrap();
+            let bytes = std::fs::read(d.path().join(name)).unwrap();
+            assert!(bytes == serial, "pushes of {cut} rows: the bytes differ");
+        }
+    }
+
+    /// A group taken from one file and pushed into another table gives the bytes of its
+    /// rows pushed; a group cannot overtake rows still waiting for theirs.
+    #[test]
+    fn a_pushed_group_equals_its_rows() {
+        let df = df! {
+            "clip" => ["a", "a", "b", "b", "b", "c"],
+            "frame" => [0i64, 1, 0, 1, 2, 0],
+        }
+        .unwrap();
+        let name = super::super::schema::FRAMES_FILE;
+        let d = tempfile::tempdir().unwrap();
+        let rows = d.path().join("rows");
+        let groups = d.path().join("groups");
+        for dir in [&rows, &groups] {
+            std::fs::create_dir(dir).unwrap();
+        }
+        let mut w = TableWriter::create(&rows, name, &df.clear()).unwrap();
+        w.push(&df).unwrap();
+        w.finish(&[]).unwrap();
+        let open = || super::super::row_groups::GroupFileReader::open(&rows.join(name)).unwrap();
+        let mut r = open();
+        let mut w = TableWriter::create(&groups, name, &df.clear()).unwrap();
+        w.push(&df.slice(0, 2)).unwrap();
+        assert!(
+            w.push_group(&r.next_group().unwrap().unwrap()).is_err(),
+            "clip a waits"
+        );
+        w.finish(&[]).unwrap();
+        let mut r = open();
+        let mut w = TableWriter::create(&groups, name, &df.clear()).unwrap();
+        let mut clips = Vec::new();
+        while let Some(clip) = r.peek_value("clip").unwrap() {
+            clips.push(String::from_utf8(clip).unwrap());
+            w.push_group(&r.next_group().unwrap().unwrap()).unwrap();
+        }
+        assert_eq!(clips, ["a", "b", "c"]);
+        assert_eq!(w.rows(), 6);
+        w.finish(&[]).unwrap();
+        assert!(
+            std::fs::read(rows.join(name)).unwrap() == std::fs::read(groups.join(name)).unwrap()
+        );
     }
 
     /// `pieces` pushed one by one through a spilling writer of `template`'s columns into a

@@ -6,7 +6,10 @@
 //! check:  every shard is a finished shard library; same schema, tool version, options,
 //!         shard count and input list (manifest `shard.inputs_sha256`); indices 1..N once each
 //! rows:   per-clip tables read forward in clip order from every shard, a batch of clips
-//!         (about one row group of frames) at a time, sorted by the table's keys, appended
+//!         (about one row group of frames) at a time, sorted by the table's keys, appended;
+//!         the per-frame tables (one row group per clip, `schema::group_column`) are not
+//!         decoded: each clip's row groups are copied from its shard, compressed pages and
+//!         all (`library::row_groups`)
 //! limits: recomputed from the stance and clip facts of the merged rows
 //! polytopes: recomputed from the shards' kinematic samples (`kinematics_samples.parquet`)
 //! ```
@@ -23,9 +26,10 @@ use super::sink::{sorted, ClipCursor, LibrarySink, Tables};
 use crate::error::{Error, Result};
 use crate::library::layout::{locate, table_exists, Layout};
 use crate::library::read::read_parquet;
+use crate::library::row_groups::GroupFileReader;
 use crate::library::schema::{
-    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, KINEMATICS_SAMPLES_FILE,
-    MANIFEST_FILE, STANCES_FILE,
+    group_column, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
+    KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, STANCES_FILE,
 };
 use crate::library::write::ROW_GROUP_ROWS;
 
@@ -181,7 +185,7 @@ fn check_shards(mut libs: Vec<ShardLib>) -> Result<Vec<ShardLib>> {
 }
 
 /// Clips in name order with their kept frame counts and shard, from the shards' clips.
-fn clip_plan(libs: &[ShardLib]) -> Result<Vec<(String, usize)>> {
+fn clip_plan(libs: &[ShardLib]) -> Result<Vec<(String, usize, usize)>> {
     let mut plan: BTreeMap<String, (usize, usize)> = BTreeMap::new();
     for (k, lib) in libs.iter().enumerate() {
         let path = lib.dir.join(CLIPS_FILE);
@@ -204,7 +208,76 @@ fn clip_plan(libs: &[ShardLib]) -> Result<Vec<(String, usize)>> {
             plan.insert(c, (k, f.unwrap_or(0).max(0) as usize));
         }
     }
-    Ok(plan.into_iter().map(|(c, (_, f))| (c, f)).collect())
+    Ok(plan.into_iter().map(|(c, (k, f))| (c, f, k)).collect())
+}
+
+/// A shard's per-clip table (`schema::group_column`), its row groups read in clip order.
+struct GroupCursor {
+    table: &'static str,
+    column: &'static str,
+    files: std::vec::IntoIter<PathBuf>,
+    reader: Option<GroupFileReader>,
+}
+
+impl GroupCursor {
+    fn open(lib: &Path, table: &'static str, column: &'static str) -> Result<GroupCursor> {
+        let mut files = locate(lib, table)?.files().into_iter();
+        let reader = files
+            .next()
+            .map(|f| GroupFileReader::open(&f))
+            .transpose()?;
+        Ok(GroupCursor {
+            table,
+            column,
+            files,
+            reader,
+        })
+    }
+
+    /// The clip of the next row group, moving on to the next file at the end of one.
+    fn next_clip(&mut self) -> Result<Option<Vec<u8>>> {
+        while let Some(r) = self.reader.as_mut() {
+            if let Some(v) = r.peek_value(self.column)? {
+                return Ok(Some(v));
+            }
+            self.reader = self
+                .files
+                .next()
+                .map(|f| GroupFileReader::open(&f))
+                .transpose()?;
+        }
+        Ok(None)
+    }
+
+    /// Append the row groups of `clip` (the next ones of the shard) to `sink`'s table; a
+    /// group of a clip before `clip` means the shard's tables disagree.
+    fn copy_clip(&mut self, clip: &str, sink: &mut LibrarySink, dir: &Path) -> Result<()> {
+        while let Some(next) = self.next_clip()? {
+            match next.as_slice().cmp(clip.as_bytes()) {
+                std::cmp::Ordering::Greater => break,
+                std::cmp::Ordering::Less => {
+                    return Err(bad(
+                        dir,
+                        format!(
+                            "{} holds clip {} that its {CLIPS_FILE} does not, or out of order",
+                            self.table,
+                            String::from_utf8_lossy(&next)
+                        ),
+                    ))
+                }
+                std::cmp::Ordering::Equal => {
+                    let g = match self.reader.as_mut() {
+                        Some(r) => r.next_group()?,
+                        None => None,
+                    };
+                    // `next_clip` has just read this group's entry.
+                    let g = g.ok_or_else(|| bad(dir, format!("{}: no row group", self.table)))?;
+                    sink.push_group(self.table, &g)?;
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Spill a shard's samples table into `sink` a row group's worth at a time (never the
@@ -261,15 +334,28 @@ pub fn merge_into(
     };
     replace_library(out, |tmp| {
         let mut sink = LibrarySink::create(tmp, joints, false, false)?;
-        let mut cursors: Vec<Vec<ClipCursor>> = Vec::new();
+        // Per shard: a row cursor per table, none for a per-clip table, whose row groups
+        // are copied by a group cursor instead.
+        let mut cursors: Vec<Vec<Option<ClipCursor>>> = Vec::new();
+        let mut groups: Vec<Vec<GroupCursor>> = Vec::new();
         for lib in &libs {
             sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
             push_samples(&mut sink, &lib.dir)?;
-            let names: Vec<&str> = sink.template().named().iter().map(|(n, _)| *n).collect();
+            let names: Vec<&'static str> =
+                sink.template().named().iter().map(|(n, _)| *n).collect();
             cursors.push(
                 names
                     .iter()
-                    .map(|n| ClipCursor::open(&lib.dir.join(n)))
+                    .map(|n| match group_column(n) {
+                        Some(_) => Ok(None),
+                        None => ClipCursor::open(&lib.dir.join(n)).map(Some),
+                    })
+                    .collect::<Result<Vec<_>>>()?,
+            );
+            groups.push(
+                names
+                    .iter()
+                    .filter_map(|n| group_column(n).map(|c| GroupCursor::open(&lib.dir, n, c)))
                     .collect::<Result<Vec<_>>>()?,
             );
         }
@@ -282,9 +368,15 @@ pub fn merge_into(
                 end += 1;
             }
             let last = plan[end - 1].0.clone();
+            for (clip, _, k) in &plan[start..end] {
+                for g in groups[*k].iter_mut() {
+                    g.copy_clip(clip, &mut sink, &libs[*k].dir)?;
+                }
+            }
             let mut t = Tables::empty(joints)?;
             for shard in cursors.iter_mut() {
                 for ((name, df), cur) in t.named().into_iter().zip(shard.iter_mut()) {
+                    let Some(cur) = cur else { continue };
                     if let Some(rows) = cur.take_through(&last, &|_| true)? {
                         let rows = super::sink::cast_like(rows, df, name)?;
                         df.vstack_mut(&rows)

@@ -31,6 +31,7 @@ use crate::library::kinematics::{
 };
 use crate::library::layout::{convert_to_dataset, locate_path, read_source, Layout, TableSource};
 use crate::library::read::parquet_rows;
+use crate::library::row_groups::EncodedGroup;
 use crate::library::schema::{
     clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE,
@@ -267,6 +268,22 @@ impl LibrarySink {
             .map(|((_, df), (_, w))| w.push(df))
             .collect();
         pushed.into_iter().collect()
+    }
+
+    /// Append a row group of table `name` as it is (a shard's group of a per-clip table,
+    /// `schema::group_column`), after the rows and groups pushed so far.
+    ///
+    /// # Errors
+    /// `name` is not a table of the library, or the write fails.
+    pub fn push_group(&mut self, name: &str, g: &EncodedGroup) -> Result<()> {
+        match self.writers.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, w)) => w.push_group(g),
+            None => Err(Error::io(
+                self.dir.join(name),
+                "cannot append a row group",
+                std::io::Error::other("not a table of this library"),
+            )),
+        }
     }
 
     /// Add error rows (any order).

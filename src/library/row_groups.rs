@@ -1,0 +1,903 @@
+//! Parquet files assembled from encoded row groups that can be moved between files: a
+//! group encoded for one file (a shard library's) is appended to another (the merged
+//! library's) as it was, its compressed pages copied, never decoded.
+//!
+//! # Layout (what polars' `FileWriter` writes, byte for byte)
+//! ```text
+//! PAR1
+//! per row group, per column chunk: its pages, then its ColumnMetaData (thrift compact)
+//! per row group, per column chunk: its ColumnIndex          (page statistics)
+//! per row group, per column chunk: its OffsetIndex          (page offsets in the file)
+//! FileMetaData (thrift compact), its length (u32 LE), PAR1
+//! ```
+//! Every offset in a group's metadata is a byte position in the file, so a group is kept
+//! here with its offsets counted from the start of each column chunk ([`EncodedGroup`]);
+//! [`GroupFileWriter::append`] adds the chunk's position in the new file. The footer
+//! entries and page indexes of the groups written so far wait in scratch files, not in
+//! memory: a file of many small groups (one per clip) holds nothing per group until the
+//! footer is written.
+//!
+//! A group is encoded by polars' own writer into a buffer ([`encode_group_bytes`]) and read
+//! back from it as from any file ([`group_from_bytes`]), so the pages, statistics and
+//! indexes are polars'; only the file's assembly is done here.
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::ArrowSchema;
+use polars_parquet::write::{
+    CompressedPage, DynIter, DynStreamingIterator, FileWriter, SchemaDescriptor, WriteOptions,
+};
+use polars_parquet_format::thrift::protocol::{
+    TCompactInputProtocol, TCompactOutputProtocol, TFieldIdentifier, TInputProtocol,
+    TListIdentifier, TOutputProtocol, TStructIdentifier, TType,
+};
+use polars_parquet_format::{ColumnChunk, FileMetaData, KeyValue, OffsetIndex, RowGroup};
+
+use super::scratch::{scratch_name, Scratch};
+use crate::error::{Error, Result};
+
+/// The Parquet magic bytes, at the start and the end of a file.
+const MAGIC: &[u8; 4] = b"PAR1";
+
+/// The most bytes a thrift structure read here may allocate (a footer of a very large
+/// file is a few MB; a corrupt length must not allocate without bound).
+const THRIFT_LIMIT: usize = 1 << 30;
+
+/// One column chunk of an [`EncodedGroup`].
+#[derive(Debug, Clone, PartialEq)]
+struct Chunk {
+    /// Its pages (headers and compressed data) in the group's bytes.
+    pages: Range<usize>,
+    /// Its footer entry, every offset counted from the chunk's first page; no page index
+    /// offsets (set when the group is appended).
+    meta: ColumnChunk,
+    /// Its ColumnIndex, thrift-encoded (no offsets in it), if the file writes one.
+    column_index: Option<Vec<u8>>,
+    /// Its OffsetIndex, page offsets counted from the chunk's first page.
+    offset_index: OffsetIndex,
+}
+
+/// A row group that can be appended to any file of its schema: its pages and its
+/// metadata with offsets relative to each column chunk (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EncodedGroup {
+    bytes: Vec<u8>,
+    chunks: Vec<Chunk>,
+    /// The group's footer entry without its columns (set when appended).
+    group: RowGroup,
+}
+
+impl EncodedGroup {
+    /// Rows of the group.
+    pub fn rows(&self) -> usize {
+        self.group.num_rows.max(0) as usize
+    }
+}
+
+/// What a malformed file or buffer is reported as.
+fn malformed(why: impl Into<String>) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidData, why.into())
+}
+
+fn thrift_err(e: polars_parquet_format::thrift::Error) -> std::io::Error {
+    malformed(format!("parquet metadata: {e}"))
+}
+
+/// Where a column chunk's pages start: its dictionary page, else its first data page.
+fn chunk_start(c: &ColumnChunk) -> Option<i64> {
+    let m = c.meta_data.as_ref()?;
+    Some(m.dictionary_page_offset.unwrap_or(m.data_page_offset))
+}
+
+/// Move every byte position of a column chunk's footer entry by `by` bytes.
+fn shift_chunk(c: &mut ColumnChunk, by: i64) {
+    c.file_offset += by;
+    if let Some(m) = c.meta_data.as_mut() {
+        m.data_page_offset += by;
+        m.dictionary_page_offset = m.dictionary_page_offset.map(|o| o + by);
+        m.index_page_offset = m.index_page_offset.map(|o| o + by);
+    }
+}
+
+/// Move every page position of an offset index by `by` bytes.
+fn shift_offsets(index: &mut OffsetIndex, by: i64) {
+    for p in &mut index.page_locations {
+        p.offset += by;
+    }
+}
+
+/// Read a thrift structure from `bytes`.
+fn read_thrift<'b, T>(
+    bytes: &'b [u8],
+    read: impl FnOnce(&mut TCompactInputProtocol<&'b [u8]>) -> polars_parquet_format::thrift::Result<T>,
+) -> std::io::Result<T> {
+    let mut p = TCompactInputProtocol::new(bytes, THRIFT_LIMIT);
+    read(&mut p).map_err(thrift_err)
+}
+
+/// The thrift bytes of a structure.
+fn thrift_bytes(
+    write: impl FnOnce(
+        &mut TCompactOutputProtocol<&mut Vec<u8>>,
+    ) -> polars_parquet_format::thrift::Result<usize>,
+) -> std::io::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    write(&mut TCompactOutputProtocol::new(&mut out)).map_err(thrift_err)?;
+    Ok(out)
+}
+
+/// `range` of `bytes`, or an error if it lies outside.
+fn slice(bytes: &[u8], start: i64, len: i64) -> std::io::Result<&[u8]> {
+    let (Ok(start), Ok(len)) = (usize::try_from(start), usize::try_from(len)) else {
+        return Err(malformed("negative offset or length"));
+    };
+    start
+        .checked_add(len)
+        .and_then(|end| bytes.get(start..end))
+        .ok_or_else(|| malformed(format!("range {start}+{len} outside {} bytes", bytes.len())))
+}
+
+/// A source of a file's bytes by position.
+trait ReadAt {
+    fn read_at(&mut self, start: i64, len: i64) -> std::io::Result<Vec<u8>>;
+}
+
+impl ReadAt for &[u8] {
+    fn read_at(&mut self, start: i64, len: i64) -> std::io::Result<Vec<u8>> {
+        slice(self, start, len).map(<[u8]>::to_vec)
+    }
+}
+
+impl ReadAt for File {
+    fn read_at(&mut self, start: i64, len: i64) -> std::io::Result<Vec<u8>> {
+        let (Ok(start), Ok(len)) = (u64::try_from(start), usize::try_from(len)) else {
+            return Err(malformed("negative offset or length"));
+        };
+        let end = start.saturating_add(len as u64);
+        if end > self.metadata()?.len() {
+            return Err(malformed(format!(
+                "range {start}+{len} past the file's end"
+            )));
+        }
+        let mut out = vec![0; len];
+        self.seek(SeekFrom::Start(start))?;
+        self.read_exact(&mut out)?;
+        Ok(out)
+    }
+}
+
+/// Group `rg` of a file read through `src`: its pages and its metadata made relative to
+/// each column chunk (module docs). The chunks' pages are read in one span.
+fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGroup> {
+    let mut spans = Vec::with_capacity(rg.columns.len());
+    for c in &rg.columns {
+        let start = chunk_start(c).ok_or_else(|| malformed("column chunk without metadata"))?;
+        let len = c.meta_data.as_ref().map_or(0, |m| m.total_compressed_size);
+        if c.meta_data
+            .as_ref()
+            .is_some_and(|m| m.bloom_filter_offset.is_some())
+        {
+            return Err(malformed("bloom filters are not supported"));
+        }
+        spans.push((start, len));
+    }
+    let lo = spans.iter().map(|s| s.0).min().unwrap_or(0);
+    let hi = spans.iter().map(|s| s.0 + s.1).max().unwrap_or(0);
+    let span = src.read_at(lo, hi - lo)?;
+    let mut bytes = Vec::with_capacity(span.len());
+    let mut chunks = Vec::with_capacity(rg.columns.len());
+    for (c, (start, len)) in rg.columns.iter().zip(spans) {
+        let at = bytes.len();
+        bytes.extend_from_slice(slice(&span, start - lo, len)?);
+        let mut meta = c.clone();
+        shift_chunk(&mut meta, -start);
+        let column_index = match (
+            meta.column_index_offset.take(),
+            meta.column_index_length.take(),
+        ) {
+            (Some(o), Some(l)) => Some(src.read_at(o, i64::from(l))?),
+            _ => None,
+        };
+        let offset_index = match (
+            meta.offset_index_offset.take(),
+            meta.offset_index_length.take(),
+        ) {
+            (Some(o), Some(l)) => {
+                let raw = src.read_at(o, i64::from(l))?;
+                let mut index = read_thrift(&raw, OffsetIndex::read_from_in_protocol)?;
+                shift_offsets(&mut index, -start);
+                index
+            }
+            _ => return Err(malformed("column chunk without an offset index")),
+        };
+        chunks.push(Chunk {
+            pages: at..bytes.len(),
+            meta,
+            column_index,
+            offset_index,
+        });
+    }
+    let mut group = rg.clone();
+    group.columns.clear();
+    group.file_offset = None;
+    group.ordinal = None;
+    Ok(EncodedGroup {
+        bytes,
+        chunks,
+        group,
+    })
+}
+
+/// The footer of a Parquet file held in `bytes` or read from `file`.
+fn read_footer(src: &mut impl ReadAt, len: u64) -> std::io::Result<FileMetaData> {
+    if len < 12 {
+        return Err(malformed("too short for a parquet file"));
+    }
+    let tail = src.read_at(len as i64 - 8, 8)?;
+    if &tail[4..] != MAGIC {
+        return Err(malformed("no parquet magic at the end"));
+    }
+    let meta_len = i64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+    let raw = src.read_at(len as i64 - 8 - meta_len, meta_len)?;
+    read_thrift(&raw, FileMetaData::read_from_in_protocol)
+}
+
+/// The schema and options every group of one table is encoded with.
+#[derive(Debug, Clone)]
+pub struct GroupSchema {
+    arrow: ArrowSchema,
+    parquet: SchemaDescriptor,
+    options: WriteOptions,
+}
+
+impl GroupSchema {
+    /// The table's Arrow schema (the newest compatibility level, as polars' batched writer
+    /// takes it), its Parquet schema and the page options.
+    pub fn new(arrow: ArrowSchema, parquet: SchemaDescriptor, options: WriteOptions) -> Self {
+        GroupSchema {
+            arrow,
+            parquet,
+            options,
+        }
+    }
+
+    fn writer(&self) -> FileWriter<Vec<u8>> {
+        FileWriter::new_with_parquet_schema(
+            Vec::new(),
+            self.arrow.clone(),
+            self.parquet.clone(),
+            self.options,
+        )
+    }
+
+    /// The footer polars writes for a file of no rows and no key-value pairs: the schema,
+    /// the writer's name, the column orders.
+    fn empty_footer(&self) -> std::io::Result<FileMetaData> {
+        let mut w = self.writer();
+        w.end(Some(Vec::new())).map_err(std::io::Error::other)?;
+        Ok(w.into_inner_and_metadata().1)
+    }
+}
+
+/// The bytes of a one-group Parquet file polars writes for `pages` (one `Vec` per leaf
+/// column, in order) of `rows` rows.
+fn encode_group_bytes(
+    schema: &GroupSchema,
+    rows: u64,
+    pages: &[Vec<CompressedPage>],
+) -> std::io::Result<Vec<u8>> {
+    let mut w = schema.writer();
+    let group = DynIter::new(pages.iter().map(|col| {
+        Ok(DynStreamingIterator::new(
+            polars_parquet::write::fallible_streaming_iterator::convert(
+                col.iter().map(polars::prelude::PolarsResult::Ok),
+            ),
+        ))
+    }));
+    w.write(rows, group).map_err(std::io::Error::other)?;
+    w.end(Some(Vec::new())).map_err(std::io::Error::other)?;
+    Ok(w.into_inner())
+}
+
+/// The one row group of a Parquet file held in `bytes`.
+fn group_from_bytes(bytes: &[u8]) -> std::io::Result<EncodedGroup> {
+    let mut src = bytes;
+    let footer = read_footer(&mut src, bytes.len() as u64)?;
+    match footer.row_groups.as_slice() {
+        [rg] => take_group(&mut src, rg),
+        groups => Err(malformed(format!("{} row groups, not one", groups.len()))),
+    }
+}
+
+/// `rows` rows encoded as `pages` (polars' compressed pages, one `Vec` per leaf column) as
+/// a group that can be appended to any file of `schema`.
+///
+/// # Errors
+/// polars cannot write the pages (a page of another schema).
+pub fn encode(
+    schema: &GroupSchema,
+    rows: u64,
+    pages: &[Vec<CompressedPage>],
+) -> std::io::Result<EncodedGroup> {
+    group_from_bytes(&encode_group_bytes(schema, rows, pages)?)
+}
+
+/// A scratch file written in order and read back once, removed when dropped.
+struct ScratchStream {
+    path: PathBuf,
+    out: Option<BufWriter<File>>,
+    len: u64,
+}
+
+impl ScratchStream {
+    fn create(path: PathBuf) -> std::io::Result<ScratchStream> {
+        let file = File::options()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(true)
+            .open(&path)?;
+        Ok(ScratchStream {
+            path,
+            out: Some(BufWriter::new(file)),
+            len: 0,
+        })
+    }
+
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<u64> {
+        let at = self.len;
+        self.out
+            .as_mut()
+            .ok_or_else(|| std::io::Error::other("scratch stream already read"))?
+            .write_all(bytes)?;
+        self.len += bytes.len() as u64;
+        Ok(at)
+    }
+
+    /// The stream's bytes, from the start.
+    fn reader(&mut self) -> std::io::Result<BufReader<File>> {
+        let out = self
+            .out
+            .take()
+            .ok_or_else(|| std::io::Error::other("scratch stream already read"))?;
+        let mut file = out.into_inner().map_err(|e| e.into_error())?;
+        file.seek(SeekFrom::Start(0))?;
+        Ok(BufReader::new(file))
+    }
+}
+
+impl Drop for ScratchStream {
+    fn drop(&mut self) {
+        self.out = None;
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// A Parquet file written group by group ([`GroupFileWriter::append`]) and finished with
+/// its footer ([`GroupFileWriter::finish`]): the bytes polars' `FileWriter` writes for the
+/// same groups (module docs).
+pub struct GroupFileWriter {
+    path: PathBuf,
+    file: BufWriter<File>,
+    offset: u64,
+    /// The footer without its groups, rows and key-value pairs.
+    footer: FileMetaData,
+    rows: i64,
+    groups: usize,
+    /// Each appended group's footer entry, thrift-encoded, its page index offsets counted
+    /// from the start of the column and offset index streams.
+    entries: ScratchStream,
+    column_indexes: ScratchStream,
+    offset_indexes: ScratchStream,
+}
+
+impl GroupFileWriter {
+    /// Start `path` (created or truncated) for groups of `schema`; the scratch files are
+    /// made beside it.
+    pub fn create(path: &Path, schema: &GroupSchema) -> std::io::Result<GroupFileWriter> {
+        let footer = schema.empty_footer()?;
+        let stem = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let scratch = |what: &str| {
+            ScratchStream::create(dir.join(scratch_name(&format!("{stem}.{what}"), Scratch::Tmp)))
+        };
+        let mut file = BufWriter::with_capacity(1 << 20, File::create(path)?);
+        file.write_all(MAGIC)?;
+        Ok(GroupFileWriter {
+            path: path.to_path_buf(),
+            file,
+            offset: MAGIC.len() as u64,
+            footer,
+            rows: 0,
+            groups: 0,
+            entries: scratch("groups")?,
+            column_indexes: scratch("column-index")?,
+            offset_indexes: scratch("offset-index")?,
+        })
+    }
+
+    /// Append `g` after the groups written so far.
+    ///
+    /// # Errors
+    /// A write fails.
+    pub fn append(&mut self, g: &EncodedGroup) -> std::io::Result<()> {
+        let mut rg = g.group.clone();
+        rg.columns = Vec::with_capacity(g.chunks.len());
+        for c in &g.chunks {
+            let start = self.offset as i64;
+            self.file.write_all(&g.bytes[c.pages.clone()])?;
+            self.offset += c.pages.len() as u64;
+            let mut meta = c.meta.clone();
+            shift_chunk(&mut meta, start);
+            if let Some(m) = meta.meta_data.as_ref() {
+                let inline = thrift_bytes(|p| m.write_to_out_protocol(p))?;
+                self.file.write_all(&inline)?;
+                self.offset += inline.len() as u64;
+            }
+            if let Some(ci) = &c.column_index {
+                meta.column_index_offset = Some(self.column_indexes.write(ci)? as i64);
+                meta.column_index_length = Some(len_i32(ci.len())?);
+            }
+            let mut oi = c.offset_index.clone();
+            shift_offsets(&mut oi, start);
+            let oi = thrift_bytes(|p| oi.write_to_out_protocol(p))?;
+            meta.offset_index_offset = Some(self.offset_indexes.write(&oi)? as i64);
+            meta.offset_index_length = Some(len_i32(oi.len())?);
+            rg.columns.push(meta);
+        }
+        rg.file_offset = rg.columns.first().and_then(|c| {
+            let m = c.meta_data.as_ref()?;
+            m.dictionary_page_offset
+                .filter(|o| *o > 0)
+                .or(Some(m.data_page_offset))
+        });
+        rg.ordinal = i16::try_from(self.groups).ok();
+        self.rows += rg.num_rows;
+        self.groups += 1;
+        let entry = thrift_bytes(|p| rg.write_to_out_protocol(p))?;
+        self.entries.write(&(entry.len() as u64).to_le_bytes())?;
+        self.entries.write(&entry)?;
+        Ok(())
+    }
+
+    /// Write the page indexes and the footer with `kv`; returns the file's length.
+    ///
+    /// # Errors
+    /// A write fails.
+    pub fn finish(mut self, kv: Vec<KeyValue>) -> std::io::Result<u64> {
+        let column_base = self.offset as i64;
+        self.offset += std::io::copy(&mut self.column_indexes.reader()?, &mut self.file)?;
+        let offset_base = self.offset as i64;
+        self.offset += std::io::copy(&mut self.offset_indexes.reader()?, &mut self.file)?;
+        let mut entries = self.entries.reader()?;
+        let mut footer = self.footer.clone();
+        footer.num_rows = self.rows;
+        footer.key_value_metadata = Some(kv);
+        let groups = self.groups;
+        let mut next_group = || -> std::io::Result<RowGroup> {
+            let mut len = [0u8; 8];
+            entries.read_exact(&mut len)?;
+            let mut raw = vec![0; u64::from_le_bytes(len) as usize];
+            entries.read_exact(&mut raw)?;
+            let mut rg = read_thrift(&raw, RowGroup::read_from_in_protocol)?;
+            for c in &mut rg.columns {
+                c.column_index_offset = c.column_index_offset.map(|o| o + column_base);
+                c.offset_index_offset = c.offset_index_offset.map(|o| o + offset_base);
+            }
+            Ok(rg)
+        };
+        let mut meta = Vec::new();
+        write_footer(&mut meta, &footer, groups, &mut next_group)?;
+        self.file.write_all(&meta)?;
+        self.file.write_all(&len_i32(meta.len())?.to_le_bytes())?;
+        self.file.write_all(MAGIC)?;
+        self.file.flush()?;
+        self.offset += meta.len() as u64 + 8;
+        Ok(self.offset)
+    }
+
+    /// The file being written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+fn len_i32(n: usize) -> std::io::Result<i32> {
+    i32::try_from(n).map_err(|_| malformed(format!("{n} bytes: over a thrift length")))
+}
+
+/// `footer` as polars writes it (`FileMetaData::write_to_out_protocol`, field for field),
+/// its `groups` row groups taken one at a time from `next_group` instead of its own list.
+fn write_footer(
+    out: &mut Vec<u8>,
+    footer: &FileMetaData,
+    groups: usize,
+    next_group: &mut dyn FnMut() -> std::io::Result<RowGroup>,
+) -> std::io::Result<()> {
+    let e = thrift_err;
+    let mut p = TCompactOutputProtocol::new(out);
+    let list = |n: usize| -> std::io::Result<TListIdentifier> {
+        Ok(TListIdentifier::new(
+            TType::Struct,
+            u32::try_from(n).map_err(|_| malformed("list too long"))?,
+        ))
+    };
+    p.write_struct_begin(&TStructIdentifier::new("FileMetaData"))
+        .map_err(e)?;
+    p.write_field_begin(&TFieldIdentifier::new("version", TType::I32, 1))
+        .map_err(e)?;
+    p.write_i32(footer.version).map_err(e)?;
+    p.write_field_end().map_err(e)?;
+    p.write_field_begin(&TFieldIdentifier::new("schema", TType::List, 2))
+        .map_err(e)?;
+    p.write_list_begin(&list(footer.schema.len())?).map_err(e)?;
+    for s in &footer.schema {
+        s.write_to_out_protocol(&mut p).map_err(e)?;
+    }
+    p.write_list_end().map_err(e)?;
+    p.write_field_end().map_err(e)?;
+    p.write_field_begin(&TFieldIdentifier::new("num_rows", TType::I64, 3))
+        .map_err(e)?;
+    p.write_i64(footer.num_rows).map_err(e)?;
+    p.write_field_end().map_err(e)?;
+    p.write_field_begin(&TFieldIdentifier::new("row_groups", TType::List, 4))
+        .map_err(e)?;
+    p.write_list_begin(&list(groups)?).map_err(e)?;
+    for _ in 0..groups {
+        next_group()?.write_to_out_protocol(&mut p).map_err(e)?;
+    }
+    p.write_list_end().map_err(e)?;
+    p.write_field_end().map_err(e)?;
+    // The fields after the groups, written by a copy of the footer without groups, would
+    // restart the field numbering; they are written here in polars' order instead.
+    if let Some(kv) = &footer.key_value_metadata {
+        p.write_field_begin(&TFieldIdentifier::new("key_value_metadata", TType::List, 5))
+            .map_err(e)?;
+        p.write_list_begin(&list(kv.len())?).map_err(e)?;
+        for x in kv {
+            x.write_to_out_protocol(&mut p).map_err(e)?;
+        }
+        p.write_list_end().map_err(e)?;
+        p.write_field_end().map_err(e)?;
+    }
+    if let Some(by) = &footer.created_by {
+        p.write_field_begin(&TFieldIdentifier::new("created_by", TType::String, 6))
+            .map_err(e)?;
+        p.write_string(by).map_err(e)?;
+        p.write_field_end().map_err(e)?;
+    }
+    if let Some(orders) = &footer.column_orders {
+        p.write_field_begin(&TFieldIdentifier::new("column_orders", TType::List, 7))
+            .map_err(e)?;
+        p.write_list_begin(&list(orders.len())?).map_err(e)?;
+        for o in orders {
+            o.write_to_out_protocol(&mut p).map_err(e)?;
+        }
+        p.write_list_end().map_err(e)?;
+        p.write_field_end().map_err(e)?;
+    }
+    if footer.encryption_algorithm.is_some() || footer.footer_signing_key_metadata.is_some() {
+        return Err(malformed("encrypted footers are not supported"));
+    }
+    p.write_field_stop().map_err(e)?;
+    p.write_struct_end().map_err(e)?;
+    Ok(())
+}
+
+/// The statistics (minimum, maximum) of the leaf column named `name` in a group's footer
+/// entry, raw Parquet bytes (a string's UTF-8).
+fn column_range<'a>(rg: &'a RowGroup, name: &str) -> Option<(&'a [u8], &'a [u8])> {
+    rg.columns.iter().find_map(|c| {
+        let m = c.meta_data.as_ref()?;
+        if m.path_in_schema.len() != 1 || m.path_in_schema[0] != name {
+            return None;
+        }
+        let st = m.statistics.as_ref()?;
+        Some((st.min_value.as_deref()?, st.max_value.as_deref()?))
+    })
+}
+
+/// The row groups of a Parquet file, read in order one at a time as [`EncodedGroup`]s.
+/// The footer is read as the groups are, never held whole: a file of thousands of
+/// groups (one per clip) costs one group's metadata in memory.
+pub struct GroupFileReader {
+    path: PathBuf,
+    data: File,
+    /// The footer, positioned at the next group's entry in its list of row groups.
+    footer: BufReader<File>,
+    /// Groups whose entries are not read yet.
+    left: usize,
+    /// The next group's entry, read ahead by [`GroupFileReader::peek_value`].
+    next: Option<RowGroup>,
+}
+
+fn io(path: &Path, what: &str, e: impl std::error::Error + Send + Sync + 'static) -> Error {
+    Error::io(path, what, e)
+}
+
+/// Read a footer up to its list of row groups; the number of groups.
+fn footer_to_groups(footer: &mut BufReader<File>) -> std::io::Result<usize> {
+    let mut p = TCompactInputProtocol::new(footer, THRIFT_LIMIT);
+    p.read_struct_begin().map_err(thrift_err)?;
+    loop {
+        let field = p.read_field_begin().map_err(thrift_err)?;
+        match (field.field_type, field.id) {
+            (TType::Stop, _) => return Err(malformed("footer without row groups")),
+            (TType::List, Some(4)) => {
+                let list = p.read_list_begin().map_err(thrift_err)?;
+                return Ok(list.size as usize);
+            }
+            (t, _) => p.skip(t).map_err(thrift_err)?,
+        }
+        p.read_field_end().map_err(thrift_err)?;
+    }
+}
+
+impl GroupFileReader {
+    /// Open `path` and read its footer up to the first group's entry.
+    ///
+    /// # Errors
+    /// The file cannot be read or is not Parquet.
+    pub fn open(path: &Path) -> Result<GroupFileReader> {
+        let err = |e| io(path, "cannot read parquet", e);
+        let mut data = File::open(path).map_err(|e| io(path, "cannot open", e))?;
+        let len = data.metadata().map_err(err)?.len();
+        if len < 12 {
+            return Err(err(malformed("too short for a parquet file")));
+        }
+        let tail = data.read_at(len as i64 - 8, 8).map_err(err)?;
+        if &tail[4..] != MAGIC {
+            return Err(err(malformed("no parquet magic at the end")));
+        }
+        let meta_len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+        let start = (len - 8)
+            .checked_sub(meta_len)
+            .ok_or_else(|| err(malformed("footer longer than the file")))?;
+        let mut footer = BufReader::new(File::open(path).map_err(|e| io(path, "cannot open", e))?);
+        footer.seek(SeekFrom::Start(start)).map_err(err)?;
+        let left = footer_to_groups(&mut footer).map_err(err)?;
+        Ok(GroupFileReader {
+            path: path.to_path_buf(),
+            data,
+            footer,
+            left,
+            next: None,
+        })
+    }
+
+    /// The next group's entry, read from the footer if not read yet (`None` after the last).
+    fn peek(&mut self) -> Result<Option<&RowGroup>> {
+        if self.next.is_none() && self.left > 0 {
+            let mut p = TCompactInputProtocol::new(&mut self.footer, THRIFT_LIMIT);
+            let rg = RowGroup::read_from_in_protocol(&mut p)
+                .map_err(|e| io(&self.path, "cannot read parquet", thrift_err(e)))?;
+            self.left -= 1;
+            self.next = Some(rg);
+        }
+        Ok(self.next.as_ref())
+    }
+
+    /// The value of column `name` in the next group, when that group holds one value of it
+    /// (its minimum and maximum statistics are equal); `None` after the last group.
+    ///
+    /// # Errors
+    /// The footer cannot be read, or the group has no statistics for `name` or more than
+    /// one value of it (not a table of one clip per group).
+    pub fn peek_value(&mut self, name: &str) -> Result<Option<Vec<u8>>> {
+        let path = self.path.clone();
+        let Some(rg) = self.peek()? else {
+            return Ok(None);
+        };
+        match column_range(rg, name) {
+            Some((lo, hi)) if lo == hi => Ok(Some(lo.to_vec())),
+            _ => Err(io(
+                &path,
+                "cannot read parquet",
+                malformed(format!(
+                    "a row group holds no single value of column {name}"
+                )),
+            )),
+        }
+    }
+
+    /// The next row group with its pages; `None` after the last.
+    ///
+    /// # Errors
+    /// Its entry or bytes cannot be read or are malformed.
+    pub fn next_group(&mut self) -> Result<Option<EncodedGroup>> {
+        self.peek()?;
+        let Some(rg) = self.next.take() else {
+            return Ok(None);
+        };
+        take_group(&mut self.data, &rg)
+            .map(Some)
+            .map_err(|e| io(&self.path, "cannot read parquet", e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polars::prelude::*;
+
+    /// A table of `n` rows: strings (dictionary pages), integers, floats, nulls, lists.
+    fn table(n: usize) -> DataFrame {
+        let mut df = df! {
+            "clip" => (0..n).map(|i| format!("clip_{:03}", i / 700)).collect::<Vec<_>>(),
+            "frame" => (0..n as i64).collect::<Vec<_>>(),
+            "x" => (0..n).map(|i| (i as f64 * 0.37).sin()).collect::<Vec<_>>(),
+            "z" => (0..n).map(|i| (i % 5 != 0).then_some(i as f64)).collect::<Vec<_>>(),
+        }
+        .unwrap();
+        let lists: Vec<Series> = (0..n)
+            .map(|i| Series::new("".into(), vec![i as f64; i % 3]))
+            .collect();
+        df.with_column(Series::new("l".into(), lists).into_column())
+            .unwrap();
+        df
+    }
+
+    fn schema_of(
+        df: &DataFrame,
+    ) -> (
+        GroupSchema,
+        Vec<(
+            polars_parquet::write::ParquetType,
+            Vec<polars_parquet::write::Encoding>,
+        )>,
+    ) {
+        let arrow = df.schema().to_arrow(CompatLevel::newest());
+        let parquet = polars_parquet::write::to_parquet_schema(&arrow).unwrap();
+        let encodings = polars::io::parquet::write::get_encodings(&arrow);
+        let columns = parquet
+            .fields()
+            .iter()
+            .cloned()
+            .zip(encodings.iter().cloned())
+            .collect();
+        (
+            GroupSchema::new(arrow, parquet, super::super::stream::write_options()),
+            columns,
+        )
+    }
+
+    fn pages(
+        df: &DataFrame,
+        columns: &[(
+            polars_parquet::write::ParquetType,
+            Vec<polars_parquet::write::Encoding>,
+        )],
+    ) -> Vec<Vec<CompressedPage>> {
+        super::super::stream::encode_group(df.columns(), columns).unwrap()
+    }
+
+    /// Groups appended one by one give the bytes polars' own writer gives for the same
+    /// groups; the file reads back as the table.
+    #[test]
+    fn appended_groups_give_polars_bytes() {
+        let df = table(5000);
+        let cuts = [(0, 1400), (1400, 2100), (3500, 1500)];
+        let (schema, columns) = schema_of(&df);
+        let kv = vec![KeyValue {
+            key: "k".into(),
+            value: Some("v".into()),
+        }];
+        let mut theirs = schema.writer();
+        for (at, n) in cuts {
+            let p = pages(&df.slice(at, n), &columns);
+            let it = DynIter::new(p.iter().map(|col| {
+                Ok(DynStreamingIterator::new(
+                    polars_parquet::write::fallible_streaming_iterator::convert(
+                        col.iter().map(PolarsResult::Ok),
+                    ),
+                ))
+            }));
+            theirs.write(n as u64, it).unwrap();
+        }
+        theirs.end(Some(kv.clone())).unwrap();
+        let theirs = theirs.into_inner();
+
+        let d = tempfile::tempdir().unwrap();
+        let path = d.path().join("t.parquet");
+        let mut w = GroupFileWriter::create(&path, &schema).unwrap();
+        for (at, n) in cuts {
+            let g = encode(&schema, n as u64, &pages(&df.slice(at, n), &columns)).unwrap();
+            assert_eq!(g.rows(), n);
+            w.append(&g).unwrap();
+        }
+        w.finish(kv).unwrap();
+        let ours = std::fs::read(&path).unwrap();
+        assert!(
+            ours == theirs,
+            "the bytes differ ({} against {})",
+            ours.len(),
+            theirs.len()
+        );
+        let left: Vec<_> = std::fs::read_dir(d.path()).unwrap().collect();
+        assert_eq!(left.len(), 1, "scratch files left: {left:?}");
+        let back = ParquetReader::new(std::io::Cursor::new(ours))
+            .finish()
+            .unwrap();
+        assert!(back.equals_missing(&df));
+    }
+
+    /// A group read from one file and appended to another at another position gives the
+    /// bytes of the same group encoded for that file, and no group gives an empty file.
+    #[test]
+    fn a_group_moved_between_files_keeps_its_bytes() {
+        let df = table(4000);
+        let (schema, columns) = schema_of(&df);
+        let d = tempfile::tempdir().unwrap();
+        let write = |name: &str, cuts: &[(i64, usize)]| {
+            let path = d.path().join(name);
+            let mut w = GroupFileWriter::create(&path, &schema).unwrap();
+            for &(at, n) in cuts {
+                w.append(&encode(&schema, n as u64, &pages(&df.slice(at, n), &columns)).unwrap())
+                    .unwrap();
+            }
+            w.finish(Vec::new()).unwrap();
+            path
+        };
+        let shard = write("shard.parquet", &[(0, 300), (300, 3700)]);
+        let direct = write("direct.parquet", &[(300, 3700), (0, 300)]);
+        let mut r = GroupFileReader::open(&shard).unwrap();
+        assert_eq!(r.peek_value("frame").ok(), None, "300 frames in a group");
+        assert_eq!(r.peek_value("clip").unwrap(), Some(b"clip_000".to_vec()));
+        let first = r.next_group().unwrap().unwrap();
+        assert!(r.peek_value("clip").is_err(), "clips 0 to 5 in a group");
+        let second = r.next_group().unwrap().unwrap();
+        assert_eq!((first.rows(), second.rows()), (300, 3700));
+        assert_eq!(r.peek_value("clip").unwrap(), None);
+        assert!(r.next_group().unwrap().is_none());
+        let moved = d.path().join("moved.parquet");
+        let mut w = GroupFileWriter::create(&moved, &schema).unwrap();
+        w.append(&second).unwrap();
+        w.append(&first).unwrap();
+        w.finish(Vec::new()).unwrap();
+        assert!(std::fs::read(&moved).unwrap() == std::fs::read(&direct).unwrap());
+        let empty = write("empty.parquet", &[]);
+        let back = ParquetReader::new(File::open(empty).unwrap())
+            .finish()
+            .unwrap();
+        assert_eq!(back.height(), 0);
+        assert_eq!(back.schema(), df.schema());
+    }
+
+    /// A file that is not Parquet, or is cut short, is an error naming it, not a panic.
+    #[test]
+    fn a_damaged_file_is_an_error() {
+        let df = table(800);
+        let (schema, columns) = schema_of(&df);
+        let d = tempfile::tempdir().unwrap();
+        let path = d.path().join("t.parquet");
+        let mut w = GroupFileWriter::create(&path, &schema).unwrap();
+        w.append(&encode(&schema, 800, &pages(&df, &columns)).unwrap())
+            .unwrap();
+        w.finish(Vec::new()).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        for cut in [0, 5, bytes.len() / 2, bytes.len() - 1] {
+            let bad = d.path().join(format!("cut{cut}.parquet"));
+            std::fs::write(&bad, &bytes[..cut]).unwrap();
+            let e = GroupFileReader::open(&bad)
+                .err()
+                .expect("a cut file is refused");
+            assert!(e.to_string().contains(&format!("cut{cut}")), "{e}");
+        }
+        // A footer whose offsets point past the end: the group read is refused.
+        let mut r = GroupFileReader::open(&path).unwrap();
+        r.peek().unwrap();
+        let m = r.next.as_mut().unwrap().columns[0]
+            .meta_data
+            .as_mut()
+            .unwrap();
+        m.data_page_offset = 1 << 40;
+        m.dictionary_page_offset = None;
+        assert!(r.next_group().is_err());
+    }
+}
