@@ -271,6 +271,61 @@ fn row_groups_hold_64_ki_rows_whatever_the_batches() {
     assert_eq!(groups, vec![65_536, 65_536, 18_928]);
 }
 
+/// Per row group of `path`: the one value of each column of `names` (an error, so a
+/// failure, where a group holds more than one).
+fn group_values(path: &Path, names: &[&str]) -> Vec<Vec<String>> {
+    let mut r = stancelib::library::row_groups::GroupFileReader::open(path).unwrap();
+    let mut out = Vec::new();
+    loop {
+        let values: Vec<Option<Vec<u8>>> = names.iter().map(|n| r.peek_value(n).unwrap()).collect();
+        if values.iter().any(Option::is_none) {
+            break;
+        }
+        out.push(
+            values
+                .into_iter()
+                .map(|v| String::from_utf8(v.unwrap()).unwrap())
+                .collect(),
+        );
+        r.next_group().unwrap().unwrap();
+    }
+    assert!(r.next_group().unwrap().is_none());
+    out
+}
+
+/// The per-frame tables hold one row group per clip and the polytopes' points one per
+/// (character, effector), so that a merge copies them without decoding them.
+#[test]
+fn per_clip_tables_hold_a_row_group_per_clip() {
+    let d = tmp();
+    let out = d.path().join("lib");
+    streamed(&fixture_inputs(), &out, 2, 2);
+    let clips = stancelib::library::read::read_parquet(&out.join("clips.parquet")).unwrap();
+    let with_frames: Vec<String> = clips
+        .column("clip")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .zip(clips.column("frames_kept").unwrap().i64().unwrap().iter())
+        .filter(|(_, n)| n.unwrap_or(0) > 0)
+        .map(|(c, _)| c.unwrap().to_string())
+        .collect();
+    let per_group: Vec<String> = group_values(&out.join("frames.parquet"), &["clip"])
+        .into_iter()
+        .map(|mut v| v.remove(0))
+        .collect();
+    assert_eq!(per_group, with_frames);
+    let points = group_values(
+        &out.join("kinematics_points.parquet"),
+        &["character_id", "effector"],
+    );
+    assert!(!points.is_empty());
+    let mut keys = points.clone();
+    keys.dedup();
+    assert_eq!(keys, points, "a (character, effector) in two row groups");
+}
+
 #[test]
 fn a_file_s_shard_follows_its_content_not_its_name_or_neighbours() {
     let d = tmp();

@@ -17,9 +17,9 @@
 //! memory: a file of many small groups (one per clip) holds nothing per group until the
 //! footer is written.
 //!
-//! A group is encoded by polars' own writer into a buffer ([`encode_group_bytes`]) and read
-//! back from it as from any file ([`group_from_bytes`]), so the pages, statistics and
-//! indexes are polars'; only the file's assembly is done here.
+//! A group is encoded by polars' own writer into a one-group file in memory and read back
+//! from it as from any file ([`encode`]), so the pages, statistics and indexes are
+//! polars'; only the file's assembly is done here.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};

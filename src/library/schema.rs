@@ -88,13 +88,25 @@ pub fn sort_keys(file: &str) -> &'static [&'static str] {
     }
 }
 
-/// The column whose every change ends a row group of a table, if any: the per-frame
-/// tables are cut into one row group per clip (longer clips into groups of at most
-/// `ROW_GROUP_ROWS` rows), so that a merge copies a clip's groups from its shard without
-/// decoding them and still writes the bytes of a single build.
-pub fn group_column(file: &str) -> Option<&'static str> {
+/// The columns whose every change ends a row group of a table (none: row groups of
+/// `ROW_GROUP_ROWS` rows across the keys). Groups longer than `ROW_GROUP_ROWS` rows are cut
+/// into groups of that many. The per-frame tables are cut per clip, so that a merge copies
+/// a clip's groups from its shard without decoding them and still writes the bytes of a
+/// single build; the polytopes' points per (character, effector), so that each group is
+/// written on its own worker and its row groups put in order after.
+pub fn group_keys(file: &str) -> &'static [&'static str] {
     match file {
-        FRAMES_FILE | JOINTS_FILE => Some(frames::CLIP),
+        FRAMES_FILE | JOINTS_FILE => &[frames::CLIP],
+        KINEMATICS_POINTS_FILE => &[kinematics::CHARACTER_ID, kinematics::EFFECTOR],
+        _ => &[],
+    }
+}
+
+/// The clip column of a table whose row groups each hold one clip ([`group_keys`]), which
+/// a merge copies group by group from its shards.
+pub fn group_column(file: &str) -> Option<&'static str> {
+    match group_keys(file) {
+        [c] if *c == frames::CLIP => Some(c),
         _ => None,
     }
 }

@@ -5,8 +5,9 @@
 //! # Layout
 //! ```text
 //! row groups: ROW_GROUP_ROWS rows each, the last one shorter (never empty unless the table is);
-//!             a per-frame table (`schema::group_column`): one group per clip, a clip of more
-//!             than ROW_GROUP_ROWS rows in groups of ROW_GROUP_ROWS and its shorter rest
+//!             a table with group keys (`schema::group_keys`: per clip, per character and
+//!             effector): one group per run of equal keys, a run of more than
+//!             ROW_GROUP_ROWS rows in groups of ROW_GROUP_ROWS and its shorter rest
 //! footer:     ARROW:schema (oldest compatibility level), then the caller's key-value pairs
 //! ```
 //! The layout depends only on the rows and their order, never on how they were cut into
@@ -27,15 +28,20 @@
 //! are held until it is written (the build's peak memory on a 25× replica of the bulk set:
 //! `tests/bench/scale.rs`).
 
+use std::cell::RefCell;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use polars::io::parquet::write::get_encodings;
 use polars::prelude::*;
+use polars_parquet::parquet::compression::Compression;
+use polars_parquet::parquet::error::ParquetResult;
+use polars_parquet::parquet::page::{CompressedDataPage, CompressedDictPage, DataPageHeader};
+use polars_parquet::parquet::CowBuffer;
 use polars_parquet::read::ParquetError;
 use polars_parquet::write::{
-    array_to_columns, to_parquet_schema, CompressedPage, Compressor, Encoding, KeyValue,
-    ParquetType, Version, WriteOptions,
+    array_to_columns, to_parquet_schema, CompressedPage, CompressionOptions, Compressor, Encoding,
+    KeyValue, Page, ParquetType, Version, WriteOptions, ZstdLevel,
 };
 use rayon::prelude::*;
 
@@ -55,8 +61,8 @@ pub struct TableWriter {
     group_schema: GroupSchema,
     /// Per column: its Parquet type and encodings, as polars' writer derives them.
     columns: Vec<LeafType>,
-    /// The column whose every change ends a row group (`schema::group_column`).
-    group_column: Option<&'static str>,
+    /// The columns whose every change ends a row group (`schema::group_keys`).
+    group_keys: &'static [&'static str],
     pending: DataFrame,
     /// Older pending rows moved to scratch Parquet files in the table's folder, in order
     /// (`PENDING_SPILL_BYTES`, `PENDING_SPILL_CHUNKS`), with their row count.
@@ -111,11 +117,86 @@ fn encode_column(
             let pages = pages.map(|p| {
                 p.map_err(|e| ParquetError::FeatureNotSupported(format!("reraised in polars: {e}")))
             });
-            Compressor::new_from_vec(pages, options.compression, vec![])
-                .collect::<std::result::Result<Vec<_>, _>>()
-                .map_err(PolarsError::from)
+            match options.compression {
+                CompressionOptions::Zstd(level) => pages
+                    .map(|p| compress_page(p?, level))
+                    .collect::<std::result::Result<Vec<_>, _>>()
+                    .map_err(PolarsError::from),
+                other => Compressor::new_from_vec(pages, other, vec![])
+                    .collect::<std::result::Result<Vec<_>, _>>()
+                    .map_err(PolarsError::from),
+            }
         })
         .collect()
+}
+
+thread_local! {
+    /// Each worker's zstd context and its level, made at its first page and reused.
+    static ZSTD: RefCell<Option<(i32, zstd::bulk::Compressor<'static>)>> =
+        const { RefCell::new(None) };
+}
+
+/// `input` compressed by zstd at `level` (polars' level rule: none is zstd's default),
+/// with the worker's context.
+///
+/// polars compresses each page with a new context (`zstd::bulk::compress_to_buffer`),
+/// whose set-up costs more than a short page's compression: 6.7 % of a build's time on the
+/// bulk set once the frames were cut per clip. A context compresses the same bytes to the
+/// same output whether new or reused (zstd resets its session at every frame); the
+/// tests compare the files with polars' own writer.
+fn zstd_compress(input: &[u8], level: Option<ZstdLevel>) -> ParquetResult<Vec<u8>> {
+    let level = level.map(|v| v.compression_level()).unwrap_or_default();
+    ZSTD.with(|cell| {
+        let mut cell = cell.borrow_mut();
+        if cell.as_ref().is_none_or(|(l, _)| *l != level) {
+            let c = zstd::bulk::Compressor::new(level)
+                .map_err(|e| ParquetError::OutOfSpec(format!("zstd: {e}")))?;
+            *cell = Some((level, c));
+        }
+        let Some((_, c)) = cell.as_mut() else {
+            return Err(ParquetError::OutOfSpec("zstd: no context".into()));
+        };
+        let mut out = vec![0u8; zstd::zstd_safe::compress_bound(input.len())];
+        let n = c
+            .compress_to_buffer(input, &mut out[..])
+            .map_err(|e| ParquetError::OutOfSpec(format!("zstd: {e}")))?;
+        out.truncate(n);
+        Ok(out)
+    })
+}
+
+/// `page` compressed with zstd as polars' `Compressor` compresses it (V1 data pages and
+/// dictionary pages; a V2 data page, which this crate does not write, goes to polars).
+fn compress_page(page: Page, level: Option<ZstdLevel>) -> ParquetResult<CompressedPage> {
+    match page {
+        Page::Data(p) if matches!(p.header(), DataPageHeader::V1(_)) => {
+            let buffer = zstd_compress(p.buffer(), level)?;
+            let rows = p
+                .num_rows()
+                .ok_or_else(|| ParquetError::OutOfSpec("a data page without rows".into()))?;
+            Ok(CompressedPage::Data(CompressedDataPage::new(
+                p.header().clone(),
+                CowBuffer::Owned(buffer),
+                Compression::Zstd,
+                p.buffer().len(),
+                p.descriptor.clone(),
+                rows,
+            )))
+        }
+        Page::Dict(d) => {
+            let buffer = zstd_compress(&d.buffer, level)?;
+            Ok(CompressedPage::Dict(CompressedDictPage::new(
+                CowBuffer::Owned(buffer),
+                Compression::Zstd,
+                d.buffer.len(),
+                d.num_values,
+                d.is_sorted,
+            )))
+        }
+        other => {
+            polars_parquet::write::compress(other, Vec::new(), CompressionOptions::Zstd(level))
+        }
+    }
 }
 
 /// The compressed pages of every column of one row group, in column order: each column is
@@ -184,19 +265,48 @@ fn group_schema(schema: &Schema) -> PolarsResult<(GroupSchema, Vec<LeafType>)> {
     Ok((GroupSchema::new(arrow, parquet, write_options()), columns))
 }
 
-/// Row counts of the groups `clips` (a string column) cuts into: one per run of equal
-/// values, a run of more than [`ROW_GROUP_ROWS`] in groups of that many. Without `all`, the
-/// last run (whose clip may go on in the next rows) gives only its full groups.
-fn clip_group_sizes(clips: &Column, all: bool) -> PolarsResult<Vec<usize>> {
-    let values = clips.str()?;
+/// Encode the float columns of `schema` as plain values, not by polars' dictionary attempt.
+///
+/// For a float column polars tries a dictionary first and estimates the chunk's distinct
+/// values (a HyperLogLog count, whose cost is fixed per column chunk, not per value); a
+/// table cut into short groups (one per clip) paid it on every chunk: 7.5 % of a build's
+/// time on the bulk set. Every float chunk of the frames of the bulk set had been written
+/// plain anyway (positions and rates: far more than 75 % distinct values).
+fn plain_floats(schema: &Schema, columns: &mut [LeafType]) {
+    for ((_, dtype), (_, encodings)) in schema.iter().zip(columns.iter_mut()) {
+        if matches!(dtype, DataType::Float64 | DataType::Float32) {
+            *encodings = vec![Encoding::Plain];
+        }
+    }
+}
+
+/// Row counts of the groups `keys` (string columns of equal length) cut into: one per run
+/// of rows with equal keys, a run of more than [`ROW_GROUP_ROWS`] in groups of that many.
+/// Without `all`, the last run (whose key may go on in the next rows) gives only its full
+/// groups.
+fn keyed_group_sizes(keys: &[&Column], all: bool) -> PolarsResult<Vec<usize>> {
+    let n = keys.first().map_or(0, |c| c.len());
+    // A run starts at row 0 and wherever any key differs from the row before.
+    let mut starts = vec![false; n];
+    if let Some(first) = starts.first_mut() {
+        *first = true;
+    }
+    for k in keys {
+        let values = k.str()?;
+        let mut last: Option<Option<&str>> = None;
+        for (i, v) in values.iter().enumerate() {
+            if last.is_some_and(|l| l != v) {
+                starts[i] = true;
+            }
+            last = Some(v);
+        }
+    }
     let mut runs: Vec<usize> = Vec::new();
-    let mut last: Option<Option<&str>> = None;
-    for v in values.iter() {
+    for start in starts {
         match runs.last_mut() {
-            Some(n) if last == Some(v) => *n += 1,
+            Some(r) if !start => *r += 1,
             _ => runs.push(1),
         }
-        last = Some(v);
     }
     let n_runs = runs.len();
     let mut sizes = Vec::new();
@@ -260,8 +370,12 @@ impl TableWriter {
         let path = dir.join(name);
         let tmp = dir.join(scratch_name(name, Scratch::Tmp));
         let schema = empty.schema().as_ref().clone();
-        let (group_schema, columns) =
+        let group_keys = super::schema::group_keys(name);
+        let (group_schema, mut columns) =
             group_schema(&schema).map_err(|e| io(&path, "cannot write parquet", e))?;
+        if !group_keys.is_empty() {
+            plain_floats(&schema, &mut columns);
+        }
         let writer = GroupFileWriter::create(&tmp, &group_schema)
             .map_err(|e| io(&tmp, "cannot create", e))?;
         Ok(TableWriter {
@@ -275,7 +389,7 @@ impl TableWriter {
             writer: Some(writer),
             group_schema,
             columns,
-            group_column: super::schema::group_column(name),
+            group_keys,
             rows: 0,
             string_hint: None,
         })
@@ -294,11 +408,11 @@ impl TableWriter {
     /// in memory, the older ones in scratch files beside the table: for a table of few, wide rows, which takes many
     /// batches to fill a row group. A long table (frames) fills one in a few batches and
     /// is better held than written twice.
-    /// Not for a per-frame table, whose rows wait for one clip at most.
+    /// Not for a table cut by keys (`schema::group_keys`), whose rows wait for one key.
     pub fn with_pending_spill(mut self) -> TableWriter {
         debug_assert!(
-            self.group_column.is_none(),
-            "a per-clip table waits for one clip"
+            self.group_keys.is_empty(),
+            "a keyed table waits for one key"
         );
         self.spill = true;
         self
@@ -325,8 +439,8 @@ impl TableWriter {
         self.pending
             .vstack_mut(&df)
             .map_err(|e| io(&self.path, "rows of another schema", e))?;
-        if self.group_column.is_some() {
-            return self.write_clip_groups(false);
+        if !self.group_keys.is_empty() {
+            return self.write_keyed_groups(false);
         }
         if self.spilled_rows + self.pending.height() < ROW_GROUP_ROWS {
             // The rows wait as one chunk per push: copying them into one buffer at every
@@ -488,15 +602,17 @@ impl TableWriter {
         }
     }
 
-    /// Write the pending rows' complete per-clip groups (all of them with `all`), encoded
-    /// in parallel and appended in order; the rest stays pending.
-    fn write_clip_groups(&mut self, all: bool) -> Result<()> {
-        let Some(name) = self.group_column else {
-            return Ok(());
-        };
+    /// Write the pending rows' complete groups of equal keys (all of them with `all`),
+    /// encoded in parallel and appended in order; the rest stays pending.
+    fn write_keyed_groups(&mut self, all: bool) -> Result<()> {
         let err = |e| io(&self.tmp, "cannot write parquet", e);
-        let clips = self.pending.column(name).map_err(err)?;
-        let sizes = clip_group_sizes(clips, all).map_err(err)?;
+        let keys = self
+            .group_keys
+            .iter()
+            .map(|k| self.pending.column(k))
+            .collect::<PolarsResult<Vec<_>>>()
+            .map_err(err)?;
+        let sizes = keyed_group_sizes(&keys, all).map_err(err)?;
         let starts: Vec<usize> = sizes
             .iter()
             .scan(0, |at, n| {
@@ -556,8 +672,8 @@ impl TableWriter {
     /// # Errors
     /// A write or the rename fails (the temporary file is removed).
     pub fn finish(mut self, kv: &[(String, String)]) -> Result<()> {
-        if self.group_column.is_some() {
-            self.write_clip_groups(true)?;
+        if !self.group_keys.is_empty() {
+            self.write_keyed_groups(true)?;
         } else if !self.spilled.is_empty() {
             self.write_pending_by_column(usize::MAX)?;
         } else if self.pending.height() > 0 {
@@ -714,6 +830,35 @@ mod tests {
             let bytes = std::fs::read(d.path().join(name)).unwrap();
             assert!(bytes == serial, "pushes of {cut} rows: the bytes differ");
         }
+    }
+
+    /// Runs of equal keys over several columns: a change in any key starts a group, the
+    /// open last run waits unless `all`, and a long run is cut at `ROW_GROUP_ROWS`.
+    #[test]
+    fn keyed_groups_follow_every_key() {
+        let col = |name: &str, v: Vec<Option<&str>>| Column::new(name.into(), v);
+        let a = col(
+            "a",
+            vec![Some("x"), Some("x"), Some("x"), Some("y"), Some("y"), None],
+        );
+        let b = col(
+            "b",
+            vec![Some("1"), Some("1"), Some("2"), Some("2"), Some("2"), None],
+        );
+        assert_eq!(keyed_group_sizes(&[&a, &b], true).unwrap(), [2, 1, 2, 1]);
+        assert_eq!(keyed_group_sizes(&[&a, &b], false).unwrap(), [2, 1, 2]);
+        assert_eq!(keyed_group_sizes(&[&a], true).unwrap(), [3, 2, 1]);
+        let long = col("a", vec![Some("z"); 2 * ROW_GROUP_ROWS + 3]);
+        assert_eq!(
+            keyed_group_sizes(&[&long], false).unwrap(),
+            [ROW_GROUP_ROWS, ROW_GROUP_ROWS]
+        );
+        assert_eq!(
+            keyed_group_sizes(&[&long], true).unwrap(),
+            [ROW_GROUP_ROWS, ROW_GROUP_ROWS, 3]
+        );
+        let empty = col("a", Vec::new());
+        assert!(keyed_group_sizes(&[&empty], true).unwrap().is_empty());
     }
 
     /// A group taken from one file and pushed into another table gives the bytes of its

@@ -31,7 +31,7 @@ use crate::library::kinematics::{
 };
 use crate::library::layout::{convert_to_dataset, locate_path, read_source, Layout, TableSource};
 use crate::library::read::parquet_rows;
-use crate::library::row_groups::EncodedGroup;
+use crate::library::row_groups::{EncodedGroup, GroupFileReader};
 use crate::library::schema::{
     clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE,
@@ -413,6 +413,11 @@ fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Re
 /// table and into the polytope's [`StreamedHull`] (bounded memory: see the module docs
 /// of [`crate::twopac::kinematic`]); a group with fewer than 4 non-coplanar points after
 /// the rules has points but no facets (an error at query time).
+///
+/// The groups are reduced in parallel on the worker pool ([`reduce_group`]), each writing
+/// its points to a scratch table of its own; their row groups (a table cut per character
+/// and effector, `schema::group_keys`) are then copied in order into the points table, so
+/// the bytes do not depend on the thread count.
 fn kinematics(
     spill: &SampleSpill,
     legs: &BTreeMap<String, f64>,
@@ -421,41 +426,97 @@ fn kinematics(
 ) -> Result<()> {
     let empty =
         points_frame(&Default::default(), &[]).map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
+    let parts =
+        ScratchDir::create(dir.join(scratch_name("kinematics_points.parts", Scratch::Tmp)))?;
+    let keys: Vec<&(String, String)> = spill.groups().into_iter().map(|(k, _)| k).collect();
+    let reduced: Vec<Vec<Facet>> = keys
+        .par_iter()
+        .enumerate()
+        .map(|(i, key)| {
+            let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
+            reduce_group(spill, key, leg, &parts.part(i)?, &empty)
+        })
+        .collect::<Result<_>>()?;
     let mut w = TableWriter::create(dir, KINEMATICS_POINTS_FILE, &empty)?;
-    let mut facets: Vec<Facet> = Vec::new();
-    for (key, _) in spill.groups() {
-        let leg = legs.get(&key.0).copied().unwrap_or(f64::INFINITY);
-        let rule = OutlierRule::fit(leg, |f| {
-            spill.read_group(key, &mut |b| {
-                b.iter().for_each(|s| f(&s.rc));
-                Ok(())
-            })
-        })?;
-        let mut hull = StreamedHull::default();
-        let mut rows = GroupRows {
-            key,
-            rows: Vec::new(),
-            w: &mut w,
-        };
-        spill.read_group(key, &mut |b| {
-            for s in b.iter().filter(|s| rule.keeps(&s.rc)) {
-                hull.push(s.rc);
-                rows.add(s)?;
-            }
-            Ok(())
-        })?;
-        rows.flush()?;
-        if let Ok(p) = hull.finish(&HullOptions::default()) {
-            facets.extend(
-                p.a.iter()
-                    .zip(&p.b)
-                    .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d)),
-            );
+    for i in 0..keys.len() {
+        let path = parts.part(i)?.join(KINEMATICS_POINTS_FILE);
+        let mut groups = GroupFileReader::open(&path)?;
+        while let Some(g) = groups.next_group()? {
+            w.push_group(&g)?;
         }
+        drop(groups);
+        let _ = std::fs::remove_file(&path);
     }
     w.finish(kv)?;
-    let mut facets = facets_table(facets).map_err(|e| pe(KINEMATICS_FILE, e))?;
+    let mut facets = facets_table(reduced.into_iter().flatten().collect())
+        .map_err(|e| pe(KINEMATICS_FILE, e))?;
     write_atomic(dir, KINEMATICS_FILE, &mut facets, kv)
+}
+
+/// One (character, effector) group of the spilled samples, with the character's leg length
+/// `leg` (m): its kept points written to `part/kinematics_points.parquet` (a table of
+/// `empty`'s columns), its polytope's facets returned ([`kinematics`]).
+fn reduce_group(
+    spill: &SampleSpill,
+    key: &(String, String),
+    leg: f64,
+    part: &Path,
+    empty: &DataFrame,
+) -> Result<Vec<Facet>> {
+    let rule = OutlierRule::fit(leg, |f| {
+        spill.read_group(key, &mut |b| {
+            b.iter().for_each(|s| f(&s.rc));
+            Ok(())
+        })
+    })?;
+    let mut w = TableWriter::create(part, KINEMATICS_POINTS_FILE, empty)?;
+    let mut hull = StreamedHull::default();
+    let mut rows = GroupRows {
+        key,
+        rows: Vec::new(),
+        w: &mut w,
+    };
+    spill.read_group(key, &mut |b| {
+        for s in b.iter().filter(|s| rule.keeps(&s.rc)) {
+            hull.push(s.rc);
+            rows.add(s)?;
+        }
+        Ok(())
+    })?;
+    rows.flush()?;
+    w.finish(&[])?;
+    Ok(match hull.finish(&HullOptions::default()) {
+        Ok(p) => {
+            p.a.iter()
+                .zip(&p.b)
+                .map(|(n, d)| (key.0.clone(), key.1.clone(), *n, *d))
+                .collect()
+        }
+        Err(_) => Vec::new(),
+    })
+}
+
+/// A scratch folder of numbered part folders, removed with everything in it when dropped.
+struct ScratchDir(PathBuf);
+
+impl ScratchDir {
+    fn create(path: PathBuf) -> Result<ScratchDir> {
+        std::fs::create_dir_all(&path).map_err(|e| Error::io(&path, "cannot create", e))?;
+        Ok(ScratchDir(path))
+    }
+
+    /// Part folder `i`, made if missing.
+    fn part(&self, i: usize) -> Result<PathBuf> {
+        let p = self.0.join(i.to_string());
+        std::fs::create_dir_all(&p).map_err(|e| Error::io(&p, "cannot create", e))?;
+        Ok(p)
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 /// `parts` stacked and sorted as table `name` (`empty` when there are none).
