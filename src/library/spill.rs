@@ -18,7 +18,7 @@
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -185,6 +185,39 @@ impl SampleSpill {
             .collect()
     }
 
+    /// Call `f` on the raw records of `key`'s runs in (clip, frame) order, up to
+    /// `READ_RECORDS` at a time, with the run they belong to (after [`SampleSpill::seal`]).
+    fn read_records(
+        &self,
+        key: &(String, String),
+        f: &mut dyn FnMut(&Run, &[u8]) -> Result<()>,
+    ) -> Result<()> {
+        let Some(runs) = self.groups.get(key) else {
+            return Ok(());
+        };
+        let err = |e| io(&self.path, "cannot read scratch file", e);
+        let mut file = File::open(&self.path).map_err(|e| io(&self.path, "cannot open", e))?;
+        let mut bytes = vec![0u8; READ_RECORDS * RECORD_BYTES];
+        let mut at = None;
+        for run in runs {
+            // Runs of one group mostly follow each other in the file: seek only where not.
+            if at != Some(run.first) {
+                file.seek(SeekFrom::Start(run.first * RECORD_BYTES as u64))
+                    .map_err(err)?;
+            }
+            at = Some(run.first + run.len);
+            let mut left = run.len;
+            while left > 0 {
+                let n = left.min(READ_RECORDS as u64) as usize;
+                let chunk = &mut bytes[..n * RECORD_BYTES];
+                file.read_exact(chunk).map_err(err)?;
+                f(run, chunk)?;
+                left -= n as u64;
+            }
+        }
+        Ok(())
+    }
+
     /// Call `f` on the samples of `key` in (clip, frame) order, up to `READ_RECORDS`
     /// at a time (after [`SampleSpill::seal`]).
     ///
@@ -195,45 +228,48 @@ impl SampleSpill {
         key: &(String, String),
         f: &mut dyn FnMut(&[Sample]) -> Result<()>,
     ) -> Result<()> {
-        let Some(runs) = self.groups.get(key) else {
-            return Ok(());
-        };
-        let file = File::open(&self.path).map_err(|e| io(&self.path, "cannot open", e))?;
-        let mut rdr = BufReader::with_capacity(READ_RECORDS * RECORD_BYTES, file);
         let mut buf: Vec<Sample> = Vec::with_capacity(READ_RECORDS);
-        let mut rec = [0u8; RECORD_BYTES];
-        let word = |r: &[u8; RECORD_BYTES], a: usize| {
-            let mut w = [0u8; 8];
-            w.copy_from_slice(&r[8 * a..8 * a + 8]);
-            w
-        };
-        let mut at = None;
-        for run in runs {
-            // A seek empties the buffer: only where the run does not follow the last one.
-            if at != Some(run.first) {
-                rdr.seek(SeekFrom::Start(run.first * RECORD_BYTES as u64))
-                    .map_err(|e| io(&self.path, "cannot read scratch file", e))?;
-            }
-            at = Some(run.first + run.len);
-            for _ in 0..run.len {
-                rdr.read_exact(&mut rec)
-                    .map_err(|e| io(&self.path, "cannot read scratch file", e))?;
-                buf.push(Sample {
-                    clip: run.clip.clone(),
-                    frame: i64::from_le_bytes(word(&rec, 0)),
-                    rc: [1, 2, 3].map(|a| f64::from_le_bytes(word(&rec, a))),
-                });
-                if buf.len() == READ_RECORDS {
-                    f(&buf)?;
-                    buf.clear();
-                }
-            }
-        }
-        if !buf.is_empty() {
-            f(&buf)?;
-        }
-        Ok(())
+        self.read_records(key, &mut |run, chunk| {
+            buf.clear();
+            buf.extend(chunk.chunks_exact(RECORD_BYTES).map(|rec| Sample {
+                clip: run.clip.clone(),
+                frame: i64::from_le_bytes(word(rec, 0)),
+                rc: point(rec),
+            }));
+            f(&buf)
+        })
     }
+
+    /// Call `f` on the points (x, y, z in m) of `key`'s samples in (clip, frame) order, up
+    /// to `READ_RECORDS` at a time: [`SampleSpill::read_group`] without the clip and frame,
+    /// for the passes that need only the points.
+    ///
+    /// # Errors
+    /// The file cannot be read, or `f` fails.
+    pub fn read_points(
+        &self,
+        key: &(String, String),
+        f: &mut dyn FnMut(&[[f64; 3]]) -> Result<()>,
+    ) -> Result<()> {
+        let mut buf: Vec<[f64; 3]> = Vec::with_capacity(READ_RECORDS);
+        self.read_records(key, &mut |_, chunk| {
+            buf.clear();
+            buf.extend(chunk.chunks_exact(RECORD_BYTES).map(point));
+            f(&buf)
+        })
+    }
+}
+
+/// The 8 bytes of word `a` of a record.
+fn word(rec: &[u8], a: usize) -> [u8; 8] {
+    let mut w = [0u8; 8];
+    w.copy_from_slice(&rec[8 * a..8 * a + 8]);
+    w
+}
+
+/// The point (x, y, z) of a record.
+fn point(rec: &[u8]) -> [f64; 3] {
+    [1, 2, 3].map(|a| f64::from_le_bytes(word(rec, a)))
 }
 
 impl Drop for SampleSpill {
@@ -358,5 +394,16 @@ mod tests {
             .iter()
             .enumerate()
             .all(|(i, r)| r.1 == i as i64 && r.2[0] == i as f64));
+        // The points alone, in the same order and chunks of at most READ_RECORDS.
+        let mut points: Vec<[f64; 3]> = Vec::new();
+        spill
+            .read_points(&("c".into(), "L".into()), &mut |b| {
+                assert!(b.len() <= READ_RECORDS);
+                points.extend_from_slice(b);
+                Ok(())
+            })
+            .unwrap();
+        let expected: Vec<[f64; 3]> = back.iter().map(|r| r.2).collect();
+        assert!(points == expected);
     }
 }

@@ -464,8 +464,8 @@ fn reduce_group(
     empty: &DataFrame,
 ) -> Result<Vec<Facet>> {
     let rule = OutlierRule::fit(leg, |f| {
-        spill.read_group(key, &mut |b| {
-            b.iter().for_each(|s| f(&s.rc));
+        spill.read_points(key, &mut |b| {
+            b.iter().for_each(&mut *f);
             Ok(())
         })
     })?;
