@@ -11,8 +11,10 @@
 //! as a child, `build DIR --out LIB --threads 2`, on the set and on the replica, one after
 //! the other, and reads each child's peak RSS from the kernel (`wait4`'s `ru_maxrss`). It
 //! prints the medians, the replica's peak over the set's (target ≤ 1.3×, and ≤ 1 GiB) and
-//! its wall time over K × the set's (target within 10 % of linear). Nothing is asserted:
-//! the figures are printed for the record.
+//! its wall time over K × the set's (target within 10 % of linear). Then it builds the
+//! replica as [`SHARDS`] shards (`build --shard I/N`, not timed) and times `merge` of
+//! them in each round: its wall time over the replica's build (target ≤ 10 %) and its
+//! peak. Nothing is asserted: the figures are printed for the record.
 //!
 //! # Results
 //! 2026-12-06, 2-core sandbox, nothing else running, `SCALE_ROUNDS=3`, after the per-clip
@@ -54,6 +56,10 @@ const DEFAULT_REPLICAS: usize = 25;
 const DEFAULT_ROUNDS: usize = 3;
 /// Target of the replica's peak over the set's (issue 16).
 const TARGET_RATIO: f64 = 1.3;
+/// Shards of the replica merged (issue 16: 8 shard libraries).
+const SHARDS: usize = 8;
+/// Target of the merge's wall time over the replica's build (issue 16).
+const TARGET_MERGE: f64 = 0.10;
 
 fn env_usize(name: &str, default: usize) -> usize {
     std::env::var(name)
@@ -77,19 +83,24 @@ fn replica(files: &[PathBuf], dst: &Path, k: usize) -> std::io::Result<()> {
 }
 
 /// Wall time (s) and peak RSS (MiB) of `bin build input --out out --threads 2`.
+fn build(bin: &str, input: &Path, out: &Path) -> (f64, f64) {
+    let _ = std::fs::remove_dir_all(out);
+    let mut args = vec!["build".into(), input.as_os_str().to_owned()];
+    args.extend(["--out".into(), out.as_os_str().to_owned()]);
+    args.extend(["--threads".into(), "2".into()]);
+    run(bin, &args)
+}
+
+/// Wall time (s) and peak RSS (MiB) of `bin --quiet ARGS`, which must succeed.
 #[expect(
     clippy::zombie_processes,
     reason = "the child is reaped by wait4, which also gives its own peak RSS"
 )]
-fn build(bin: &str, input: &Path, out: &Path) -> (f64, f64) {
-    let _ = std::fs::remove_dir_all(out);
+fn run(bin: &str, args: &[std::ffi::OsString]) -> (f64, f64) {
     let t0 = Instant::now();
     let child = Command::new(bin)
-        .args(["--quiet", "build"])
-        .arg(input)
-        .arg("--out")
-        .arg(out)
-        .args(["--threads", "2"])
+        .arg("--quiet")
+        .args(args)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -103,8 +114,7 @@ fn build(bin: &str, input: &Path, out: &Path) -> (f64, f64) {
     let wall = t0.elapsed().as_secs_f64();
     assert!(
         got == pid && libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "stancelib build {} failed (status {status})",
-        input.display()
+        "stancelib {args:?} failed (status {status})"
     );
     (wall, usage.ru_maxrss as f64 / 1024.0)
 }
@@ -167,5 +177,31 @@ fn main() {
         "replica / set: peak {:.2}× (target ≤ {TARGET_RATIO}×, ≤ 1024 MiB), wall {:.2}× of linear (target ≤ 1.10)",
         pr / ps,
         wr / (k as f64 * ws)
+    );
+    let shards: Vec<PathBuf> = (1..=SHARDS)
+        .map(|i| tmp.path().join(format!("shard_{i}")))
+        .collect();
+    for (i, out) in shards.iter().enumerate() {
+        let mut args = vec!["build".into(), rep.as_os_str().to_owned()];
+        args.extend(["--shard".into(), format!("{}/{SHARDS}", i + 1).into()]);
+        args.extend(["--out".into(), out.as_os_str().to_owned()]);
+        args.extend(["--threads".into(), "2".into()]);
+        run(bin, &args);
+    }
+    let merged = tmp.path().join("lib_merged");
+    let merges: Vec<(f64, f64)> = (0..rounds)
+        .map(|_| {
+            let _ = std::fs::remove_dir_all(&merged);
+            let mut args = vec!["merge".into()];
+            args.extend(shards.iter().map(|s| s.as_os_str().to_owned()));
+            args.extend(["--out".into(), merged.as_os_str().to_owned()]);
+            run(bin, &args)
+        })
+        .collect();
+    let (wm, pm) = (wall(&merges), peak(&merges));
+    println!(
+        "merge of {SHARDS} shards  wall {wm:7.3} s  peak {pm:7.1} MiB: {:.0} % of the replica's build (target ≤ {:.0} %)",
+        100.0 * wm / wr,
+        100.0 * TARGET_MERGE
     );
 }
