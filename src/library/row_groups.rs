@@ -42,9 +42,21 @@ use crate::error::{Error, Result};
 /// The Parquet magic bytes, at the start and the end of a file.
 const MAGIC: &[u8; 4] = b"PAR1";
 
-/// The most bytes a thrift structure read here may allocate (a footer of a very large
-/// file is a few MB; a corrupt length must not allocate without bound).
-const THRIFT_LIMIT: usize = 1 << 30;
+/// The thrift reader's allocation budget per byte of the structure read. The reader
+/// charges 8 bytes per list element (1 per string byte) and stops past its budget; an
+/// element takes at least one byte of input, and the largest one allocated (a column
+/// chunk) is 544 bytes, so a structure of `n` bytes allocates at most about 68 × 4 × `n`
+/// bytes however its lengths lie. The structures this tool writes fit the budget: every
+/// group written is read back through it (`encode`), and so is every footer entry.
+const THRIFT_BUDGET_PER_BYTE: usize = 4;
+
+/// The longest footer entry of one row group read (bytes): a group of this tool's tables
+/// (at most about 50 columns) takes about 4 kB; a corrupt entry longer than this is
+/// refused before it is parsed.
+const MAX_GROUP_ENTRY_BYTES: usize = 256 << 10;
+
+/// The longest whole footer read at once (only footers this tool just wrote in memory are).
+const MAX_FOOTER_BYTES: usize = 64 << 20;
 
 /// One column chunk of an [`EncodedGroup`].
 #[derive(Debug, Clone, PartialEq)]
@@ -92,29 +104,39 @@ fn chunk_start(c: &ColumnChunk) -> Option<i64> {
     Some(m.dictionary_page_offset.unwrap_or(m.data_page_offset))
 }
 
+/// `o + by`, or an error where a corrupt offset overflows.
+fn moved(o: i64, by: i64) -> std::io::Result<i64> {
+    o.checked_add(by)
+        .ok_or_else(|| malformed(format!("offset {o} + {by} overflows")))
+}
+
 /// Move every byte position of a column chunk's footer entry by `by` bytes.
-fn shift_chunk(c: &mut ColumnChunk, by: i64) {
-    c.file_offset += by;
+fn shift_chunk(c: &mut ColumnChunk, by: i64) -> std::io::Result<()> {
+    c.file_offset = moved(c.file_offset, by)?;
     if let Some(m) = c.meta_data.as_mut() {
-        m.data_page_offset += by;
-        m.dictionary_page_offset = m.dictionary_page_offset.map(|o| o + by);
-        m.index_page_offset = m.index_page_offset.map(|o| o + by);
+        m.data_page_offset = moved(m.data_page_offset, by)?;
+        m.dictionary_page_offset = m.dictionary_page_offset.map(|o| moved(o, by)).transpose()?;
+        m.index_page_offset = m.index_page_offset.map(|o| moved(o, by)).transpose()?;
     }
+    Ok(())
 }
 
 /// Move every page position of an offset index by `by` bytes.
-fn shift_offsets(index: &mut OffsetIndex, by: i64) {
+fn shift_offsets(index: &mut OffsetIndex, by: i64) -> std::io::Result<()> {
     for p in &mut index.page_locations {
-        p.offset += by;
+        p.offset = moved(p.offset, by)?;
     }
+    Ok(())
 }
 
-/// Read a thrift structure from `bytes`.
+/// Read a thrift structure from `bytes`, with an allocation budget in proportion to them
+/// ([`THRIFT_BUDGET_PER_BYTE`]).
 fn read_thrift<'b, T>(
     bytes: &'b [u8],
     read: impl FnOnce(&mut TCompactInputProtocol<&'b [u8]>) -> polars_parquet_format::thrift::Result<T>,
 ) -> std::io::Result<T> {
-    let mut p = TCompactInputProtocol::new(bytes, THRIFT_LIMIT);
+    let budget = bytes.len().saturating_mul(THRIFT_BUDGET_PER_BYTE);
+    let mut p = TCompactInputProtocol::new(bytes, budget);
     read(&mut p).map_err(thrift_err)
 }
 
@@ -182,18 +204,40 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
         {
             return Err(malformed("bloom filters are not supported"));
         }
-        spans.push((start, len));
+        if c.file_path.is_some()
+            || c.crypto_metadata.is_some()
+            || c.encrypted_column_metadata.is_some()
+        {
+            return Err(malformed(
+                "column chunks in other files or encrypted are not supported",
+            ));
+        }
+        let end = start
+            .checked_add(len)
+            .filter(|_| start >= 0 && len >= 0)
+            .ok_or_else(|| malformed(format!("column chunk at {start}, {len} bytes")))?;
+        spans.push((start, len, end));
     }
     let lo = spans.iter().map(|s| s.0).min().unwrap_or(0);
-    let hi = spans.iter().map(|s| s.0 + s.1).max().unwrap_or(0);
+    let hi = spans.iter().map(|s| s.2).max().unwrap_or(0);
+    // The chunks follow each other, each after its own metadata (a few hundred bytes): a
+    // span much wider than the chunks is a corrupt entry, not read.
+    let pages: i64 = spans.iter().map(|s| s.1).sum();
+    let slack = 64 * 1024 * (spans.len() as i64 + 1);
+    if hi - lo > pages.saturating_add(slack) {
+        return Err(malformed(format!(
+            "a row group's chunks spread over {} bytes for {pages} bytes of pages",
+            hi - lo
+        )));
+    }
     let span = src.read_at(lo, hi - lo)?;
     let mut bytes = Vec::with_capacity(span.len());
     let mut chunks = Vec::with_capacity(rg.columns.len());
-    for (c, (start, len)) in rg.columns.iter().zip(spans) {
+    for (c, (start, len, _)) in rg.columns.iter().zip(spans) {
         let at = bytes.len();
         bytes.extend_from_slice(slice(&span, start - lo, len)?);
         let mut meta = c.clone();
-        shift_chunk(&mut meta, -start);
+        shift_chunk(&mut meta, -start)?;
         let column_index = match (
             meta.column_index_offset.take(),
             meta.column_index_length.take(),
@@ -208,7 +252,7 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
             (Some(o), Some(l)) => {
                 let raw = src.read_at(o, i64::from(l))?;
                 let mut index = read_thrift(&raw, OffsetIndex::read_from_in_protocol)?;
-                shift_offsets(&mut index, -start);
+                shift_offsets(&mut index, -start)?;
                 index
             }
             _ => return Err(malformed("column chunk without an offset index")),
@@ -241,6 +285,9 @@ fn read_footer(src: &mut impl ReadAt, len: u64) -> std::io::Result<FileMetaData>
         return Err(malformed("no parquet magic at the end"));
     }
     let meta_len = i64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+    if meta_len as usize > MAX_FOOTER_BYTES {
+        return Err(malformed(format!("a footer of {meta_len} bytes")));
+    }
     let raw = src.read_at(len as i64 - 8 - meta_len, meta_len)?;
     read_thrift(&raw, FileMetaData::read_from_in_protocol)
 }
@@ -325,54 +372,79 @@ pub fn encode(
     group_from_bytes(&encode_group_bytes(schema, rows, pages)?)
 }
 
-/// A scratch file written in order and read back once, removed when dropped.
+/// Bytes a [`ScratchStream`] holds in memory before it moves them to its file: a small
+/// table (a query's output) writes no scratch file at all; the frames of a large build
+/// (about 4 kB of footer entry and 2 kB of page index a clip) go to disk.
+const SCRATCH_MEMORY_BYTES: usize = 1 << 20;
+
+/// A stream written in order and read back once: in memory up to
+/// [`SCRATCH_MEMORY_BYTES`], then in a scratch file at `path`, removed when dropped.
 struct ScratchStream {
     path: PathBuf,
+    held: Vec<u8>,
     out: Option<BufWriter<File>>,
     len: u64,
+    read: bool,
 }
 
 impl ScratchStream {
-    fn create(path: PathBuf) -> std::io::Result<ScratchStream> {
-        let file = File::options()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(true)
-            .open(&path)?;
-        Ok(ScratchStream {
+    fn new(path: PathBuf) -> ScratchStream {
+        ScratchStream {
             path,
-            out: Some(BufWriter::new(file)),
+            held: Vec::new(),
+            out: None,
             len: 0,
-        })
+            read: false,
+        }
     }
 
     fn write(&mut self, bytes: &[u8]) -> std::io::Result<u64> {
+        if self.read {
+            return Err(std::io::Error::other("scratch stream already read"));
+        }
         let at = self.len;
-        self.out
-            .as_mut()
-            .ok_or_else(|| std::io::Error::other("scratch stream already read"))?
-            .write_all(bytes)?;
+        if self.out.is_none() && self.held.len() + bytes.len() > SCRATCH_MEMORY_BYTES {
+            let file = File::options()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(true)
+                .open(&self.path)?;
+            let mut out = BufWriter::new(file);
+            out.write_all(&std::mem::take(&mut self.held))?;
+            self.out = Some(out);
+        }
+        match self.out.as_mut() {
+            Some(out) => out.write_all(bytes)?,
+            None => self.held.extend_from_slice(bytes),
+        }
         self.len += bytes.len() as u64;
         Ok(at)
     }
 
     /// The stream's bytes, from the start.
-    fn reader(&mut self) -> std::io::Result<BufReader<File>> {
-        let out = self
-            .out
-            .take()
-            .ok_or_else(|| std::io::Error::other("scratch stream already read"))?;
-        let mut file = out.into_inner().map_err(|e| e.into_error())?;
-        file.seek(SeekFrom::Start(0))?;
-        Ok(BufReader::new(file))
+    fn reader(&mut self) -> std::io::Result<Box<dyn Read + '_>> {
+        if std::mem::replace(&mut self.read, true) {
+            return Err(std::io::Error::other("scratch stream already read"));
+        }
+        match self.out.take() {
+            Some(out) => {
+                let mut file = out.into_inner().map_err(|e| e.into_error())?;
+                file.seek(SeekFrom::Start(0))?;
+                Ok(Box::new(BufReader::new(file)))
+            }
+            None => Ok(Box::new(std::io::Cursor::new(std::mem::take(
+                &mut self.held,
+            )))),
+        }
     }
 }
 
 impl Drop for ScratchStream {
     fn drop(&mut self) {
-        self.out = None;
-        let _ = std::fs::remove_file(&self.path);
+        if self.out.take().is_some() || self.read {
+            let _ = std::fs::remove_file(&self.path);
+        }
     }
 }
 
@@ -392,41 +464,122 @@ pub struct GroupFileWriter {
     entries: ScratchStream,
     column_indexes: ScratchStream,
     offset_indexes: ScratchStream,
+    /// Per leaf column of the schema: its path and physical type, which an appended
+    /// group's chunks must have.
+    leaves: Vec<(Vec<String>, Option<polars_parquet_format::Type>)>,
+    /// A write failed part-way: the file is not finished.
+    failed: bool,
+}
+
+/// The names (`<table>.<what>`, before [`scratch_name`]) of the scratch files a
+/// [`GroupFileWriter`] of table `table` makes beside it, for the removal of those a killed
+/// run left ([`super::scratch::remove_stale`]).
+pub fn scratch_stems(table: &str) -> [String; 3] {
+    ["groups", "column-index", "offset-index"].map(|what| format!("{table}.{what}"))
+}
+
+/// Per leaf column of a footer's schema (depth-first, the root left out): its path and
+/// physical type.
+fn leaf_columns(
+    schema: &[polars_parquet_format::SchemaElement],
+) -> Vec<(Vec<String>, Option<polars_parquet_format::Type>)> {
+    fn walk(
+        els: &[polars_parquet_format::SchemaElement],
+        at: &mut usize,
+        path: &mut Vec<String>,
+        out: &mut Vec<(Vec<String>, Option<polars_parquet_format::Type>)>,
+    ) {
+        let Some(e) = els.get(*at) else { return };
+        *at += 1;
+        path.push(e.name.clone());
+        match e.num_children {
+            Some(n) if n > 0 => (0..n).for_each(|_| walk(els, at, path, out)),
+            _ => out.push((path.clone(), e.type_)),
+        }
+        path.pop();
+    }
+    let mut out = Vec::new();
+    let mut at = 1;
+    let mut path = Vec::new();
+    let children = schema.first().and_then(|r| r.num_children).unwrap_or(0);
+    for _ in 0..children {
+        walk(schema, &mut at, &mut path, &mut out);
+    }
+    out
 }
 
 impl GroupFileWriter {
-    /// Start `path` (created or truncated) for groups of `schema`; the scratch files are
-    /// made beside it.
-    pub fn create(path: &Path, schema: &GroupSchema) -> std::io::Result<GroupFileWriter> {
+    /// Start `path` (created or truncated) for groups of `schema`; its scratch files, if
+    /// the groups' footer entries and page indexes grow past 1 MiB, are
+    /// made beside it, named after `table` ([`scratch_stems`]).
+    pub fn create(
+        path: &Path,
+        table: &str,
+        schema: &GroupSchema,
+    ) -> std::io::Result<GroupFileWriter> {
         let footer = schema.empty_footer()?;
-        let stem = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
         let dir = path.parent().unwrap_or(Path::new("."));
-        let scratch = |what: &str| {
-            ScratchStream::create(dir.join(scratch_name(&format!("{stem}.{what}"), Scratch::Tmp)))
-        };
+        let [groups, column_index, offset_index] =
+            scratch_stems(table).map(|stem| dir.join(scratch_name(&stem, Scratch::Tmp)));
+        let entries = ScratchStream::new(groups);
+        let column_indexes = ScratchStream::new(column_index);
+        let offset_indexes = ScratchStream::new(offset_index);
         let mut file = BufWriter::with_capacity(1 << 20, File::create(path)?);
         file.write_all(MAGIC)?;
         Ok(GroupFileWriter {
             path: path.to_path_buf(),
             file,
             offset: MAGIC.len() as u64,
+            leaves: leaf_columns(&footer.schema),
             footer,
             rows: 0,
             groups: 0,
-            entries: scratch("groups")?,
-            column_indexes: scratch("column-index")?,
-            offset_indexes: scratch("offset-index")?,
+            entries,
+            column_indexes,
+            offset_indexes,
+            failed: false,
         })
+    }
+
+    /// A group of another schema (other columns, paths or types) is refused.
+    fn check_schema(&self, g: &EncodedGroup) -> std::io::Result<()> {
+        if g.chunks.len() != self.leaves.len() {
+            return Err(malformed(format!(
+                "a row group of {} columns for a table of {}",
+                g.chunks.len(),
+                self.leaves.len()
+            )));
+        }
+        for (c, (path, type_)) in g.chunks.iter().zip(&self.leaves) {
+            let m = c.meta.meta_data.as_ref();
+            if m.map(|m| &m.path_in_schema) != Some(path) || m.map(|m| m.type_) != *type_ {
+                return Err(malformed(format!(
+                    "a row group's column {:?} where the table has {}",
+                    m.map(|m| m.path_in_schema.join(".")),
+                    path.join(".")
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Append `g` after the groups written so far.
     ///
     /// # Errors
-    /// A write fails.
+    /// `g` has other columns than the table, a write fails, or one failed before (the
+    /// file is then not finished).
     pub fn append(&mut self, g: &EncodedGroup) -> std::io::Result<()> {
+        if self.failed {
+            return Err(std::io::Error::other("an earlier write failed"));
+        }
+        self.check_schema(g)?;
+        self.failed = true;
+        self.append_checked(g)?;
+        self.failed = false;
+        Ok(())
+    }
+
+    fn append_checked(&mut self, g: &EncodedGroup) -> std::io::Result<()> {
         let mut rg = g.group.clone();
         rg.columns = Vec::with_capacity(g.chunks.len());
         for c in &g.chunks {
@@ -434,7 +587,7 @@ impl GroupFileWriter {
             self.file.write_all(&g.bytes[c.pages.clone()])?;
             self.offset += c.pages.len() as u64;
             let mut meta = c.meta.clone();
-            shift_chunk(&mut meta, start);
+            shift_chunk(&mut meta, start)?;
             if let Some(m) = meta.meta_data.as_ref() {
                 let inline = thrift_bytes(|p| m.write_to_out_protocol(p))?;
                 self.file.write_all(&inline)?;
@@ -445,7 +598,7 @@ impl GroupFileWriter {
                 meta.column_index_length = Some(len_i32(ci.len())?);
             }
             let mut oi = c.offset_index.clone();
-            shift_offsets(&mut oi, start);
+            shift_offsets(&mut oi, start)?;
             let oi = thrift_bytes(|p| oi.write_to_out_protocol(p))?;
             meta.offset_index_offset = Some(self.offset_indexes.write(&oi)? as i64);
             meta.offset_index_length = Some(len_i32(oi.len())?);
@@ -458,11 +611,15 @@ impl GroupFileWriter {
                 .or(Some(m.data_page_offset))
         });
         rg.ordinal = i16::try_from(self.groups).ok();
-        self.rows += rg.num_rows;
-        self.groups += 1;
+        let rows = self
+            .rows
+            .checked_add(rg.num_rows)
+            .ok_or_else(|| malformed("row count overflows"))?;
         let entry = thrift_bytes(|p| rg.write_to_out_protocol(p))?;
         self.entries.write(&(entry.len() as u64).to_le_bytes())?;
         self.entries.write(&entry)?;
+        self.rows = rows;
+        self.groups += 1;
         Ok(())
     }
 
@@ -471,6 +628,9 @@ impl GroupFileWriter {
     /// # Errors
     /// A write fails.
     pub fn finish(mut self, kv: Vec<KeyValue>) -> std::io::Result<u64> {
+        if self.failed {
+            return Err(std::io::Error::other("an earlier write failed"));
+        }
         let column_base = self.offset as i64;
         self.offset += std::io::copy(&mut self.column_indexes.reader()?, &mut self.file)?;
         let offset_base = self.offset as i64;
@@ -483,7 +643,11 @@ impl GroupFileWriter {
         let mut next_group = || -> std::io::Result<RowGroup> {
             let mut len = [0u8; 8];
             entries.read_exact(&mut len)?;
-            let mut raw = vec![0; u64::from_le_bytes(len) as usize];
+            let len = u64::from_le_bytes(len) as usize;
+            if len > MAX_GROUP_ENTRY_BYTES {
+                return Err(malformed(format!("a row group entry of {len} bytes")));
+            }
+            let mut raw = vec![0; len];
             entries.read_exact(&mut raw)?;
             let mut rg = read_thrift(&raw, RowGroup::read_from_in_protocol)?;
             for c in &mut rg.columns {
@@ -492,19 +656,55 @@ impl GroupFileWriter {
             }
             Ok(rg)
         };
-        let mut meta = Vec::new();
-        write_footer(&mut meta, &footer, groups, &mut next_group)?;
-        self.file.write_all(&meta)?;
-        self.file.write_all(&len_i32(meta.len())?.to_le_bytes())?;
+        // Streamed to the file: a footer grows with the groups (about 4 kB each).
+        let mut out = Counted {
+            inner: &mut self.file,
+            bytes: 0,
+        };
+        write_footer(&mut out, &footer, groups, &mut next_group)?;
+        let meta_len = out.bytes;
+        self.file.write_all(&len_i32(meta_len)?.to_le_bytes())?;
         self.file.write_all(MAGIC)?;
         self.file.flush()?;
-        self.offset += meta.len() as u64 + 8;
+        self.offset += meta_len as u64 + 8;
         Ok(self.offset)
     }
 
     /// The file being written.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+}
+
+/// A writer that counts the bytes written through it.
+struct Counted<'a, W: Write> {
+    inner: &'a mut W,
+    bytes: usize,
+}
+
+impl<W: Write> Write for Counted<'_, W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.bytes += n;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// A reader that counts the bytes read through it.
+struct CountedRead<'a, R: Read> {
+    inner: &'a mut R,
+    bytes: usize,
+}
+
+impl<R: Read> Read for CountedRead<'_, R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.bytes += n;
+        Ok(n)
     }
 }
 
@@ -515,7 +715,7 @@ fn len_i32(n: usize) -> std::io::Result<i32> {
 /// `footer` as polars writes it (`FileMetaData::write_to_out_protocol`, field for field),
 /// its `groups` row groups taken one at a time from `next_group` instead of its own list.
 fn write_footer(
-    out: &mut Vec<u8>,
+    out: &mut impl Write,
     footer: &FileMetaData,
     groups: usize,
     next_group: &mut dyn FnMut() -> std::io::Result<RowGroup>,
@@ -622,8 +822,8 @@ fn io(path: &Path, what: &str, e: impl std::error::Error + Send + Sync + 'static
 }
 
 /// Read a footer up to its list of row groups; the number of groups.
-fn footer_to_groups(footer: &mut BufReader<File>) -> std::io::Result<usize> {
-    let mut p = TCompactInputProtocol::new(footer, THRIFT_LIMIT);
+fn footer_to_groups(footer: &mut BufReader<File>, len: usize) -> std::io::Result<usize> {
+    let mut p = TCompactInputProtocol::new(footer, len.saturating_mul(THRIFT_BUDGET_PER_BYTE));
     p.read_struct_begin().map_err(thrift_err)?;
     loop {
         let field = p.read_field_begin().map_err(thrift_err)?;
@@ -661,7 +861,7 @@ impl GroupFileReader {
             .ok_or_else(|| err(malformed("footer longer than the file")))?;
         let mut footer = BufReader::new(File::open(path).map_err(|e| io(path, "cannot open", e))?);
         footer.seek(SeekFrom::Start(start)).map_err(err)?;
-        let left = footer_to_groups(&mut footer).map_err(err)?;
+        let left = footer_to_groups(&mut footer, meta_len as usize).map_err(err)?;
         Ok(GroupFileReader {
             path: path.to_path_buf(),
             data,
@@ -674,13 +874,34 @@ impl GroupFileReader {
     /// The next group's entry, read from the footer if not read yet (`None` after the last).
     fn peek(&mut self) -> Result<Option<&RowGroup>> {
         if self.next.is_none() && self.left > 0 {
-            let mut p = TCompactInputProtocol::new(&mut self.footer, THRIFT_LIMIT);
-            let rg = RowGroup::read_from_in_protocol(&mut p)
-                .map_err(|e| io(&self.path, "cannot read parquet", thrift_err(e)))?;
+            let rg = self
+                .read_entry()
+                .map_err(|e| io(&self.path, "cannot read parquet", e))?;
             self.left -= 1;
             self.next = Some(rg);
         }
         Ok(self.next.as_ref())
+    }
+
+    /// The next group's entry, read with the allocation budget of the longest entry
+    /// accepted ([`MAX_GROUP_ENTRY_BYTES`]): whatever lengths a corrupt entry claims, it
+    /// allocates a bounded amount (about 70 MB at most) before it is refused.
+    fn read_entry(&mut self) -> std::io::Result<RowGroup> {
+        let mut counted = CountedRead {
+            inner: &mut self.footer,
+            bytes: 0,
+        };
+        let budget = MAX_GROUP_ENTRY_BYTES * THRIFT_BUDGET_PER_BYTE;
+        let rg =
+            RowGroup::read_from_in_protocol(&mut TCompactInputProtocol::new(&mut counted, budget))
+                .map_err(thrift_err)?;
+        if counted.bytes > MAX_GROUP_ENTRY_BYTES {
+            return Err(malformed(format!(
+                "a row group entry of {} bytes",
+                counted.bytes
+            )));
+        }
+        Ok(rg)
     }
 
     /// The value of column `name` in the next group, when that group holds one value of it
@@ -805,7 +1026,7 @@ mod tests {
 
         let d = tempfile::tempdir().unwrap();
         let path = d.path().join("t.parquet");
-        let mut w = GroupFileWriter::create(&path, &schema).unwrap();
+        let mut w = GroupFileWriter::create(&path, "t.parquet", &schema).unwrap();
         for (at, n) in cuts {
             let g = encode(&schema, n as u64, &pages(&df.slice(at, n), &columns)).unwrap();
             assert_eq!(g.rows(), n);
@@ -836,7 +1057,7 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let write = |name: &str, cuts: &[(i64, usize)]| {
             let path = d.path().join(name);
-            let mut w = GroupFileWriter::create(&path, &schema).unwrap();
+            let mut w = GroupFileWriter::create(&path, "t.parquet", &schema).unwrap();
             for &(at, n) in cuts {
                 w.append(&encode(&schema, n as u64, &pages(&df.slice(at, n), &columns)).unwrap())
                     .unwrap();
@@ -856,7 +1077,7 @@ mod tests {
         assert_eq!(r.peek_value("clip").unwrap(), None);
         assert!(r.next_group().unwrap().is_none());
         let moved = d.path().join("moved.parquet");
-        let mut w = GroupFileWriter::create(&moved, &schema).unwrap();
+        let mut w = GroupFileWriter::create(&moved, "moved.parquet", &schema).unwrap();
         w.append(&second).unwrap();
         w.append(&first).unwrap();
         w.finish(Vec::new()).unwrap();
@@ -869,6 +1090,51 @@ mod tests {
         assert_eq!(back.schema(), df.schema());
     }
 
+    /// A footer whose row group claims 2^27 − 1 column chunks in a few bytes is an error,
+    /// not a 73 GB allocation; so is a group of another table's columns.
+    #[test]
+    fn lying_lengths_and_foreign_groups_are_errors() {
+        let d = tempfile::tempdir().unwrap();
+        let path = d.path().join("bad.parquet");
+        // FileMetaData field 4 (row_groups): a list of 1 struct whose field 1 (columns)
+        // is a list of structs of varint length 2^27 − 1, then nothing.
+        let mut footer = vec![0x49u8, 0x1C, 0x19, 0xFC];
+        let mut n: u32 = (1 << 27) - 1;
+        loop {
+            let b = (n & 0x7f) as u8;
+            n >>= 7;
+            if n == 0 {
+                footer.push(b);
+                break;
+            }
+            footer.push(b | 0x80);
+        }
+        footer.push(0);
+        let mut bytes = MAGIC.to_vec();
+        bytes.extend_from_slice(&footer);
+        bytes.extend_from_slice(&(footer.len() as u32).to_le_bytes());
+        bytes.extend_from_slice(MAGIC);
+        std::fs::write(&path, &bytes).unwrap();
+        let mut r = GroupFileReader::open(&path).unwrap();
+        let e = r.peek_value("clip").unwrap_err().to_string();
+        assert!(e.contains("bad.parquet"), "{e}");
+
+        // A group of a two-column table appended to a five-column one.
+        let df = table(100);
+        let (schema, columns) = schema_of(&df);
+        let narrow = df.select(["clip", "frame"]).unwrap();
+        let (narrow_schema, narrow_columns) = schema_of(&narrow);
+        let g = encode(&narrow_schema, 100, &pages(&narrow, &narrow_columns)).unwrap();
+        let mut w =
+            GroupFileWriter::create(&d.path().join("t.parquet"), "t.parquet", &schema).unwrap();
+        let e = w.append(&g).unwrap_err().to_string();
+        assert!(e.contains("2 columns"), "{e}");
+        // The table's own groups still go in.
+        w.append(&encode(&schema, 100, &pages(&df, &columns)).unwrap())
+            .unwrap();
+        w.finish(Vec::new()).unwrap();
+    }
+
     /// A file that is not Parquet, or is cut short, is an error naming it, not a panic.
     #[test]
     fn a_damaged_file_is_an_error() {
@@ -876,7 +1142,7 @@ mod tests {
         let (schema, columns) = schema_of(&df);
         let d = tempfile::tempdir().unwrap();
         let path = d.path().join("t.parquet");
-        let mut w = GroupFileWriter::create(&path, &schema).unwrap();
+        let mut w = GroupFileWriter::create(&path, "t.parquet", &schema).unwrap();
         w.append(&encode(&schema, 800, &pages(&df, &columns)).unwrap())
             .unwrap();
         w.finish(Vec::new()).unwrap();

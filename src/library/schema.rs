@@ -93,7 +93,9 @@ pub fn sort_keys(file: &str) -> &'static [&'static str] {
 /// into groups of that many. The per-frame tables are cut per clip, so that a merge copies
 /// a clip's groups from its shard without decoding them and still writes the bytes of a
 /// single build; the polytopes' points per (character, effector), so that each group is
-/// written on its own worker and its row groups put in order after.
+/// written on its own worker and its row groups put in order after. This is the `file`
+/// layout's cut: the `dataset` layout rewrites the partitioned tables (`kinematics_points`
+/// among them) in row groups of `ROW_GROUP_ROWS` rows.
 pub fn group_keys(file: &str) -> &'static [&'static str] {
     match file {
         FRAMES_FILE | JOINTS_FILE => &[frames::CLIP],

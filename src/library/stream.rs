@@ -96,7 +96,14 @@ const COMPRESSION: ParquetCompression = ParquetCompression::Zstd(None);
 /// statistics (its `materialize_options`): the writer and the parallel encoder share them.
 pub(super) fn write_options() -> WriteOptions {
     WriteOptions {
-        statistics: StatisticsOptions::full(),
+        // Full statistics, string minima and maxima never truncated (polars cuts them to
+        // 64 bytes by default, or to `POLARS_PARQUET_BINARY_STATISTICS_TRUNCATE_LEN`): a
+        // per-clip row group is found by its clip name (min = max), and the bytes must
+        // not depend on the environment.
+        statistics: StatisticsOptions {
+            binary_statistics_truncate_length: Some(0),
+            ..StatisticsOptions::full()
+        },
         compression: COMPRESSION.into(),
         version: Version::V1,
         data_page_size: None,
@@ -247,7 +254,7 @@ fn encode_rows(
         .map_err(PolarsError::from)
 }
 
-/// A leaf column's Parquet type and encodings.
+/// A top-level column's Parquet type and the encodings of its leaves.
 type LeafType = (ParquetType, Vec<Encoding>);
 
 /// The schemas polars' batched writer derives from `schema`, and per column its Parquet
@@ -271,7 +278,10 @@ fn group_schema(schema: &Schema) -> PolarsResult<(GroupSchema, Vec<LeafType>)> {
 /// values (a HyperLogLog count, whose cost is fixed per column chunk, not per value); a
 /// table cut into short groups (one per clip) paid it on every chunk: 7.5 % of a build's
 /// time on the bulk set. Every float chunk of the frames of the bulk set had been written
-/// plain anyway (positions and rates: far more than 75 % distinct values).
+/// plain anyway (positions and rates: far more than 75 % distinct values), so their bytes
+/// did not change. Where polars would have chosen a dictionary (a chunk of at most 128
+/// rows, or a float column constant over a clip) the file is larger than it would be;
+/// zstd compresses the repeated values.
 fn plain_floats(schema: &Schema, columns: &mut [LeafType]) {
     for ((_, dtype), (_, encodings)) in schema.iter().zip(columns.iter_mut()) {
         if matches!(dtype, DataType::Float64 | DataType::Float32) {
@@ -376,7 +386,7 @@ impl TableWriter {
         if !group_keys.is_empty() {
             plain_floats(&schema, &mut columns);
         }
-        let writer = GroupFileWriter::create(&tmp, &group_schema)
+        let writer = GroupFileWriter::create(&tmp, name, &group_schema)
             .map_err(|e| io(&tmp, "cannot create", e))?;
         Ok(TableWriter {
             path,
@@ -859,6 +869,25 @@ mod tests {
         );
         let empty = col("a", Vec::new());
         assert!(keyed_group_sizes(&[&empty], true).unwrap().is_empty());
+    }
+
+    /// A clip name longer than polars' 64-byte statistics cut keeps whole statistics, so
+    /// its row groups are still found by name.
+    #[test]
+    fn a_long_clip_name_keeps_whole_statistics() {
+        let long = format!("subject_{}_take", "x".repeat(120));
+        let df = df! {
+            "clip" => [long.as_str(), long.as_str(), "z"],
+            "frame" => [0i64, 1, 0],
+        }
+        .unwrap();
+        let name = super::super::schema::FRAMES_FILE;
+        let d = tempfile::tempdir().unwrap();
+        let mut w = TableWriter::create(d.path(), name, &df.clear()).unwrap();
+        w.push(&df).unwrap();
+        w.finish(&[]).unwrap();
+        let mut r = super::super::row_groups::GroupFileReader::open(&d.path().join(name)).unwrap();
+        assert_eq!(r.peek_value("clip").unwrap(), Some(long.into_bytes()));
     }
 
     /// A group taken from one file and pushed into another table gives the bytes of its

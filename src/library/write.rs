@@ -433,7 +433,13 @@ impl FramesWriter {
     pub fn create(dir: &Path, joints: bool) -> Result<FramesWriter> {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::io(dir, "cannot create output folder", e))?;
-        remove_stale(dir, &FRAMES_RUN_FILES, Scratch::Tmp);
+        let scratch: Vec<String> = FRAMES_RUN_FILES
+            .iter()
+            .flat_map(|t| super::row_groups::scratch_stems(t))
+            .collect();
+        let mut names: Vec<&str> = FRAMES_RUN_FILES.to_vec();
+        names.extend(scratch.iter().map(String::as_str));
+        remove_stale(dir, &names, Scratch::Tmp);
         let mut w = FramesWriter {
             dir: dir.to_path_buf(),
             writers: Vec::new(),

@@ -249,6 +249,21 @@ impl GroupCursor {
         Ok(None)
     }
 
+    /// An error naming the clip of the next row group, if any is left.
+    fn refuse_leftover(&mut self, dir: &Path) -> Result<()> {
+        match self.next_clip()? {
+            Some(clip) => Err(bad(
+                dir,
+                format!(
+                    "{} holds clip {} that its {CLIPS_FILE} does not",
+                    self.table,
+                    String::from_utf8_lossy(&clip)
+                ),
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// Append the row groups of `clip` (the next ones of the shard) to `sink`'s table; a
     /// group of a clip before `clip` means the shard's tables disagree.
     fn copy_clip(&mut self, clip: &str, sink: &mut LibrarySink, dir: &Path) -> Result<()> {
@@ -399,6 +414,13 @@ pub fn merge_into(
             drop(t);
             super::memory::release_free_memory();
             start = end;
+        }
+        // Every shard's per-clip groups were copied: one left holds a clip its shard's
+        // clips table does not.
+        for (shard, lib) in groups.iter_mut().zip(&libs) {
+            for g in shard.iter_mut() {
+                g.refuse_leftover(&lib.dir)?;
+            }
         }
         sink.finish(&fingerprint, t0, None, layout)
     })?;
