@@ -973,19 +973,7 @@ mod tests {
             Vec<polars_parquet::write::Encoding>,
         )>,
     ) {
-        let arrow = df.schema().to_arrow(CompatLevel::newest());
-        let parquet = polars_parquet::write::to_parquet_schema(&arrow).unwrap();
-        let encodings = polars::io::parquet::write::get_encodings(&arrow);
-        let columns = parquet
-            .fields()
-            .iter()
-            .cloned()
-            .zip(encodings.iter().cloned())
-            .collect();
-        (
-            GroupSchema::new(arrow, parquet, super::super::stream::write_options()),
-            columns,
-        )
+        super::super::stream::group_schema(df.schema()).unwrap()
     }
 
     fn pages(

@@ -255,11 +255,11 @@ fn encode_rows(
 }
 
 /// A top-level column's Parquet type and the encodings of its leaves.
-type LeafType = (ParquetType, Vec<Encoding>);
+pub(super) type LeafType = (ParquetType, Vec<Encoding>);
 
 /// The schemas polars' batched writer derives from `schema`, and per column its Parquet
 /// type and encodings.
-fn group_schema(schema: &Schema) -> PolarsResult<(GroupSchema, Vec<LeafType>)> {
+pub(super) fn group_schema(schema: &Schema) -> PolarsResult<(GroupSchema, Vec<LeafType>)> {
     let arrow = schema.to_arrow(CompatLevel::newest());
     let parquet = to_parquet_schema(&arrow)?;
     let encodings = get_encodings(&arrow);
