@@ -13,9 +13,9 @@
 //! Every offset in a group's metadata is a byte position in the file, so a group is kept
 //! here with its offsets counted from the start of each column chunk ([`EncodedGroup`]);
 //! [`GroupFileWriter::append`] adds the chunk's position in the new file. The footer
-//! entries and page indexes of the groups written so far wait in scratch files, not in
-//! memory: a file of many small groups (one per clip) holds nothing per group until the
-//! footer is written.
+//! entries and page indexes of the groups written so far wait in memory up to 1 MiB each,
+//! then in scratch files: a file of many small groups (one per clip) holds at most 3 MiB
+//! of them until the footer is written, however many groups it has.
 //!
 //! A group is encoded by polars' own writer into a one-group file in memory and read back
 //! from it as from any file ([`encode`]), so the pages, statistics and indexes are
@@ -43,17 +43,26 @@ use crate::error::{Error, Result};
 const MAGIC: &[u8; 4] = b"PAR1";
 
 /// The thrift reader's allocation budget per byte of the structure read. The reader
-/// charges 8 bytes per list element (1 per string byte) and stops past its budget; an
-/// element takes at least one byte of input, and the largest one allocated (a column
-/// chunk) is 544 bytes, so a structure of `n` bytes allocates at most about 68 × 4 × `n`
-/// bytes however its lengths lie. The structures this tool writes fit the budget: every
+/// charges 8 bytes per claimed list element when it reads the list's header (2 per
+/// struct, 1 per string byte) and stops past its budget; the largest element it allocates
+/// (a column chunk) is about 544 bytes, so a structure read with a budget of `b` bytes
+/// allocates at most about 68 × `b` bytes however its lengths lie. The structures this tool writes fit the budget: every
 /// group written is read back through it (`encode`), and so is every footer entry.
 const THRIFT_BUDGET_PER_BYTE: usize = 4;
 
 /// The longest footer entry of one row group read (bytes): a group of this tool's tables
-/// (at most about 50 columns) takes about 4 kB; a corrupt entry longer than this is
-/// refused before it is parsed.
+/// (at most about 50 columns) takes about 4 kB; a longer entry is refused (when read
+/// back from a file, once it has been parsed within the budget of this length).
 const MAX_GROUP_ENTRY_BYTES: usize = 256 << 10;
+
+/// The most bytes between two column chunks of a group (the first one's metadata): a
+/// chunk's metadata is a few hundred bytes, longer only by its string statistics (values
+/// of more than about 30 kB in a column would not be read back).
+const CHUNK_GAP_BYTES: i64 = 64 * 1024;
+
+/// The longest column or offset index of one column chunk read (bytes): an offset index
+/// takes about 12 bytes a page, a column index a page's statistics.
+const MAX_INDEX_BYTES: i32 = 16 << 20;
 
 /// The longest whole footer read at once (only footers this tool just wrote in memory are).
 const MAX_FOOTER_BYTES: usize = 64 << 20;
@@ -218,12 +227,21 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
             .ok_or_else(|| malformed(format!("column chunk at {start}, {len} bytes")))?;
         spans.push((start, len, end));
     }
-    let lo = spans.iter().map(|s| s.0).min().unwrap_or(0);
-    let hi = spans.iter().map(|s| s.2).max().unwrap_or(0);
-    // The chunks follow each other, each after its own metadata (a few hundred bytes): a
-    // span much wider than the chunks is a corrupt entry, not read.
-    let pages: i64 = spans.iter().map(|s| s.1).sum();
-    let slack = 64 * 1024 * (spans.len() as i64 + 1);
+    // The chunks follow each other in column order, each after the metadata of the one
+    // before (a few hundred bytes): chunks that overlap, or a span much wider than the
+    // chunks, are a corrupt entry, not read (each chunk's bytes are then read once).
+    if spans.windows(2).any(|w| w[1].0 < w[0].2) {
+        return Err(malformed(
+            "a row group's column chunks overlap or are out of order",
+        ));
+    }
+    let lo = spans.first().map_or(0, |s| s.0);
+    let hi = spans.last().map_or(0, |s| s.2);
+    let pages = spans
+        .iter()
+        .try_fold(0i64, |sum, s| sum.checked_add(s.1))
+        .ok_or_else(|| malformed("a row group's chunk sizes overflow"))?;
+    let slack = CHUNK_GAP_BYTES.saturating_mul(spans.len() as i64 + 1);
     if hi - lo > pages.saturating_add(slack) {
         return Err(malformed(format!(
             "a row group's chunks spread over {} bytes for {pages} bytes of pages",
@@ -242,7 +260,7 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
             meta.column_index_offset.take(),
             meta.column_index_length.take(),
         ) {
-            (Some(o), Some(l)) => Some(src.read_at(o, i64::from(l))?),
+            (Some(o), Some(l)) => Some(src.read_at(o, i64::from(index_len(l)?))?),
             _ => None,
         };
         let offset_index = match (
@@ -250,7 +268,7 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
             meta.offset_index_length.take(),
         ) {
             (Some(o), Some(l)) => {
-                let raw = src.read_at(o, i64::from(l))?;
+                let raw = src.read_at(o, i64::from(index_len(l)?))?;
                 let mut index = read_thrift(&raw, OffsetIndex::read_from_in_protocol)?;
                 shift_offsets(&mut index, -start)?;
                 index
@@ -273,6 +291,15 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
         chunks,
         group,
     })
+}
+
+/// `l`, the length of a page index, if it is at most [`MAX_INDEX_BYTES`].
+fn index_len(l: i32) -> std::io::Result<i32> {
+    if (0..=MAX_INDEX_BYTES).contains(&l) {
+        Ok(l)
+    } else {
+        Err(malformed(format!("a page index of {l} bytes")))
+    }
 }
 
 /// The footer of a Parquet file held in `bytes` or read from `file`.
@@ -410,9 +437,9 @@ impl ScratchStream {
                 .create(true)
                 .truncate(true)
                 .open(&self.path)?;
-            let mut out = BufWriter::new(file);
+            // Kept before it is written to, so that `Drop` removes it whatever fails.
+            let out = self.out.insert(BufWriter::new(file));
             out.write_all(&std::mem::take(&mut self.held))?;
-            self.out = Some(out);
         }
         match self.out.as_mut() {
             Some(out) => out.write_all(bytes)?,
@@ -493,8 +520,8 @@ fn leaf_columns(
         *at += 1;
         path.push(e.name.clone());
         match e.num_children {
-            Some(n) if n > 0 => (0..n).for_each(|_| walk(els, at, path, out)),
-            _ => out.push((path.clone(), e.type_)),
+            Some(n) => (0..n).for_each(|_| walk(els, at, path, out)),
+            None => out.push((path.clone(), e.type_)),
         }
         path.pop();
     }
@@ -541,7 +568,9 @@ impl GroupFileWriter {
         })
     }
 
-    /// A group of another schema (other columns, paths or types) is refused.
+    /// A group of other columns (their count, paths or physical types) is refused. Logical
+    /// types and repetition are not compared: a merge has already required the shards'
+    /// schema and tool version to be the running tool's.
     fn check_schema(&self, g: &EncodedGroup) -> std::io::Result<()> {
         if g.chunks.len() != self.leaves.len() {
             return Err(malformed(format!(
@@ -1104,8 +1133,12 @@ mod tests {
         bytes.extend_from_slice(MAGIC);
         std::fs::write(&path, &bytes).unwrap();
         let mut r = GroupFileReader::open(&path).unwrap();
-        let e = r.peek_value("clip").unwrap_err().to_string();
-        assert!(e.contains("bad.parquet"), "{e}");
+        let e = r.peek_value("clip").unwrap_err();
+        assert!(e.to_string().contains("bad.parquet"), "{e}");
+        // Refused by the allocation budget (not by the end of the data, which a machine
+        // that granted the allocation would only meet after it).
+        let why = format!("{e:?}");
+        assert!(why.contains("message too long"), "{why}"); // thrift SizeLimit
 
         // A group of a two-column table appended to a five-column one.
         let df = table(100);

@@ -14,7 +14,8 @@
 //! batches, so a streaming build, a one-batch build and a merge of shards write the same
 //! bytes for the same rows. A merge appends a clip's groups as its shard holds them
 //! ([`TableWriter::push_group`]): the file is assembled by [`super::row_groups`], which
-//! keeps no per-group state in memory. The key-value metadata is given at [`TableWriter::finish`], once
+//! keeps at most 3 MiB of footer entries and page indexes in memory (the rest in scratch
+//! files until the footer is written). The key-value metadata is given at [`TableWriter::finish`], once
 //! everything it describes (the per-character limits) is known.
 //!
 //! # Parallel encoding
@@ -668,8 +669,9 @@ impl TableWriter {
                 std::io::Error::other("rows are waiting for their own group"),
             ));
         }
+        self.append(g)?;
         self.rows += g.rows();
-        self.append(g)
+        Ok(())
     }
 
     /// Write the last row group and the footer with `kv` (after an `ARROW:schema` entry of
