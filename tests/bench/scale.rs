@@ -17,6 +17,21 @@
 //! peak. Nothing is asserted: the figures are printed for the record.
 //!
 //! # Results
+//! 2026-12-06 (later), same sandbox, `SCALE_ROUNDS=3`, after the per-clip row groups, the
+//! merge's copy of them and the parallel polytopes:
+//!
+//! ```text
+//! scale: 93 clips and a 25× replica, build --threads 2, 3 rounds (medians)
+//! set      wall   0.624 s  peak    70.7 MiB
+//! replica  wall  14.268 s  peak    89.9 MiB
+//! replica / set: peak 1.27× (target ≤ 1.3×, ≤ 1024 MiB), wall 0.92× of linear (target ≤ 1.10)
+//! merge of 8 shards  wall   4.316 s  peak   132.2 MiB: 30 % of the replica's build (target ≤ 10 %)
+//! ```
+//! Memory and linearity met; the merge is not (`docs/decisions.md`, issue 16 item 2: it
+//! must refit the polytopes over every kinematic sample). `farm-bench` A/B against the
+//! commit before the session (3 pairs): merge 3.82 against 6.58 s, build 14.09 against
+//! 14.29 s.
+//!
 //! 2026-12-06, 2-core sandbox, nothing else running, `SCALE_ROUNDS=3`, after the per-clip
 //! limit summaries (`stances::limits::group_facts`), the count-bounded waiting rows
 //! (`PENDING_SPILL_CHUNKS`) and the compact per-clip outcomes (`library::ClipStatus`):
