@@ -368,6 +368,51 @@ fn merge_cli(shards: &[&Path], out: &Path) -> (i32, String) {
     (code, err)
 }
 
+/// A shard whose frames hold a clip its clips table does not (here its last clip with
+/// frames, and those after it, are cut from `clips.parquet`) is refused, naming the shard,
+/// the table and the clip: the merge copies frames by row group and would otherwise drop
+/// the groups left after the shard's last listed clip.
+#[test]
+fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let (a, b) = (d.path().join("a"), d.path().join("b"));
+    build_cli(&inputs, &a, &["--shard", "1/2"]);
+    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    let clips_path = b.join("clips.parquet");
+    let mut clips = stancelib::library::read::read_parquet(&clips_path).unwrap();
+    let with_frames: Vec<usize> = clips
+        .column("frames_kept")
+        .unwrap()
+        .i64()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.unwrap_or(0) > 0)
+        .map(|(i, _)| i)
+        .collect();
+    let last = *with_frames.last().expect("a clip with frames in shard 2");
+    let name = clips
+        .column("clip")
+        .unwrap()
+        .str()
+        .unwrap()
+        .get(last)
+        .unwrap()
+        .to_string();
+    // The clips from it on are cut, so that no listed clip of this shard comes after it.
+    clips = clips.slice(0, last);
+    stancelib::library::write::write_atomic(&b, "clips.parquet", &mut clips, &[]).unwrap();
+    let out = d.path().join("merged");
+    let (code, err) = merge_cli(&[&a, &b], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&s(&b)) && err.contains("frames.parquet") && err.contains(&name),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
 #[test]
 fn merge_refuses_shards_built_with_other_options_naming_the_shard() {
     let inputs = fixture_inputs();
