@@ -293,6 +293,19 @@ fn group_values(path: &Path, names: &[&str]) -> Vec<Vec<String>> {
     out
 }
 
+/// (row, clip) of the rows of a clips table whose clip kept frames.
+fn clips_with_frames(clips: &polars::prelude::DataFrame) -> Vec<(usize, String)> {
+    let names = clips.column("clip").unwrap().str().unwrap();
+    let kept = clips.column("frames_kept").unwrap().i64().unwrap();
+    names
+        .iter()
+        .zip(kept.iter())
+        .enumerate()
+        .filter(|(_, (_, n))| n.unwrap_or(0) > 0)
+        .map(|(i, (c, _))| (i, c.unwrap().to_string()))
+        .collect()
+}
+
 /// The per-frame tables hold one row group per clip and the polytopes' points one per
 /// (character, effector), so that a merge copies them without decoding them.
 #[test]
@@ -301,15 +314,9 @@ fn per_clip_tables_hold_a_row_group_per_clip() {
     let out = d.path().join("lib");
     streamed(&fixture_inputs(), &out, 2, 2);
     let clips = stancelib::library::read::read_parquet(&out.join("clips.parquet")).unwrap();
-    let with_frames: Vec<String> = clips
-        .column("clip")
-        .unwrap()
-        .str()
-        .unwrap()
-        .iter()
-        .zip(clips.column("frames_kept").unwrap().i64().unwrap().iter())
-        .filter(|(_, n)| n.unwrap_or(0) > 0)
-        .map(|(c, _)| c.unwrap().to_string())
+    let with_frames: Vec<String> = clips_with_frames(&clips)
+        .into_iter()
+        .map(|(_, c)| c)
         .collect();
     let per_group: Vec<String> = group_values(&out.join("frames.parquet"), &["clip"])
         .into_iter()
@@ -381,25 +388,9 @@ fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
     build_cli(&inputs, &b, &["--shard", "2/2"]);
     let clips_path = b.join("clips.parquet");
     let mut clips = stancelib::library::read::read_parquet(&clips_path).unwrap();
-    let with_frames: Vec<usize> = clips
-        .column("frames_kept")
-        .unwrap()
-        .i64()
-        .unwrap()
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| n.unwrap_or(0) > 0)
-        .map(|(i, _)| i)
-        .collect();
-    let last = *with_frames.last().expect("a clip with frames in shard 2");
-    let name = clips
-        .column("clip")
-        .unwrap()
-        .str()
-        .unwrap()
-        .get(last)
-        .unwrap()
-        .to_string();
+    let (last, name) = clips_with_frames(&clips)
+        .pop()
+        .expect("a clip with frames in shard 2");
     // The clips from it on are cut, so that no listed clip of this shard comes after it.
     clips = clips.slice(0, last);
     stancelib::library::write::write_atomic(&b, "clips.parquet", &mut clips, &[]).unwrap();

@@ -70,7 +70,7 @@ const MAX_FOOTER_BYTES: usize = 64 << 20;
 /// One column chunk of an [`EncodedGroup`].
 #[derive(Debug, Clone, PartialEq)]
 struct Chunk {
-    /// Its pages (headers and compressed data) in the group's bytes.
+    /// Its pages (headers and compressed data): a range of the group's bytes.
     pages: Range<usize>,
     /// Its footer entry, every offset counted from the chunk's first page; no page index
     /// offsets (set when the group is appended).
@@ -85,6 +85,8 @@ struct Chunk {
 /// metadata with offsets relative to each column chunk (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct EncodedGroup {
+    /// The group's column chunks as they lay in their file, from its first page to its
+    /// last chunk's end.
     bytes: Vec<u8>,
     chunks: Vec<Chunk>,
     /// The group's footer entry without its columns (set when appended).
@@ -248,12 +250,13 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
             hi - lo
         )));
     }
-    let span = src.read_at(lo, hi - lo)?;
-    let mut bytes = Vec::with_capacity(span.len());
+    // The group's bytes are the span as read (the chunks' inline metadata between them is
+    // left unused): each chunk is a range of it, not a copy.
+    let bytes = src.read_at(lo, hi - lo)?;
     let mut chunks = Vec::with_capacity(rg.columns.len());
     for (c, (start, len, _)) in rg.columns.iter().zip(spans) {
-        let at = bytes.len();
-        bytes.extend_from_slice(slice(&span, start - lo, len)?);
+        let at = (start - lo) as usize;
+        let pages = at..at + slice(&bytes, start - lo, len)?.len();
         let mut meta = c.clone();
         shift_chunk(&mut meta, -start)?;
         let column_index = match (
@@ -276,7 +279,7 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
             _ => return Err(malformed("column chunk without an offset index")),
         };
         chunks.push(Chunk {
-            pages: at..bytes.len(),
+            pages,
             meta,
             column_index,
             offset_index,
@@ -302,8 +305,9 @@ fn index_len(l: i32) -> std::io::Result<i32> {
     }
 }
 
-/// The footer of a Parquet file held in `bytes` or read from `file`.
-fn read_footer(src: &mut impl ReadAt, len: u64) -> std::io::Result<FileMetaData> {
+/// Where the footer of a Parquet file of `len` bytes starts, and its length: from its last
+/// 8 bytes (the footer's length, `PAR1`).
+fn footer_span(src: &mut impl ReadAt, len: u64) -> std::io::Result<(u64, u64)> {
     if len < 12 {
         return Err(malformed("too short for a parquet file"));
     }
@@ -311,11 +315,20 @@ fn read_footer(src: &mut impl ReadAt, len: u64) -> std::io::Result<FileMetaData>
     if &tail[4..] != MAGIC {
         return Err(malformed("no parquet magic at the end"));
     }
-    let meta_len = i64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+    let meta_len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+    let start = (len - 8)
+        .checked_sub(meta_len)
+        .ok_or_else(|| malformed("footer longer than the file"))?;
+    Ok((start, meta_len))
+}
+
+/// The whole footer of a Parquet file held in `bytes` or read from `file`.
+fn read_footer(src: &mut impl ReadAt, len: u64) -> std::io::Result<FileMetaData> {
+    let (start, meta_len) = footer_span(src, len)?;
     if meta_len as usize > MAX_FOOTER_BYTES {
         return Err(malformed(format!("a footer of {meta_len} bytes")));
     }
-    let raw = src.read_at(len as i64 - 8 - meta_len, meta_len)?;
+    let raw = src.read_at(start as i64, meta_len as i64)?;
     read_thrift(&raw, FileMetaData::read_from_in_protocol)
 }
 
@@ -741,6 +754,28 @@ fn len_i32(n: usize) -> std::io::Result<i32> {
     i32::try_from(n).map_err(|_| malformed(format!("{n} bytes: over a thrift length")))
 }
 
+/// List field `id` of `n` structs, each written by `item(p, k)`, as the generated thrift
+/// code writes a list field.
+fn write_struct_list<P: TOutputProtocol>(
+    p: &mut P,
+    name: &str,
+    id: i16,
+    n: usize,
+    mut item: impl FnMut(&mut P, usize) -> std::io::Result<usize>,
+) -> std::io::Result<()> {
+    let size = u32::try_from(n).map_err(|_| malformed("list too long"))?;
+    p.write_field_begin(&TFieldIdentifier::new(name, TType::List, id))
+        .map_err(thrift_err)?;
+    p.write_list_begin(&TListIdentifier::new(TType::Struct, size))
+        .map_err(thrift_err)?;
+    for k in 0..n {
+        item(p, k)?;
+    }
+    p.write_list_end().map_err(thrift_err)?;
+    p.write_field_end().map_err(thrift_err)?;
+    Ok(())
+}
+
 /// `footer` as polars writes it (`FileMetaData::write_to_out_protocol`, field for field),
 /// its `groups` row groups taken one at a time from `next_group` instead of its own list.
 fn write_footer(
@@ -751,49 +786,29 @@ fn write_footer(
 ) -> std::io::Result<()> {
     let e = thrift_err;
     let mut p = TCompactOutputProtocol::new(out);
-    let list = |n: usize| -> std::io::Result<TListIdentifier> {
-        Ok(TListIdentifier::new(
-            TType::Struct,
-            u32::try_from(n).map_err(|_| malformed("list too long"))?,
-        ))
-    };
     p.write_struct_begin(&TStructIdentifier::new("FileMetaData"))
         .map_err(e)?;
     p.write_field_begin(&TFieldIdentifier::new("version", TType::I32, 1))
         .map_err(e)?;
     p.write_i32(footer.version).map_err(e)?;
     p.write_field_end().map_err(e)?;
-    p.write_field_begin(&TFieldIdentifier::new("schema", TType::List, 2))
-        .map_err(e)?;
-    p.write_list_begin(&list(footer.schema.len())?).map_err(e)?;
-    for s in &footer.schema {
-        s.write_to_out_protocol(&mut p).map_err(e)?;
-    }
-    p.write_list_end().map_err(e)?;
-    p.write_field_end().map_err(e)?;
+    let schema = &footer.schema;
+    write_struct_list(&mut p, "schema", 2, schema.len(), |p, k| {
+        schema[k].write_to_out_protocol(p).map_err(e)
+    })?;
     p.write_field_begin(&TFieldIdentifier::new("num_rows", TType::I64, 3))
         .map_err(e)?;
     p.write_i64(footer.num_rows).map_err(e)?;
     p.write_field_end().map_err(e)?;
-    p.write_field_begin(&TFieldIdentifier::new("row_groups", TType::List, 4))
-        .map_err(e)?;
-    p.write_list_begin(&list(groups)?).map_err(e)?;
-    for _ in 0..groups {
-        next_group()?.write_to_out_protocol(&mut p).map_err(e)?;
-    }
-    p.write_list_end().map_err(e)?;
-    p.write_field_end().map_err(e)?;
+    write_struct_list(&mut p, "row_groups", 4, groups, |p, _| {
+        next_group()?.write_to_out_protocol(p).map_err(e)
+    })?;
     // The fields after the groups, written by a copy of the footer without groups, would
     // restart the field numbering; they are written here in polars' order instead.
     if let Some(kv) = &footer.key_value_metadata {
-        p.write_field_begin(&TFieldIdentifier::new("key_value_metadata", TType::List, 5))
-            .map_err(e)?;
-        p.write_list_begin(&list(kv.len())?).map_err(e)?;
-        for x in kv {
-            x.write_to_out_protocol(&mut p).map_err(e)?;
-        }
-        p.write_list_end().map_err(e)?;
-        p.write_field_end().map_err(e)?;
+        write_struct_list(&mut p, "key_value_metadata", 5, kv.len(), |p, k| {
+            kv[k].write_to_out_protocol(p).map_err(e)
+        })?;
     }
     if let Some(by) = &footer.created_by {
         p.write_field_begin(&TFieldIdentifier::new("created_by", TType::String, 6))
@@ -802,14 +817,9 @@ fn write_footer(
         p.write_field_end().map_err(e)?;
     }
     if let Some(orders) = &footer.column_orders {
-        p.write_field_begin(&TFieldIdentifier::new("column_orders", TType::List, 7))
-            .map_err(e)?;
-        p.write_list_begin(&list(orders.len())?).map_err(e)?;
-        for o in orders {
-            o.write_to_out_protocol(&mut p).map_err(e)?;
-        }
-        p.write_list_end().map_err(e)?;
-        p.write_field_end().map_err(e)?;
+        write_struct_list(&mut p, "column_orders", 7, orders.len(), |p, k| {
+            orders[k].write_to_out_protocol(p).map_err(e)
+        })?;
     }
     if footer.encryption_algorithm.is_some() || footer.footer_signing_key_metadata.is_some() {
         return Err(malformed("encrypted footers are not supported"));
@@ -877,17 +887,7 @@ impl GroupFileReader {
         let err = |e| io(path, "cannot read parquet", e);
         let mut data = File::open(path).map_err(|e| io(path, "cannot open", e))?;
         let len = data.metadata().map_err(err)?.len();
-        if len < 12 {
-            return Err(err(malformed("too short for a parquet file")));
-        }
-        let tail = data.read_at(len as i64 - 8, 8).map_err(err)?;
-        if &tail[4..] != MAGIC {
-            return Err(err(malformed("no parquet magic at the end")));
-        }
-        let meta_len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
-        let start = (len - 8)
-            .checked_sub(meta_len)
-            .ok_or_else(|| err(malformed("footer longer than the file")))?;
+        let (start, meta_len) = footer_span(&mut data, len).map_err(err)?;
         let mut footer = BufReader::new(File::open(path).map_err(|e| io(path, "cannot open", e))?);
         footer.seek(SeekFrom::Start(start)).map_err(err)?;
         let left = footer_to_groups(&mut footer, meta_len as usize).map_err(err)?;
