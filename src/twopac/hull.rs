@@ -186,12 +186,18 @@ pub const STREAM_CHUNK_POINTS: usize = 65_536;
 /// (no 3-D hull) keeps every point, and then has no polytope anyway.
 ///
 /// Speed: the depth test visits only the planes whose normals face the point (a cube map
-/// of the normals with a lower bound per bucket, `PlaneIndex`), not every triangle.
+/// of the normals with a lower bound per bucket, `PlaneIndex`), not every triangle. A new
+/// point is tested against the last running hull as it arrives and dropped at once when
+/// deeper than δ in it (safe by the same argument: `conv R ⊆ H`), so a chunk holds only
+/// the points near or outside the running hull, and a stream that revisits its own poses
+/// (a long recording, clips of one motion) rarely rebuilds the hull.
 #[derive(Debug, Clone)]
 pub struct StreamedHull {
     kept: Vec<[f64; 3]>,
     pending: Vec<[f64; 3]>,
     chunk: usize,
+    /// The planes of the running hull `conv R`, after the first reduction.
+    index: Option<PlaneIndex>,
 }
 
 impl Default for StreamedHull {
@@ -207,12 +213,17 @@ impl StreamedHull {
             kept: Vec::new(),
             pending: Vec::new(),
             chunk: chunk.max(1),
+            index: None,
         }
     }
 
-    /// Add a point; a non-finite point is ignored (it has no place in a hull).
+    /// Add a point; a non-finite point is ignored (it has no place in a hull), and so is
+    /// one deeper than δ in the running hull (see the type's docs).
     pub fn push(&mut self, p: [f64; 3]) {
         if !p.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        if self.index.as_ref().is_some_and(|i| !i.near_a_plane(p)) {
             return;
         }
         self.pending.push(p);
@@ -238,6 +249,7 @@ impl StreamedHull {
         let index = PlaneIndex::new(&verts, &faces);
         all.retain(|p| index.near_a_plane(*p));
         self.kept = all;
+        self.index = Some(index);
     }
 
     /// The polytope of every point pushed ([`hull_hrep`] of `T`, see the type's docs).
@@ -273,6 +285,7 @@ const BOUND_SLACK_M: f64 = 1e-9;
 /// ```
 /// so a bucket whose bound exceeds δ (plus a slack) is skipped whole: only the few buckets
 /// facing `p` are scanned, and a point near the centre none.
+#[derive(Debug, Clone)]
 struct PlaneIndex {
     centroid: [f64; 3],
     buckets: Vec<PlaneBucket>,
