@@ -237,25 +237,74 @@ pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRow
 }
 
 /// Rows of one (character, effector) group's samples in the layout of
+/// Points of one (character, effector) gathered column by column for [`points_frame`]'s
+/// table: the clip names as runs (one shared name per run of a clip's samples, not a copy
+/// per row), the frames and the three coordinates.
+#[derive(Debug, Default)]
+pub struct PointRows {
+    runs: Vec<(Arc<str>, usize)>,
+    frame: Vec<i64>,
+    xyz: [Vec<f64>; 3],
+}
+
+impl PointRows {
+    /// Append one sample.
+    pub fn push(&mut self, s: &Sample) {
+        match self.runs.last_mut() {
+            Some((clip, n)) if Arc::ptr_eq(clip, &s.clip) || **clip == *s.clip => *n += 1,
+            _ => self.runs.push((Arc::clone(&s.clip), 1)),
+        }
+        self.frame.push(s.frame);
+        for (column, v) in self.xyz.iter_mut().zip(s.rc) {
+            column.push(v);
+        }
+    }
+
+    /// Rows gathered.
+    pub fn len(&self) -> usize {
+        self.frame.len()
+    }
+
+    /// No rows gathered.
+    pub fn is_empty(&self) -> bool {
+        self.frame.is_empty()
+    }
+
+    /// The rows as the points table of `key` (character, effector), leaving none.
+    ///
+    /// # Errors
+    /// A column cannot be built.
+    pub fn take_frame(&mut self, key: &(String, String)) -> PolarsResult<DataFrame> {
+        let n = self.len();
+        let mut clip = StringChunkedBuilder::new(K::CLIP.into(), n);
+        for (name, count) in self.runs.drain(..) {
+            for _ in 0..count {
+                clip.append_value(&name);
+            }
+        }
+        let [x, y, z] = std::mem::take(&mut self.xyz);
+        let name = |k: &str| PlSmallStr::from(k);
+        DataFrame::new_infer_height(vec![
+            StringChunked::full(name(K::CHARACTER_ID), &key.0, n).into_column(),
+            StringChunked::full(name(K::EFFECTOR), &key.1, n).into_column(),
+            clip.finish().into_column(),
+            col(K::FRAME, std::mem::take(&mut self.frame)),
+            col(K::POINT[0], x),
+            col(K::POINT[1], y),
+            col(K::POINT[2], z),
+        ])
+    }
+}
+
 /// `kinematics_points.parquet` and `kinematics_samples.parquet`: `character_id`,
 /// `effector`, `clip`, `frame`, `x_m`, `y_m`, `z_m`.
 ///
 /// # Errors
 /// A column cannot be built.
 pub fn points_frame(key: &(String, String), rows: &[Sample]) -> PolarsResult<DataFrame> {
-    let p = |a: usize| -> Vec<f64> { rows.iter().map(|s| s.rc[a]).collect() };
-    DataFrame::new_infer_height(vec![
-        col(K::CHARACTER_ID, vec![key.0.as_str(); rows.len()]),
-        col(K::EFFECTOR, vec![key.1.as_str(); rows.len()]),
-        col(
-            K::CLIP,
-            rows.iter().map(|s| &*s.clip).collect::<Vec<&str>>(),
-        ),
-        col(K::FRAME, rows.iter().map(|s| s.frame).collect::<Vec<_>>()),
-        col(K::POINT[0], p(0)),
-        col(K::POINT[1], p(1)),
-        col(K::POINT[2], p(2)),
-    ])
+    let mut p = PointRows::default();
+    rows.iter().for_each(|s| p.push(s));
+    p.take_frame(key)
 }
 
 #[cfg(test)]

@@ -18,6 +18,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use super::build::replace_library;
@@ -31,6 +32,7 @@ use crate::library::schema::{
     group_column, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, STANCES_FILE,
 };
+use crate::library::stream::TableWriter;
 use crate::library::write::ROW_GROUP_ROWS;
 
 /// What a merge wrote.
@@ -264,9 +266,9 @@ impl GroupCursor {
         }
     }
 
-    /// Append the row groups of `clip` (the next ones of the shard) to `sink`'s table; a
-    /// group of a clip before `clip` means the shard's tables disagree.
-    fn copy_clip(&mut self, clip: &str, sink: &mut LibrarySink, dir: &Path) -> Result<()> {
+    /// Append the row groups of `clip` (the next ones of the shard) to `w`; a group of a
+    /// clip before `clip` means the shard's tables disagree.
+    fn copy_clip(&mut self, clip: &str, w: &mut TableWriter, dir: &Path) -> Result<()> {
         while let Some(next) = self.next_clip()? {
             match next.as_slice().cmp(clip.as_bytes()) {
                 std::cmp::Ordering::Greater => break,
@@ -287,12 +289,46 @@ impl GroupCursor {
                     };
                     // `next_clip` has just read this group's entry.
                     let g = g.ok_or_else(|| bad(dir, format!("{}: no row group", self.table)))?;
-                    sink.push_group(self.table, &g)?;
+                    w.push_group(&g)?;
                 }
             }
         }
         Ok(())
     }
+}
+
+/// Copy the per-clip row groups of every clip of `plan` (clip, frames, shard) from its
+/// shard's `groups` (one cursor per table of `writers`, in that order) into `writers`, then
+/// refuse a shard with groups left; `stop` (set on a failure elsewhere) ends the copy
+/// early. Runs beside the rest of the merge and hands the writers back.
+fn copy_groups(
+    plan: &[(String, usize, usize)],
+    libs: &[ShardLib],
+    mut groups: Vec<Vec<GroupCursor>>,
+    mut writers: Vec<(&'static str, TableWriter)>,
+    stop: &AtomicBool,
+) -> Result<Vec<(&'static str, TableWriter)>> {
+    for (clip, _, k) in plan {
+        if stop.load(Ordering::Relaxed) {
+            return Ok(writers);
+        }
+        for g in groups[*k].iter_mut() {
+            let w = writers
+                .iter_mut()
+                .find(|(n, _)| *n == g.table)
+                .map(|(_, w)| w)
+                .ok_or_else(|| bad(&libs[*k].dir, format!("{}: no writer", g.table)))?;
+            g.copy_clip(clip, w, &libs[*k].dir)?;
+        }
+    }
+    // Every shard's per-clip groups were copied: one left holds a clip its shard's clips
+    // table does not.
+    for (shard, lib) in groups.iter_mut().zip(libs) {
+        for g in shard.iter_mut() {
+            g.refuse_leftover(&lib.dir)?;
+        }
+    }
+    Ok(writers)
 }
 
 /// Spill a shard's samples table into `sink` a row group's worth at a time (never the
@@ -349,80 +385,104 @@ pub fn merge_into(
     };
     replace_library(out, |tmp| {
         let mut sink = LibrarySink::create(tmp, joints, false, false)?;
-        // Per shard: a row cursor per table, none for a per-clip table, whose row groups
-        // are copied by a group cursor instead.
-        let mut cursors: Vec<Vec<Option<ClipCursor>>> = Vec::new();
-        let mut groups: Vec<Vec<GroupCursor>> = Vec::new();
-        for lib in &libs {
-            sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
-            push_samples(&mut sink, &lib.dir)?;
-            let names: Vec<&'static str> =
-                sink.template().named().iter().map(|(n, _)| *n).collect();
-            cursors.push(
-                names
+        let names: Vec<&'static str> = sink.template().named().iter().map(|(n, _)| *n).collect();
+        let per_clip: Vec<&'static str> = names
+            .iter()
+            .copied()
+            .filter(|n| group_column(n).is_some())
+            .collect();
+        // The per-clip tables' row groups are copied by group cursors on a thread of their
+        // own, beside the samples, the other tables and the polytopes (`finish_with`).
+        let groups = libs
+            .iter()
+            .map(|lib| {
+                per_clip
                     .iter()
-                    .map(|n| match group_column(n) {
-                        Some(_) => Ok(None),
-                        None => ClipCursor::open(&lib.dir.join(n)).map(Some),
-                    })
-                    .collect::<Result<Vec<_>>>()?,
-            );
-            groups.push(
-                names
-                    .iter()
-                    .filter_map(|n| group_column(n).map(|c| GroupCursor::open(&lib.dir, n, c)))
-                    .collect::<Result<Vec<_>>>()?,
-            );
-        }
-        let mut start = 0;
-        while start < plan.len() {
-            // A batch: clips until about one row group of frames.
-            let (mut end, mut frames) = (start, 0);
-            while end < plan.len() && (end == start || frames < ROW_GROUP_ROWS) {
-                frames += plan[end].1;
-                end += 1;
+                    .map(|n| GroupCursor::open(&lib.dir, n, group_column(n).unwrap_or_default()))
+                    .collect::<Result<Vec<_>>>()
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let writers = sink.detach(&per_clip);
+        let stop = AtomicBool::new(false);
+        std::thread::scope(|scope| {
+            let copier = scope.spawn(|| copy_groups(&plan, &libs, groups, writers, &stop));
+            let rejoin = || {
+                copier
+                    .join()
+                    .unwrap_or_else(|_| Err(bad(tmp, "the row group copy stopped unexpectedly")))
+            };
+            let merged = merge_rows(&mut sink, &libs, &plan, &names, joints, &mut summary)
+                .and_then(|()| sink.finish_with(&fingerprint, t0, None, layout, rejoin));
+            if merged.is_err() {
+                stop.store(true, Ordering::Relaxed);
             }
-            let last = plan[end - 1].0.clone();
-            for (clip, _, k) in &plan[start..end] {
-                for g in groups[*k].iter_mut() {
-                    g.copy_clip(clip, &mut sink, &libs[*k].dir)?;
-                }
-            }
-            let mut t = Tables::empty(joints)?;
-            for shard in cursors.iter_mut() {
-                for ((name, df), cur) in t.named().into_iter().zip(shard.iter_mut()) {
-                    let Some(cur) = cur else { continue };
-                    if let Some(rows) = cur.take_through(&last, &|_| true)? {
-                        let rows = super::sink::cast_like(rows, df, name)?;
-                        df.vstack_mut(&rows)
-                            .map_err(|e| Error::io(name, "cannot stack rows", e))?;
-                    }
-                }
-            }
-            for (name, df) in t.named() {
-                *df = sorted(std::mem::take(df), name)?;
-            }
-            summary.failed += t
-                .clips
-                .column("status")
-                .and_then(|c| {
-                    c.str()
-                        .map(|s| s.iter().filter(|v| *v == Some("error")).count())
-                })
-                .unwrap_or(0);
-            sink.push(&mut t)?;
-            drop(t);
-            super::memory::release_free_memory();
-            start = end;
-        }
-        // Every shard's per-clip groups were copied: one left holds a clip its shard's
-        // clips table does not.
-        for (shard, lib) in groups.iter_mut().zip(&libs) {
-            for g in shard.iter_mut() {
-                g.refuse_leftover(&lib.dir)?;
-            }
-        }
-        sink.finish(&fingerprint, t0, None, layout)
+            merged
+        })
     })?;
     Ok(summary)
+}
+
+/// The samples, the errors and the tables of a few rows a clip (every table but the
+/// per-clip ones) of every shard, appended to `sink` in `plan`'s clip order, a batch of
+/// clips at a time; the failed clips are counted into `summary`.
+fn merge_rows(
+    sink: &mut LibrarySink,
+    libs: &[ShardLib],
+    plan: &[(String, usize, usize)],
+    names: &[&'static str],
+    joints: bool,
+    summary: &mut MergeSummary,
+) -> Result<()> {
+    // Per shard: a row cursor per table, none for a per-clip table.
+    let mut cursors: Vec<Vec<Option<ClipCursor>>> = Vec::new();
+    for lib in libs {
+        sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
+        push_samples(sink, &lib.dir)?;
+        cursors.push(
+            names
+                .iter()
+                .map(|n| match group_column(n) {
+                    Some(_) => Ok(None),
+                    None => ClipCursor::open(&lib.dir.join(n)).map(Some),
+                })
+                .collect::<Result<Vec<_>>>()?,
+        );
+    }
+    let mut start = 0;
+    while start < plan.len() {
+        // A batch: clips until about one row group of frames.
+        let (mut end, mut frames) = (start, 0);
+        while end < plan.len() && (end == start || frames < ROW_GROUP_ROWS) {
+            frames += plan[end].1;
+            end += 1;
+        }
+        let last = plan[end - 1].0.clone();
+        let mut t = Tables::empty(joints)?;
+        for shard in cursors.iter_mut() {
+            for ((name, df), cur) in t.named().into_iter().zip(shard.iter_mut()) {
+                let Some(cur) = cur else { continue };
+                if let Some(rows) = cur.take_through(&last, &|_| true)? {
+                    let rows = super::sink::cast_like(rows, df, name)?;
+                    df.vstack_mut(&rows)
+                        .map_err(|e| Error::io(name, "cannot stack rows", e))?;
+                }
+            }
+        }
+        for (name, df) in t.named() {
+            *df = sorted(std::mem::take(df), name)?;
+        }
+        summary.failed += t
+            .clips
+            .column("status")
+            .and_then(|c| {
+                c.str()
+                    .map(|s| s.iter().filter(|v| *v == Some("error")).count())
+            })
+            .unwrap_or(0);
+        sink.push(&mut t)?;
+        drop(t);
+        super::memory::release_free_memory();
+        start = end;
+    }
+    Ok(())
 }

@@ -27,11 +27,11 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::library::kinematics::{
-    add_character_legs, facets_table, points_frame, samples_table, Facet, Sample,
+    add_character_legs, facets_table, points_frame, samples_table, Facet, PointRows, Sample,
 };
 use crate::library::layout::{convert_to_dataset, locate_path, read_source, Layout, TableSource};
 use crate::library::read::parquet_rows;
-use crate::library::row_groups::{EncodedGroup, GroupFileReader};
+use crate::library::row_groups::GroupFileReader;
 use crate::library::schema::{
     clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_FILE, KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE,
@@ -260,30 +260,35 @@ impl LibrarySink {
         if t.errors.height() > 0 {
             self.errors.push(std::mem::take(&mut t.errors));
         }
-        // The tables are written side by side on the worker pool (each its own file).
-        let pushed: Vec<Result<()>> = t
-            .named()
-            .into_par_iter()
-            .zip(self.writers.par_iter_mut())
-            .map(|((_, df), (_, w))| w.push(df))
+        // The tables are written side by side on the worker pool (each its own file); a
+        // detached table's writer is elsewhere, so its rows cannot come here.
+        let mut named: BTreeMap<&str, &mut DataFrame> = t.named().into_iter().collect();
+        let jobs: Vec<(&mut DataFrame, &mut TableWriter)> = self
+            .writers
+            .iter_mut()
+            .filter_map(|(n, w)| named.remove(n).map(|df| (df, w)))
             .collect();
+        if let Some((name, _)) = named.iter().find(|(_, df)| df.height() > 0) {
+            return Err(Error::io(
+                self.dir.join(name),
+                "cannot append rows",
+                std::io::Error::other("the table's writer is detached"),
+            ));
+        }
+        let pushed: Vec<Result<()>> = jobs.into_par_iter().map(|(df, w)| w.push(df)).collect();
         pushed.into_iter().collect()
     }
 
-    /// Append a row group of table `name` as it is (a shard's group of a per-clip table,
-    /// `schema::group_column`), after the rows and groups pushed so far.
-    ///
-    /// # Errors
-    /// `name` is not a table of the library, or the write fails.
-    pub fn push_group(&mut self, name: &str, g: &EncodedGroup) -> Result<()> {
-        match self.writers.iter_mut().find(|(n, _)| *n == name) {
-            Some((_, w)) => w.push_group(g),
-            None => Err(Error::io(
-                self.dir.join(name),
-                "cannot append a row group",
-                std::io::Error::other("not a table of this library"),
-            )),
-        }
+    /// Take the writers of the tables `names` out of the sink, to be filled elsewhere (a
+    /// merge copies the per-clip row groups on a thread of their own) and handed back to
+    /// [`LibrarySink::finish_with`]. Rows of those tables given to [`LibrarySink::push`]
+    /// are then refused.
+    pub fn detach(&mut self, names: &[&str]) -> Vec<(&'static str, TableWriter)> {
+        let (out, keep) = std::mem::take(&mut self.writers)
+            .into_iter()
+            .partition(|(n, _)| names.contains(n));
+        self.writers = keep;
+        out
     }
 
     /// Add error rows (any order).
@@ -302,11 +307,25 @@ impl LibrarySink {
     /// their datasets ([`convert_to_dataset`]) and its manifest names the layout (a `file`
     /// library's has no `layout` key, as before there were two).
     pub fn finish(
+        self,
+        fingerprint: &str,
+        t0: Instant,
+        shard: Option<serde_json::Value>,
+        layout: Layout,
+    ) -> Result<()> {
+        self.finish_with(fingerprint, t0, shard, layout, || Ok(Vec::new()))
+    }
+
+    /// [`LibrarySink::finish`] for a sink with detached writers ([`LibrarySink::detach`]):
+    /// `rejoin` hands them back, filled, once the polytopes are written (the longest part
+    /// of the finish, which thus overlaps whatever fills them).
+    pub fn finish_with(
         mut self,
         fingerprint: &str,
         t0: Instant,
         shard: Option<serde_json::Value>,
         layout: Layout,
+        rejoin: impl FnOnce() -> Result<Vec<(&'static str, TableWriter)>>,
     ) -> Result<()> {
         let dir = self.dir.clone();
         let mut errors = concat(
@@ -333,6 +352,9 @@ impl LibrarySink {
             write_samples(&self.samples, &dir, &kv)?;
         }
         kinematics(&self.samples, &self.legs, &dir, &kv)?;
+        for (_, w) in rejoin()? {
+            w.finish(&kv)?;
+        }
         if layout == Layout::Dataset {
             convert_to_dataset(&dir)?;
         }
@@ -370,13 +392,13 @@ impl LibrarySink {
 /// Rows of a group's samples appended to `w`, a row group's worth at a time.
 struct GroupRows<'a> {
     key: &'a (String, String),
-    rows: Vec<Sample>,
+    rows: PointRows,
     w: &'a mut TableWriter,
 }
 
 impl GroupRows<'_> {
     fn add(&mut self, s: &Sample) -> Result<()> {
-        self.rows.push(s.clone());
+        self.rows.push(s);
         if self.rows.len() >= ROW_GROUP_ROWS {
             self.flush()?;
         }
@@ -384,8 +406,10 @@ impl GroupRows<'_> {
     }
 
     fn flush(&mut self) -> Result<()> {
-        let df = points_frame(self.key, &self.rows).map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
-        self.rows.clear();
+        let df = self
+            .rows
+            .take_frame(self.key)
+            .map_err(|e| pe(KINEMATICS_POINTS_FILE, e))?;
         self.w.push(&df)
     }
 }
@@ -398,7 +422,7 @@ fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Re
     for (key, _) in spill.groups() {
         let mut rows = GroupRows {
             key,
-            rows: Vec::new(),
+            rows: PointRows::default(),
             w: &mut w,
         };
         spill.read_group(key, &mut |b| b.iter().try_for_each(|s| rows.add(s)))?;
@@ -473,7 +497,7 @@ fn reduce_group(
     let mut hull = StreamedHull::default();
     let mut rows = GroupRows {
         key,
-        rows: Vec::new(),
+        rows: PointRows::default(),
         w: &mut w,
     };
     spill.read_group(key, &mut |b| {
