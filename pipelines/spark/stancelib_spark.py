@@ -142,25 +142,29 @@ def main(argv):
     # One partition per shard: Spark runs each shard as one task, retrying lost executors.
     results = sc.parallelize(specs, count).map(shard_task).collect()
     t_shards = time.monotonic()
-    spark.stop()
     # 0: every clip ok; 1: some clips failed (their rows say why); anything else: the build
     # of the shard did not finish.
     failed = sorted((i, code, err) for i, code, err in results if code not in (0, 1))
     if failed:
+        spark.stop()
         for i, code, err in failed:
             sys.stderr.write("shard %d/%d failed (exit %d):\n%s\n" % (i, count, code, err))
         sys.stderr.write("nothing merged; %s is unchanged\n" % out)
         return 2
     shards = [os.path.join(work, "shard-%d" % i) for i in range(1, count + 1)]
-    t_merge0 = time.monotonic()
-    merge = subprocess.run([resolve_binary(args.stancelib), "merge", *shards, "--out", out])
+    # The merge needs no Spark: it runs while the JVM shuts down (about a second).
+    merge = subprocess.Popen([resolve_binary(args.stancelib), "merge", *shards, "--out", out])
+    spark.stop()
+    t_stopped = time.monotonic()
+    code = merge.wait()
     t_end = time.monotonic()
     report_phases([("Spark start", t_session - t0), ("shards", t_shards - t_session),
-                   ("Spark stop", t_merge0 - t_shards), ("merge", t_end - t_merge0)],
-                  count, master)
-    if merge.returncode in (0, 1) and not (args.keep_shards or args.incremental):
+                   ("merge", t_end - t_shards)], count, master)
+    sys.stderr.write("stancelib-spark: Spark stopped %.2f s into the merge\n"
+                     % (t_stopped - t_shards))
+    if code in (0, 1) and not (args.keep_shards or args.incremental):
         shutil.rmtree(work, ignore_errors=True)
-    return merge.returncode
+    return code
 
 
 if __name__ == "__main__":
