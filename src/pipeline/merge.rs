@@ -9,9 +9,10 @@
 //!         (about one row group of frames) at a time, sorted by the table's keys, appended;
 //!         the per-frame tables (one row group per clip, `schema::group_column`) are not
 //!         decoded: each clip's row groups are copied from its shard, compressed pages and
-//!         all (`library::row_groups`)
+//!         all (`library::row_groups`), on a thread of their own beside everything else
 //! limits: recomputed from the stance and clip facts of the merged rows
 //! polytopes: recomputed from the shards' kinematic samples (`kinematics_samples.parquet`)
+//!         on the worker pool while the row groups are still being copied
 //! ```
 //! The output obeys the policy of [`super::output`] (the shards are its inputs: `--out`
 //! never is, holds or lies in one), is locked while written and swapped in at the end.

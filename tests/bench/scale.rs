@@ -17,6 +17,18 @@
 //! peak. Nothing is asserted: the figures are printed for the record.
 //!
 //! # Results
+//! 2026-12-06 (second session, a slower day for the same sandbox), `SCALE_ROUNDS=3`, after
+//! the merge's copy moved to a thread of its own beside the polytopes:
+//!
+//! ```text
+//! scale: 93 clips and a 25× replica, build --threads 2, 3 rounds (medians)
+//! set      wall   0.787 s  peak    63.6 MiB
+//! replica  wall  16.872 s  peak    79.8 MiB
+//! replica / set: peak 1.26× (target ≤ 1.3×, ≤ 1024 MiB), wall 0.86× of linear (target ≤ 1.10)
+//! merge of 8 shards  wall   2.754 s  peak   111.8 MiB: 16 % of the replica's build (target ≤ 10 %)
+//! ```
+//! `farm-bench` A/B against 70ad962 the same day (3 pairs): merge 2.61 against 4.59 s.
+//!
 //! 2026-12-06 (later), same sandbox, `SCALE_ROUNDS=3`, after the per-clip row groups, the
 //! merge's copy of them and the parallel polytopes:
 //!
