@@ -238,15 +238,20 @@ impl StreamedHull {
     }
 
     /// Replace the running set and the pending points by their `T` (see the type's docs);
-    /// a set with no 3-D hull is kept whole.
+    /// a set with no solid 3-D hull (collinear or flat: parry then returns a segment or a
+    /// two-sided flat mesh, not an error) is kept whole, and new points are not tested.
     fn reduce(&mut self) {
         let mut all = std::mem::take(&mut self.kept);
         all.append(&mut self.pending);
-        let Ok((verts, faces)) = triangle_planes(&all) else {
+        let index = match triangle_planes(&all) {
+            Ok((verts, faces)) => PlaneIndex::new(&verts, &faces),
+            Err(_) => None,
+        };
+        let Some(index) = index else {
             self.kept = all;
+            self.index = None;
             return;
         };
-        let index = PlaneIndex::new(&verts, &faces);
         all.retain(|p| index.near_a_plane(*p));
         self.kept = all;
         self.index = Some(index);
@@ -296,7 +301,10 @@ struct PlaneIndex {
 type PlaneBucket = ([f64; 3], f64, f64, Vec<([f64; 3], f64)>);
 
 impl PlaneIndex {
-    fn new(verts: &[[f64; 3]], faces: &[TrianglePlane]) -> PlaneIndex {
+    /// The index of a hull's planes; `None` unless the hull is solid: at least 4 planes,
+    /// each farther than δ from the vertices' centroid (a collinear set has no planes, a
+    /// flat one's two-sided mesh passes through its centroid).
+    fn new(verts: &[[f64; 3]], faces: &[TrianglePlane]) -> Option<PlaneIndex> {
         let centroid = scale(
             1.0 / verts.len().max(1) as f64,
             verts.iter().fold([0.0; 3], |acc, p| add(acc, *p)),
@@ -321,8 +329,12 @@ impl PlaneIndex {
                     .fold(f64::INFINITY, f64::min);
                 (u, spread, h_min, planes)
             })
-            .collect();
-        PlaneIndex { centroid, buckets }
+            .collect::<Vec<PlaneBucket>>();
+        let solid = faces.len() >= 4
+            && buckets
+                .iter()
+                .all(|(_, _, h_min, _)| *h_min > KEEP_DEPTH_M + BOUND_SLACK_M);
+        solid.then_some(PlaneIndex { centroid, buckets })
     }
 
     /// Some plane has `d − n·p ≤ KEEP_DEPTH_M`: `p` is within δ of the hull's surface or

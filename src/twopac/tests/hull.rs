@@ -206,6 +206,31 @@ fn a_streamed_hull_holds_the_surface_not_the_stream() {
 }
 
 #[test]
+fn a_collinear_first_chunk_drops_nothing_that_follows() {
+    // parry gives a collinear chunk a segment, not an error: no planes to test against,
+    // so the chunk is kept and the points after it are not dropped.
+    let mut h = StreamedHull::with_chunk(16);
+    let line: Vec<[f64; 3]> = (0..16).map(|i| [0.1 * i as f64, 0.0, 0.0]).collect();
+    let cube: Vec<[f64; 3]> = (0..8)
+        .map(|k| [(k & 1) as f64, ((k >> 1) & 1) as f64, ((k >> 2) & 1) as f64])
+        .collect();
+    for p in line.iter().chain(&cube) {
+        h.push(*p);
+    }
+    assert_eq!(
+        h.held(),
+        24,
+        "nothing dropped against a hull without volume"
+    );
+    let all: Vec<[f64; 3]> = line.iter().chain(&cube).copied().collect();
+    let (whole, _) = streamed(&all, usize::MAX);
+    assert_eq!(
+        bits(&h.finish(&HullOptions::default()).unwrap()),
+        bits(&whole)
+    );
+}
+
+#[test]
 fn a_flat_stream_has_no_polytope() {
     let mut h = StreamedHull::with_chunk(16);
     for i in 0..100 {
