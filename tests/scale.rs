@@ -404,6 +404,33 @@ fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
     assert!(!out.exists());
 }
 
+/// A table the merge reads while its row group copy runs beside it (here a shard's
+/// samples, cut in half) fails the merge with that table's own error, not the copy's
+/// "stopped" one, and the library already at `--out` is kept as it was.
+#[test]
+fn a_failure_beside_the_row_group_copy_names_its_table_and_keeps_the_old_library() {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let (a, b) = (d.path().join("a"), d.path().join("b"));
+    build_cli(&inputs, &a, &["--shard", "1/2"]);
+    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    let out = d.path().join("merged");
+    let (code, err) = merge_cli(&[&a, &b], &out);
+    assert!(code <= 1, "{err}");
+    let before = std::fs::read(out.join("frames.parquet")).unwrap();
+    let samples = b.join("kinematics_samples.parquet");
+    let bytes = std::fs::read(&samples).unwrap();
+    std::fs::write(&samples, &bytes[..bytes.len() / 2]).unwrap();
+    let mut args: Vec<String> = vec!["merge".into(), s(&a), s(&b), "--out".into(), s(&out)];
+    args.push("--force".into());
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, err) = stancelib(&argv);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("kinematics_samples.parquet"), "{err}");
+    assert!(!err.contains("copy was stopped"), "{err}");
+    assert_eq!(std::fs::read(out.join("frames.parquet")).unwrap(), before);
+}
+
 #[test]
 fn merge_refuses_shards_built_with_other_options_naming_the_shard() {
     let inputs = fixture_inputs();

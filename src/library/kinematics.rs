@@ -236,7 +236,6 @@ pub fn read_facets(lib_dir: &Path) -> Result<BTreeMap<(String, String), FacetRow
     Ok(rows)
 }
 
-/// Rows of one (character, effector) group's samples in the layout of
 /// Points of one (character, effector) gathered column by column for [`points_frame`]'s
 /// table: the clip names as runs (one shared name per run of a clip's samples, not a copy
 /// per row), the frames and the three coordinates.

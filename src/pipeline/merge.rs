@@ -298,20 +298,45 @@ impl GroupCursor {
     }
 }
 
+/// How the two sides of a merge tell each other to end early.
+#[derive(Default)]
+struct Signals {
+    /// The rows' side failed or panicked: the copy ends (with an error).
+    stop: AtomicBool,
+    /// The copy failed: the rows' side ends, and the copy's error is the merge's.
+    failed: AtomicBool,
+}
+
+/// Sets its flag when dropped: when the rows' side of a merge returns or panics.
+struct SetOnDrop<'a>(&'a AtomicBool);
+
+impl Drop for SetOnDrop<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+}
+
+/// The error of a merge side that ended without a result of its own (`out`: the library).
+fn side_ended(out: &Path, why: &str) -> Error {
+    Error::io(out, "cannot merge", std::io::Error::other(why.to_string()))
+}
+
 /// Copy the per-clip row groups of every clip of `plan` (clip, frames, shard) from its
 /// shard's `groups` (one cursor per table of `writers`, in that order) into `writers`, then
-/// refuse a shard with groups left; `stop` (set on a failure elsewhere) ends the copy
-/// early. Runs beside the rest of the merge and hands the writers back.
+/// refuse a shard with groups left; `stop` (set when the rest of the merge `out` ended)
+/// ends the copy early with an error. Runs beside the rest of the merge and hands the
+/// writers back.
 fn copy_groups(
     plan: &[(String, usize, usize)],
     libs: &[ShardLib],
     mut groups: Vec<Vec<GroupCursor>>,
     mut writers: Vec<(&'static str, TableWriter)>,
     stop: &AtomicBool,
+    out: &Path,
 ) -> Result<Vec<(&'static str, TableWriter)>> {
     for (clip, _, k) in plan {
         if stop.load(Ordering::Relaxed) {
-            return Ok(writers);
+            return Err(side_ended(out, "the row group copy was stopped"));
         }
         for g in groups[*k].iter_mut() {
             let w = writers
@@ -404,20 +429,44 @@ pub fn merge_into(
             })
             .collect::<Result<Vec<_>>>()?;
         let writers = sink.detach(&per_clip);
-        let stop = AtomicBool::new(false);
+        let signals = Signals::default();
         std::thread::scope(|scope| {
-            let copier = scope.spawn(|| copy_groups(&plan, &libs, groups, writers, &stop));
-            let rejoin = || {
-                copier
-                    .join()
-                    .unwrap_or_else(|_| Err(bad(tmp, "the row group copy stopped unexpectedly")))
+            let copier = scope.spawn(|| {
+                let copied = copy_groups(&plan, &libs, groups, writers, &signals.stop, out);
+                if copied.is_err() && !signals.stop.load(Ordering::Relaxed) {
+                    signals.failed.store(true, Ordering::Relaxed);
+                }
+                copied
+            });
+            // Joined by whichever comes first: the finish (to write the footers) or the
+            // end of this scope (after a failure), never left to the scope's own join.
+            let copier = std::sync::Mutex::new(Some(copier));
+            let join = || {
+                copier.lock().ok().and_then(|mut h| h.take()).map(|h| {
+                    h.join()
+                        .unwrap_or_else(|_| Err(side_ended(out, "the row group copy panicked")))
+                })
             };
-            let merged = merge_rows(&mut sink, &libs, &plan, &names, joints, &mut summary)
-                .and_then(|()| sink.finish_with(&fingerprint, t0, None, layout, rejoin));
-            if merged.is_err() {
-                stop.store(true, Ordering::Relaxed);
+            let ended = SetOnDrop(&signals.stop);
+            let merged = merge_rows(
+                &mut sink,
+                &libs,
+                &plan,
+                &names,
+                joints,
+                &mut summary,
+                &signals.failed,
+            )
+            .and_then(|()| {
+                sink.finish_with(&fingerprint, t0, None, layout, || {
+                    join().unwrap_or_else(|| Err(side_ended(out, "the row group copy is gone")))
+                })
+            });
+            drop(ended);
+            match (merged, join()) {
+                (Err(_), Some(Err(copy))) if signals.failed.load(Ordering::Relaxed) => Err(copy),
+                (merged, _) => merged,
             }
-            merged
         })
     })?;
     Ok(summary)
@@ -433,6 +482,7 @@ fn merge_rows(
     names: &[&'static str],
     joints: bool,
     summary: &mut MergeSummary,
+    copy_failed: &AtomicBool,
 ) -> Result<()> {
     // Per shard: a row cursor per table, none for a per-clip table.
     let mut cursors: Vec<Vec<Option<ClipCursor>>> = Vec::new();
@@ -451,6 +501,14 @@ fn merge_rows(
     }
     let mut start = 0;
     while start < plan.len() {
+        if copy_failed.load(Ordering::Relaxed) {
+            // The copy's own error is the merge's (`merge_into`).
+            return Err(Error::io(
+                "merge",
+                "cannot merge",
+                std::io::Error::other("the row group copy failed"),
+            ));
+        }
         // A batch: clips until about one row group of frames.
         let (mut end, mut frames) = (start, 0);
         while end < plan.len() && (end == start || frames < ROW_GROUP_ROWS) {

@@ -317,15 +317,16 @@ impl LibrarySink {
     }
 
     /// [`LibrarySink::finish`] for a sink with detached writers ([`LibrarySink::detach`]):
-    /// `rejoin` hands them back, filled, once the polytopes are written (the longest part
-    /// of the finish, which thus overlaps whatever fills them).
+    /// `rejoin` hands them back, filled. It is called on a thread of its own as the finish
+    /// starts, and the writers get their footers there, so whatever fills them (and their
+    /// footers) overlaps the polytopes, the longest part of the finish.
     pub fn finish_with(
         mut self,
         fingerprint: &str,
         t0: Instant,
         shard: Option<serde_json::Value>,
         layout: Layout,
-        rejoin: impl FnOnce() -> Result<Vec<(&'static str, TableWriter)>>,
+        rejoin: impl FnOnce() -> Result<Vec<(&'static str, TableWriter)>> + Send,
     ) -> Result<()> {
         let dir = self.dir.clone();
         let mut errors = concat(
@@ -342,19 +343,25 @@ impl LibrarySink {
             (INPUTS_KEY.into(), json(&self.inputs)),
             (LIMITS_KEY.into(), json(&lim)),
         ];
-        for (_, w) in std::mem::take(&mut self.writers) {
-            w.finish(&kv)?;
-            super::memory::release_free_memory();
-        }
-        write_atomic(&dir, ERRORS_FILE, &mut errors, &kv)?;
-        self.samples.seal()?;
-        if self.keep_samples {
-            write_samples(&self.samples, &dir, &kv)?;
-        }
-        kinematics(&self.samples, &self.legs, &dir, &kv)?;
-        for (_, w) in rejoin()? {
-            w.finish(&kv)?;
-        }
+        // The detached writers are handed back and get their footers on a thread of their
+        // own, beside the rest (in a build there are none).
+        std::thread::scope(|scope| {
+            let detached = scope.spawn(|| -> Result<()> {
+                for (_, w) in rejoin()? {
+                    w.finish(&kv)?;
+                }
+                Ok(())
+            });
+            let ours = self.finish_tables(&mut errors, &kv);
+            let theirs = detached.join().unwrap_or_else(|_| {
+                Err(Error::io(
+                    &dir,
+                    "cannot finish the tables",
+                    std::io::Error::other("the thread of the detached tables stopped"),
+                ))
+            });
+            ours.and(theirs)
+        })?;
         if layout == Layout::Dataset {
             convert_to_dataset(&dir)?;
         }
@@ -386,6 +393,21 @@ impl LibrarySink {
         }
         let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
         crate::library::atomic::write_text_atomic(&dir.join(MANIFEST_FILE), &text)
+    }
+
+    /// The footers of the sink's own tables, `errors.parquet`, the samples (a shard's) and
+    /// the kinematic tables, each with the key-value pairs `kv`.
+    fn finish_tables(&mut self, errors: &mut DataFrame, kv: &[(String, String)]) -> Result<()> {
+        for (_, w) in std::mem::take(&mut self.writers) {
+            w.finish(kv)?;
+            super::memory::release_free_memory();
+        }
+        write_atomic(&self.dir, ERRORS_FILE, errors, kv)?;
+        self.samples.seal()?;
+        if self.keep_samples {
+            write_samples(&self.samples, &self.dir, kv)?;
+        }
+        kinematics(&self.samples, &self.legs, &self.dir, kv)
     }
 }
 
