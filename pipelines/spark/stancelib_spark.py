@@ -152,11 +152,20 @@ def main(argv):
         sys.stderr.write("nothing merged; %s is unchanged\n" % out)
         return 2
     shards = [os.path.join(work, "shard-%d" % i) for i in range(1, count + 1)]
-    # The merge needs no Spark: it runs while the JVM shuts down (about a second).
-    merge = subprocess.Popen([resolve_binary(args.stancelib), "merge", *shards, "--out", out])
-    spark.stop()
-    t_stopped = time.monotonic()
-    code = merge.wait()
+    # The merge needs no Spark: it runs while the JVM shuts down (about a second), and is
+    # waited for whatever the stop does.
+    cmd = [resolve_binary(args.stancelib), "merge", *shards, "--out", out]
+    try:
+        merge = subprocess.Popen(cmd)
+    except OSError as e:
+        spark.stop()
+        sys.stderr.write("%s: %s\nnothing merged; %s is unchanged\n" % (cmd[0], e, out))
+        return 2
+    try:
+        spark.stop()
+    finally:
+        t_stopped = time.monotonic()
+        code = merge.wait()
     t_end = time.monotonic()
     report_phases([("Spark start", t_session - t0), ("shards", t_shards - t_session),
                    ("merge", t_end - t_shards)], count, master)
