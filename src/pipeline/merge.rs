@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use super::build::replace_library;
 use super::output::{claim, is_library, OutputRules};
-use super::sink::{sorted, ClipCursor, LibrarySink, Tables};
+use super::sink::{sorted, ClipCursor, Defer, LibrarySink, Tables};
 use crate::error::{Error, Result};
 use crate::library::layout::{locate, table_exists, Layout};
 use crate::library::read::read_parquet;
@@ -307,15 +307,6 @@ struct Signals {
     failed: AtomicBool,
 }
 
-/// Sets its flag when dropped: when the rows' side of a merge returns or panics.
-struct SetOnDrop<'a>(&'a AtomicBool);
-
-impl Drop for SetOnDrop<'_> {
-    fn drop(&mut self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
-}
-
 /// The error of a merge side that ended without a result of its own (`out`: the library).
 fn side_ended(out: &Path, why: &str) -> Error {
     Error::io(out, "cannot merge", std::io::Error::other(why.to_string()))
@@ -432,9 +423,10 @@ pub fn merge_into(
         let signals = Signals::default();
         std::thread::scope(|scope| {
             let copier = scope.spawn(|| {
+                let mut failed = Defer::new(|| signals.failed.store(true, Ordering::Relaxed));
                 let copied = copy_groups(&plan, &libs, groups, writers, &signals.stop, out);
-                if copied.is_err() && !signals.stop.load(Ordering::Relaxed) {
-                    signals.failed.store(true, Ordering::Relaxed);
+                if copied.is_ok() || signals.stop.load(Ordering::Relaxed) {
+                    failed.disarm();
                 }
                 copied
             });
@@ -447,7 +439,9 @@ pub fn merge_into(
                         .unwrap_or_else(|_| Err(side_ended(out, "the row group copy panicked")))
                 })
             };
-            let ended = SetOnDrop(&signals.stop);
+            // When this side ends, however it ends, the copy stops (if still going).
+            let ended = Defer::new(|| signals.stop.store(true, Ordering::Relaxed));
+            let stop = || signals.stop.store(true, Ordering::Relaxed);
             let merged = merge_rows(
                 &mut sink,
                 &libs,
@@ -458,9 +452,14 @@ pub fn merge_into(
                 &signals.failed,
             )
             .and_then(|()| {
-                sink.finish_with(&fingerprint, t0, None, layout, || {
-                    join().unwrap_or_else(|| Err(side_ended(out, "the row group copy is gone")))
-                })
+                sink.finish_with(
+                    &fingerprint,
+                    t0,
+                    None,
+                    layout,
+                    || join().unwrap_or_else(|| Err(side_ended(out, "the row group copy is gone"))),
+                    &stop,
+                )
             });
             drop(ended);
             match (merged, join()) {
@@ -470,6 +469,19 @@ pub fn merge_into(
         })
     })?;
     Ok(summary)
+}
+
+/// An error once the row group copy has failed (its own error is then the merge's,
+/// `merge_into`), so the rows' side ends early.
+fn check_copy(copy_failed: &AtomicBool) -> Result<()> {
+    if copy_failed.load(Ordering::Relaxed) {
+        return Err(Error::io(
+            "merge",
+            "cannot merge",
+            std::io::Error::other("the row group copy failed"),
+        ));
+    }
+    Ok(())
 }
 
 /// The samples, the errors and the tables of a few rows a clip (every table but the
@@ -487,6 +499,7 @@ fn merge_rows(
     // Per shard: a row cursor per table, none for a per-clip table.
     let mut cursors: Vec<Vec<Option<ClipCursor>>> = Vec::new();
     for lib in libs {
+        check_copy(copy_failed)?;
         sink.push_errors(read_parquet(&lib.dir.join(ERRORS_FILE))?);
         push_samples(sink, &lib.dir)?;
         cursors.push(
@@ -501,14 +514,7 @@ fn merge_rows(
     }
     let mut start = 0;
     while start < plan.len() {
-        if copy_failed.load(Ordering::Relaxed) {
-            // The copy's own error is the merge's (`merge_into`).
-            return Err(Error::io(
-                "merge",
-                "cannot merge",
-                std::io::Error::other("the row group copy failed"),
-            ));
-        }
+        check_copy(copy_failed)?;
         // A batch: clips until about one row group of frames.
         let (mut end, mut frames) = (start, 0);
         while end < plan.len() && (end == start || frames < ROW_GROUP_ROWS) {
@@ -544,4 +550,30 @@ fn merge_rows(
         start = end;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stopped_copy_ends_with_an_error_naming_the_library() {
+        let stop = AtomicBool::new(true);
+        let plan = vec![("clip".to_string(), 10, 0)];
+        let out = Path::new("/some/library");
+        let e = copy_groups(&plan, &[], Vec::new(), Vec::new(), &stop, out).unwrap_err();
+        assert!(e.to_string().contains("/some/library"), "{e}");
+        assert!(format!("{e:?}").contains("copy was stopped"), "{e:?}");
+        // Not stopped, with nothing to copy: the writers come back.
+        stop.store(false, Ordering::Relaxed);
+        assert!(copy_groups(&[], &[], Vec::new(), Vec::new(), &stop, out).is_ok());
+    }
+
+    #[test]
+    fn a_failed_copy_ends_the_rows_side() {
+        let failed = AtomicBool::new(false);
+        assert!(check_copy(&failed).is_ok());
+        failed.store(true, Ordering::Relaxed);
+        assert!(check_copy(&failed).is_err());
+    }
 }

@@ -168,6 +168,28 @@ fn stance_facts(s: &DataFrame) -> Vec<StanceFacts> {
         .collect()
 }
 
+/// Calls its function when dropped, unless disarmed: on an early return or a panic.
+pub(crate) struct Defer<F: FnOnce()>(Option<F>);
+
+impl<F: FnOnce()> Defer<F> {
+    pub fn new(f: F) -> Defer<F> {
+        Defer(Some(f))
+    }
+
+    /// The function is not called.
+    pub fn disarm(&mut self) {
+        self.0 = None;
+    }
+}
+
+impl<F: FnOnce()> Drop for Defer<F> {
+    fn drop(&mut self) {
+        if let Some(f) = self.0.take() {
+            f();
+        }
+    }
+}
+
 /// A library being written into a temporary folder (see the module docs).
 pub(crate) struct LibrarySink {
     dir: PathBuf,
@@ -313,13 +335,15 @@ impl LibrarySink {
         shard: Option<serde_json::Value>,
         layout: Layout,
     ) -> Result<()> {
-        self.finish_with(fingerprint, t0, shard, layout, || Ok(Vec::new()))
+        self.finish_with(fingerprint, t0, shard, layout, || Ok(Vec::new()), &|| {})
     }
 
     /// [`LibrarySink::finish`] for a sink with detached writers ([`LibrarySink::detach`]):
     /// `rejoin` hands them back, filled. It is called on a thread of its own as the finish
     /// starts, and the writers get their footers there, so whatever fills them (and their
-    /// footers) overlaps the polytopes, the longest part of the finish.
+    /// footers) overlaps the polytopes, the longest part of the finish. `cancel` is called
+    /// when the rest of the finish fails or panics, before `rejoin`'s thread is waited
+    /// for (to end whatever fills the writers early).
     pub fn finish_with(
         mut self,
         fingerprint: &str,
@@ -327,6 +351,7 @@ impl LibrarySink {
         shard: Option<serde_json::Value>,
         layout: Layout,
         rejoin: impl FnOnce() -> Result<Vec<(&'static str, TableWriter)>> + Send,
+        cancel: &(dyn Fn() + Sync),
     ) -> Result<()> {
         let dir = self.dir.clone();
         let mut errors = concat(
@@ -352,7 +377,12 @@ impl LibrarySink {
                 }
                 Ok(())
             });
+            let mut failed = Defer::new(cancel);
             let ours = self.finish_tables(&mut errors, &kv);
+            if ours.is_ok() {
+                failed.disarm();
+            }
+            drop(failed);
             let theirs = detached.join().unwrap_or_else(|_| {
                 Err(Error::io(
                     &dir,
