@@ -100,6 +100,14 @@ def shard_task(spec):
     return index, r.returncode, r.stderr[-MAX_ERROR_CHARS:]
 
 
+def stop_spark(spark):
+    """Stop Spark; a failure to stop is a warning (the exit code is the merge's)."""
+    try:
+        spark.stop()
+    except Exception as e:  # the JVM already gone, a gateway error: nothing left to do
+        sys.stderr.write("stancelib-spark: warning: stopping Spark failed: %s\n" % e)
+
+
 def report_phases(phases, count, master):
     """One line on stderr: where the wall time went (Spark start, shards, merge), s."""
     total = sum(t for _, t in phases)
@@ -146,7 +154,7 @@ def main(argv):
     # of the shard did not finish.
     failed = sorted((i, code, err) for i, code, err in results if code not in (0, 1))
     if failed:
-        spark.stop()
+        stop_spark(spark)
         for i, code, err in failed:
             sys.stderr.write("shard %d/%d failed (exit %d):\n%s\n" % (i, count, code, err))
         sys.stderr.write("nothing merged; %s is unchanged\n" % out)
@@ -158,11 +166,11 @@ def main(argv):
     try:
         merge = subprocess.Popen(cmd)
     except OSError as e:
-        spark.stop()
+        stop_spark(spark)
         sys.stderr.write("%s: %s\nnothing merged; %s is unchanged\n" % (cmd[0], e, out))
         return 2
     try:
-        spark.stop()
+        stop_spark(spark)
     finally:
         t_stopped = time.monotonic()
         code = merge.wait()
