@@ -375,17 +375,24 @@ fn merge_cli(shards: &[&Path], out: &Path) -> (i32, String) {
     (code, err)
 }
 
+/// The fixtures built as shards 1/2 and 2/2 (folders `a` and `b` of the returned
+/// temporary folder).
+fn two_fixture_shards() -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let inputs = fixture_inputs();
+    let d = tmp();
+    let (a, b) = (d.path().join("a"), d.path().join("b"));
+    build_cli(&inputs, &a, &["--shard", "1/2"]);
+    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    (d, a, b)
+}
+
 /// A shard whose frames hold a clip its clips table does not (here its last clip with
 /// frames, and those after it, are cut from `clips.parquet`) is refused, naming the shard,
 /// the table and the clip: the merge copies frames by row group and would otherwise drop
 /// the groups left after the shard's last listed clip.
 #[test]
 fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
-    let inputs = fixture_inputs();
-    let d = tmp();
-    let (a, b) = (d.path().join("a"), d.path().join("b"));
-    build_cli(&inputs, &a, &["--shard", "1/2"]);
-    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    let (d, a, b) = two_fixture_shards();
     let clips_path = b.join("clips.parquet");
     let mut clips = stancelib::library::read::read_parquet(&clips_path).unwrap();
     let (last, name) = clips_with_frames(&clips)
@@ -409,11 +416,7 @@ fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
 /// "stopped" one, and the library already at `--out` is kept as it was.
 #[test]
 fn a_failure_beside_the_row_group_copy_names_its_table_and_keeps_the_old_library() {
-    let inputs = fixture_inputs();
-    let d = tmp();
-    let (a, b) = (d.path().join("a"), d.path().join("b"));
-    build_cli(&inputs, &a, &["--shard", "1/2"]);
-    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    let (d, a, b) = two_fixture_shards();
     let out = d.path().join("merged");
     let (code, err) = merge_cli(&[&a, &b], &out);
     assert!(code <= 1, "{err}");
