@@ -190,7 +190,10 @@ pub const STREAM_CHUNK_POINTS: usize = 65_536;
 /// point is tested against the last running hull as it arrives and dropped at once when
 /// deeper than δ in it (safe by the same argument: `conv R ⊆ H`), so a chunk holds only
 /// the points near or outside the running hull, and a stream that revisits its own poses
-/// (a long recording, clips of one motion) rarely rebuilds the hull.
+/// (a long recording, clips of one motion) rarely rebuilds the hull. A point found deep
+/// by the bucket bounds alone leaves its depth's lower bound as an anchor: the next
+/// points within that bound less δ of it are deep too (depth is 1-Lipschitz), with no
+/// plane or bucket looked at.
 #[derive(Debug, Clone)]
 pub struct StreamedHull {
     kept: Vec<[f64; 3]>,
@@ -198,6 +201,9 @@ pub struct StreamedHull {
     chunk: usize,
     /// The planes of the running hull `conv R`, after the first reduction.
     index: Option<PlaneIndex>,
+    /// The last point found deep by the index's bounds alone, and that lower bound on
+    /// its depth (m).
+    anchor: Option<([f64; 3], f64)>,
 }
 
 impl Default for StreamedHull {
@@ -214,6 +220,7 @@ impl StreamedHull {
             pending: Vec::new(),
             chunk: chunk.max(1),
             index: None,
+            anchor: None,
         }
     }
 
@@ -223,8 +230,21 @@ impl StreamedHull {
         if !p.iter().all(|v| v.is_finite()) {
             return;
         }
-        if self.index.as_ref().is_some_and(|i| !i.near_a_plane(p)) {
-            return;
+        if let Some(index) = &self.index {
+            // Depth is 1-Lipschitz: depth(p) ≥ depth(a) − |p − a|, so a point close to the
+            // last deep one is deep too (consecutive frames are centimetres apart).
+            if let Some((a, floor)) = self.anchor {
+                if floor - norm(sub(p, a)) > KEEP_DEPTH_M + BOUND_SLACK_M {
+                    return;
+                }
+            }
+            if let Some(floor) = index.depth_floor(p) {
+                self.anchor = Some((p, floor));
+                return;
+            }
+            if !index.near_a_plane(p) {
+                return;
+            }
         }
         self.pending.push(p);
         if self.pending.len() >= self.chunk {
@@ -247,6 +267,7 @@ impl StreamedHull {
             Ok((verts, faces)) => PlaneIndex::new(&verts, &faces),
             Err(_) => None,
         };
+        self.anchor = None;
         let Some(index) = index else {
             self.kept = all;
             self.index = None;
@@ -335,6 +356,25 @@ impl PlaneIndex {
                 .iter()
                 .all(|(_, _, h_min, _)| *h_min > KEEP_DEPTH_M + BOUND_SLACK_M);
         solid.then_some(PlaneIndex { centroid, buckets })
+    }
+
+    /// A lower bound on the depth of `p` under every plane (m), when the buckets' bounds
+    /// alone show it deeper than δ (plus the slack): the least bucket bound; `None`
+    /// otherwise (then [`PlaneIndex::near_a_plane`] decides).
+    fn depth_floor(&self, p: [f64; 3]) -> Option<f64> {
+        let q = sub(p, self.centroid);
+        let q_norm = norm(q);
+        let mut floor = f64::INFINITY;
+        for (u, spread, h_min, _) in &self.buckets {
+            let bound = h_min - dot(*u, q) - spread * q_norm;
+            // A NaN bound (a degenerate bucket) proves nothing.
+            let deep = bound > KEEP_DEPTH_M + BOUND_SLACK_M;
+            if !deep {
+                return None;
+            }
+            floor = floor.min(bound);
+        }
+        Some(floor)
     }
 
     /// Some plane has `d − n·p ≤ KEEP_DEPTH_M`: `p` is within δ of the hull's surface or
