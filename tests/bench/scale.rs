@@ -17,17 +17,19 @@
 //! peak. Nothing is asserted: the figures are printed for the record.
 //!
 //! # Results
-//! 2026-12-06 (second session, a slower day for the same sandbox), `SCALE_ROUNDS=3`, after
-//! the merge's copy moved to a thread of its own beside the polytopes:
+//! 2026-12-06 (second session, a slower hour for the same sandbox), `SCALE_ROUNDS=3`, after
+//! the merge's copy moved to a thread of its own beside the polytopes and the streamed
+//! hull's early drop and anchors:
 //!
 //! ```text
 //! scale: 93 clips and a 25× replica, build --threads 2, 3 rounds (medians)
-//! set      wall   0.787 s  peak    63.6 MiB
-//! replica  wall  16.872 s  peak    79.8 MiB
-//! replica / set: peak 1.26× (target ≤ 1.3×, ≤ 1024 MiB), wall 0.86× of linear (target ≤ 1.10)
-//! merge of 8 shards  wall   2.754 s  peak   111.8 MiB: 16 % of the replica's build (target ≤ 10 %)
+//! set      wall   0.779 s  peak    63.1 MiB
+//! replica  wall  15.555 s  peak    78.9 MiB
+//! replica / set: peak 1.25× (target ≤ 1.3×, ≤ 1024 MiB), wall 0.80× of linear (target ≤ 1.10)
+//! merge of 8 shards  wall   2.500 s  peak   111.6 MiB: 16 % of the replica's build (target ≤ 10 %)
 //! ```
-//! `farm-bench` A/B against 70ad962 the same day (3 pairs): merge 2.61 against 4.59 s.
+//! `farm-bench` A/B against 70ad962 in the same hour (3 pairs): merge 2.52 against 4.66 s
+//! (0.53×). Before the anchors: 2.754 s, 16 % of a 16.872 s build.
 //!
 //! 2026-12-06 (later), same sandbox, `SCALE_ROUNDS=3`, after the per-clip row groups, the
 //! merge's copy of them and the parallel polytopes:
