@@ -403,10 +403,10 @@ pub fn merge_into(
     replace_library(out, |tmp| {
         let mut sink = LibrarySink::create(tmp, joints, false, false)?;
         let names: Vec<&'static str> = sink.template().named().iter().map(|(n, _)| *n).collect();
-        let per_clip: Vec<&'static str> = names
+        // (table, the column its row groups are cut by)
+        let per_clip: Vec<(&'static str, &'static str)> = names
             .iter()
-            .copied()
-            .filter(|n| group_column(n).is_some())
+            .filter_map(|n| group_column(n).map(|c| (*n, c)))
             .collect();
         // The per-clip tables' row groups are copied by group cursors on a thread of their
         // own, beside the samples, the other tables and the polytopes (`finish_with`).
@@ -415,11 +415,11 @@ pub fn merge_into(
             .map(|lib| {
                 per_clip
                     .iter()
-                    .map(|n| GroupCursor::open(&lib.dir, n, group_column(n).unwrap_or_default()))
+                    .map(|(n, c)| GroupCursor::open(&lib.dir, n, c))
                     .collect::<Result<Vec<_>>>()
             })
             .collect::<Result<Vec<_>>>()?;
-        let writers = sink.detach(&per_clip);
+        let writers = sink.detach(&per_clip.iter().map(|(n, _)| *n).collect::<Vec<_>>());
         let signals = Signals::default();
         std::thread::scope(|scope| {
             let copier = scope.spawn(|| {
@@ -440,8 +440,8 @@ pub fn merge_into(
                 })
             };
             // When this side ends, however it ends, the copy stops (if still going).
-            let ended = Defer::new(|| signals.stop.store(true, Ordering::Relaxed));
             let stop = || signals.stop.store(true, Ordering::Relaxed);
+            let ended = Defer::new(&stop);
             let merged = merge_rows(
                 &mut sink,
                 &libs,

@@ -191,9 +191,8 @@ pub const STREAM_CHUNK_POINTS: usize = 65_536;
 /// deeper than δ in it (safe by the same argument: `conv R ⊆ H`), so a chunk holds only
 /// the points near or outside the running hull, and a stream that revisits its own poses
 /// (a long recording, clips of one motion) rarely rebuilds the hull. A point found deep
-/// by the bucket bounds alone leaves its depth's lower bound as an anchor: the next
-/// points within that bound less δ of it are deep too (depth is 1-Lipschitz), with no
-/// plane or bucket looked at.
+/// leaves a lower bound on its depth as an anchor: the next points within that bound
+/// less δ of it are deep too (depth is 1-Lipschitz), with no plane or bucket looked at.
 #[derive(Debug, Clone)]
 pub struct StreamedHull {
     kept: Vec<[f64; 3]>,
@@ -201,8 +200,7 @@ pub struct StreamedHull {
     chunk: usize,
     /// The planes of the running hull `conv R`, after the first reduction.
     index: Option<PlaneIndex>,
-    /// The last point found deep by the index's bounds alone, and that lower bound on
-    /// its depth (m).
+    /// The last point found deeper than δ, and a lower bound on its depth (m).
     anchor: Option<([f64; 3], f64)>,
 }
 
@@ -240,9 +238,6 @@ impl StreamedHull {
             }
             if let Some(floor) = index.depth_floor(p) {
                 self.anchor = Some((p, floor));
-                return;
-            }
-            if !index.near_a_plane(p) {
                 return;
             }
         }
@@ -358,21 +353,28 @@ impl PlaneIndex {
         solid.then_some(PlaneIndex { centroid, buckets })
     }
 
-    /// A lower bound on the depth of `p` under every plane (m), when the buckets' bounds
-    /// alone show it deeper than δ (plus the slack): the least bucket bound; `None`
-    /// otherwise (then [`PlaneIndex::near_a_plane`] decides).
+    /// A lower bound on the depth of `p` under every plane (m) when it is deeper than δ
+    /// under all of them: the least of the skipped buckets' bounds and of the depths
+    /// under the planes looked at; `None` when some plane has `d − n·p ≤ KEEP_DEPTH_M`
+    /// (`p` within δ of the hull's surface or outside it).
     fn depth_floor(&self, p: [f64; 3]) -> Option<f64> {
         let q = sub(p, self.centroid);
         let q_norm = norm(q);
         let mut floor = f64::INFINITY;
-        for (u, spread, h_min, _) in &self.buckets {
+        for (u, spread, h_min, planes) in &self.buckets {
             let bound = h_min - dot(*u, q) - spread * q_norm;
-            // A NaN bound (a degenerate bucket) proves nothing.
-            let deep = bound > KEEP_DEPTH_M + BOUND_SLACK_M;
-            if !deep {
-                return None;
+            // A NaN bound (a degenerate bucket) is never skipped.
+            if bound > KEEP_DEPTH_M + BOUND_SLACK_M {
+                floor = floor.min(bound);
+                continue;
             }
-            floor = floor.min(bound);
+            for (n, d) in planes {
+                let depth = d - dot(*n, p);
+                if depth <= KEEP_DEPTH_M {
+                    return None;
+                }
+                floor = floor.min(depth);
+            }
         }
         Some(floor)
     }
@@ -380,14 +382,7 @@ impl PlaneIndex {
     /// Some plane has `d − n·p ≤ KEEP_DEPTH_M`: `p` is within δ of the hull's surface or
     /// outside it.
     fn near_a_plane(&self, p: [f64; 3]) -> bool {
-        let q = sub(p, self.centroid);
-        let q_norm = norm(q);
-        self.buckets.iter().any(|(u, spread, h_min, planes)| {
-            let bound = h_min - dot(*u, q) - spread * q_norm;
-            // A NaN bound (a degenerate bucket) is never skipped.
-            let skip = bound > KEEP_DEPTH_M + BOUND_SLACK_M;
-            !skip && planes.iter().any(|(n, d)| d - dot(*n, p) <= KEEP_DEPTH_M)
-        })
+        self.depth_floor(p).is_none()
     }
 }
 
