@@ -165,14 +165,22 @@ fn ingest_counted(
 ) -> Vec<ClipRecord> {
     let mut recs: Vec<ClipRecord> = files
         .par_iter()
-        .map(|(p, n)| {
-            let r = ingest_file(p, n.clone(), opts);
-            bar.inc(1);
-            r
-        })
+        .map(|(p, n)| ingest_counted_one(p, n, opts, bar))
         .collect();
     recs.sort_by(|a, b| a.clip.cmp(&b.clip));
     recs
+}
+
+/// [`ingest_file`], counting the clip on `bar`.
+fn ingest_counted_one(
+    path: &Path,
+    clip: &str,
+    opts: &IngestOptions,
+    bar: &ProgressBar,
+) -> ClipRecord {
+    let r = ingest_file(path, clip.to_string(), opts);
+    bar.inc(1);
+    r
 }
 
 /// SHA-256 of an input's bytes, hex (`None` when it is not a readable regular file of at
@@ -306,8 +314,8 @@ pub fn default_batch_bounds() -> (usize, u64) {
 }
 
 /// Ingest in batches of clips in name order, writing batch i (table assembly and Parquet
-/// encoding) while batch i + 1 is ingested; a batch's frames are freed once written, so
-/// memory depends on the batch, not on the number of clips. The tables are those of one
+/// encoding) while batch i + 1 is ingested ([`super::ordered`]); a batch's frames are
+/// freed once written, so memory depends on the batch, not on the number of clips. The tables are those of one
 /// batch of every clip, byte for byte ([`FramesWriter`]); batches are as a build's
 /// ([`default_batch_bounds`]). Records come back without their
 /// frames, contact runs and summaries (those are in the tables).
@@ -318,24 +326,17 @@ fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<
     let bar = progress(files.len(), "clips ingested");
     let mut w = FramesWriter::create(out, opts.joints)?;
     let mut records: Vec<ClipStatus> = Vec::with_capacity(files.len());
-    let mut write = |recs: Vec<ClipRecord>| -> Result<()> {
-        w.push(&recs)?;
-        records.extend(recs.into_iter().map(ClipRecord::written));
-        super::memory::release_free_memory();
-        Ok(())
-    };
-    let mut pending: Option<Vec<ClipRecord>> = None;
-    for chunk in file_batches(&named, max_clips, max_bytes) {
-        let (written, recs) = rayon::join(
-            || pending.take().map_or(Ok(()), &mut write),
-            || ingest_counted(chunk, opts, &bar),
-        );
-        written?;
-        pending = Some(recs);
-    }
-    if let Some(recs) = pending {
-        write(recs)?;
-    }
+    super::ordered::in_order(
+        &file_batches(&named, max_clips, max_bytes),
+        |chunk| chunk,
+        |(p, n)| ingest_counted_one(p, n, opts, &bar),
+        |_, recs| {
+            w.push(&recs)?;
+            records.extend(recs.into_iter().map(ClipRecord::written));
+            super::memory::release_free_memory();
+            Ok(())
+        },
+    )?;
     bar.finish_and_clear();
     w.finish()?;
     Ok(records)

@@ -160,29 +160,50 @@ impl Progress {
     }
 }
 
+/// One batch of a streaming build: the (file, clip) pairs to build, and the batch's last
+/// clip, reused or not (the previous library's rows are taken through it).
+struct BuildBatch<'a> {
+    todo: Vec<&'a (PathBuf, String)>,
+    last: Option<&'a String>,
+}
+
 /// What the stance stage made of one clip: its stances and notes.
 type ClipStances = (Vec<Stance>, Vec<StanceNote>);
 
 fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions, bar: &Progress) -> BuildReport {
-    let mut per_clip: Vec<(ClipRecord, ClipStances)> = named
+    let per_clip: Vec<(ClipRecord, ClipStances)> = named
         .par_iter()
-        .map(|(path, clip)| {
-            let r = ingest_file(path, clip.clone(), &opts.ingest);
-            let out = match (&r.frames, r.status) {
-                (Some(fr), Status::Ok) => build_clip(
-                    &r.clip,
-                    fr,
-                    &r.summary,
-                    &r.contacts,
-                    r.mass_kg,
-                    &opts.stances,
-                ),
-                _ => (Vec::new(), Vec::new()),
-            };
-            bar.done(1, r.frames.as_ref().map_or(0, |f| f.frame.len() as u64));
-            (r, out)
-        })
+        .map(|(path, clip)| build_one(path, clip, opts, bar))
         .collect();
+    assemble(per_clip)
+}
+
+/// One clip ingested and its stances built, counted on `bar`.
+fn build_one(
+    path: &Path,
+    clip: &str,
+    opts: &BuildOptions,
+    bar: &Progress,
+) -> (ClipRecord, ClipStances) {
+    let r = ingest_file(path, clip.to_string(), &opts.ingest);
+    let out = match (&r.frames, r.status) {
+        (Some(fr), Status::Ok) => build_clip(
+            &r.clip,
+            fr,
+            &r.summary,
+            &r.contacts,
+            r.mass_kg,
+            &opts.stances,
+        ),
+        _ => (Vec::new(), Vec::new()),
+    };
+    bar.done(1, r.frames.as_ref().map_or(0, |f| f.frame.len() as u64));
+    (r, out)
+}
+
+/// The report of a batch of built clips: records in clip order, their error rows (failed
+/// inputs, ingests and stance fits) and their stances sorted by (clip, first frame, label).
+fn assemble(mut per_clip: Vec<(ClipRecord, ClipStances)>) -> BuildReport {
     per_clip.sort_by(|a, b| a.0.clip.cmp(&b.0.clip));
     let (mut records, per_clip): (Vec<ClipRecord>, Vec<ClipStances>) = per_clip.into_iter().unzip();
     let mut errors: Vec<ErrorRow> = records
@@ -401,8 +422,9 @@ pub fn build_into(
             sink.push_errors(previous_errors(out, &reuse)?);
             Some(Previous::open(out, sink.template())?)
         };
-        // Batch i is written while batch i + 1 is built (two batches in memory at most):
-        // the writing is mostly one thread's work, and the other workers build meanwhile.
+        // Batch i is written while batch i + 1 is built (two batches in memory at most,
+        // `ordered`): the writing is mostly one thread's work, and the other workers build
+        // meanwhile.
         let mut write = |report: BuildReport, last: Option<&String>| -> Result<()> {
             let mut t = Tables::from_report(&report, joints)?;
             // The frames are in the tables now: free them before the tables are encoded.
@@ -418,23 +440,19 @@ pub fn build_into(
             super::memory::release_free_memory();
             Ok(())
         };
-        let mut pending: Option<(BuildReport, Option<&String>)> = None;
-        for chunk in super::batch::file_batches(&named, max_clips, max_bytes) {
-            let todo: Vec<(PathBuf, String)> = chunk
-                .iter()
-                .filter(|(_, c)| !reuse.contains(c))
-                .cloned()
-                .collect();
-            let (written, report) = rayon::join(
-                || pending.take().map_or(Ok(()), |(r, last)| write(r, last)),
-                || build_named(&todo, opts, &bar),
-            );
-            written?;
-            pending = Some((report, chunk.last().map(|(_, c)| c)));
-        }
-        if let Some((r, last)) = pending {
-            write(r, last)?;
-        }
+        let batches: Vec<BuildBatch> = super::batch::file_batches(&named, max_clips, max_bytes)
+            .into_iter()
+            .map(|chunk| BuildBatch {
+                todo: chunk.iter().filter(|(_, c)| !reuse.contains(c)).collect(),
+                last: chunk.last().map(|(_, c)| c),
+            })
+            .collect();
+        super::ordered::in_order(
+            &batches,
+            |b| &b.todo,
+            |(path, clip)| build_one(path, clip, opts, &bar),
+            |b, per_clip| write(assemble(per_clip), b.last),
+        )?;
         bar.bar.finish_and_clear();
         sink.finish(&fingerprint, t0, shard_entry.clone(), plan.layout)
     })?;

@@ -13,6 +13,7 @@ pub mod job;
 pub mod memory;
 pub mod merge;
 pub mod names;
+pub mod ordered;
 pub mod output;
 pub mod plots;
 pub mod queries;
