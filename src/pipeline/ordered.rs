@@ -13,9 +13,9 @@
 //! run, `perf` timeline, 2026-12-06). The batches, their order and the results are the
 //! same, so the outputs are too.
 //!
-//! A panic in a task is carried to the caller after the other tasks end; an error from
-//! `write` is returned once the tasks already spawned have ended (those not yet started
-//! skip their work).
+//! A panic in a task or in `write` is carried to the caller after the other tasks end,
+//! even when `write` has failed meanwhile; an error from `write` is returned once the
+//! tasks already spawned have ended (those not yet started skip their work).
 
 use std::collections::VecDeque;
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
@@ -43,25 +43,28 @@ struct Slots<R> {
 
 /// Run `work` on every item of every batch on the current rayon pool and call `write` with
 /// each batch and its results, in item order, batch after batch. `write` runs on the
-/// calling thread; while it waits for a batch, that thread runs the pool's pending tasks.
+/// calling thread; while it waits for a batch, that thread runs the pool's pending tasks
+/// (called outside a pool, the tasks go to the global pool and the caller only waits).
 ///
 /// # Errors
 /// The first error of `write`; the batches after it are not written.
+///
+/// # Panics
+/// When `work` or `write` panics, with its payload, once the spawned tasks have ended.
 pub fn in_order<B, T, R>(
     batches: &[B],
-    items: impl Fn(&B) -> &[T] + Sync,
+    items: impl Fn(&B) -> &[T],
     work: impl Fn(&T) -> R + Sync,
     mut write: impl FnMut(&B, Vec<R>) -> Result<()>,
 ) -> Result<()>
 where
-    B: Sync,
     T: Sync,
     R: Send,
 {
     let stop = AtomicBool::new(false);
     let (tx, rx) = channel::<Done<R>>();
     let (items, work, stop_ref) = (&items, &work, &stop);
-    rayon::in_place_scope_fifo(|scope| {
+    let outcome = rayon::in_place_scope_fifo(|scope| {
         // However this ends (an error, a panic here or in a task), the tasks not yet
         // started skip their work.
         let _stop = StopOnDrop(stop_ref);
@@ -70,6 +73,8 @@ where
             for (k, item) in list.iter().enumerate() {
                 let tx = tx.clone();
                 scope.spawn_fifo(move |_| {
+                    // Every task must send, panic or not: the wait below counts on it (a
+                    // sender stays alive, so a missing message would not end the wait).
                     let r = catch_unwind(AssertUnwindSafe(|| {
                         (!stop_ref.load(Ordering::Relaxed)).then(|| work(item))
                     }));
@@ -92,13 +97,27 @@ where
             }
             let done = open.pop_front().map(|s| s.results).unwrap_or_default();
             // `stop` is set only when this returns, so every task of the batch ran its work.
-            write(&batches[b], done.into_iter().flatten().collect())?;
+            let done: Option<Vec<R>> = done.into_iter().collect();
+            write(&batches[b], done.ok_or_else(skipped)?)?;
             if b + AHEAD + 1 < batches.len() {
                 open.push_back(spawn(b + AHEAD + 1));
             }
         }
         Ok(())
-    })
+    });
+    // A task of the next batch may have panicked while `write` failed: the panic wins, as
+    // it would have had the batch been joined.
+    if outcome.is_err() {
+        if let Some(panic) = rx.try_iter().find_map(|(_, _, r)| r.err()) {
+            resume_unwind(panic);
+        }
+    }
+    outcome
+}
+
+/// The error of a batch handed over with a result missing (a task skipped its work).
+fn skipped() -> Error {
+    Error::invalid("worker pool", "a batch's task ended without its result")
 }
 
 /// Sets the flag when dropped.
@@ -125,12 +144,7 @@ fn next_done<R>(rx: &Receiver<Done<R>>) -> Result<Done<R>> {
         match rx.recv_timeout(IDLE_WAIT) {
             Ok(d) => return Ok(d),
             Err(RecvTimeoutError::Timeout) => {}
-            Err(RecvTimeoutError::Disconnected) => {
-                return Err(Error::invalid(
-                    "worker pool",
-                    "a batch's tasks ended without their results",
-                ))
-            }
+            Err(RecvTimeoutError::Disconnected) => return Err(skipped()),
         }
     }
 }
@@ -140,6 +154,7 @@ mod tests {
     use super::in_order;
     use crate::error::Error;
     use proptest::prelude::*;
+    use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
     fn pool(threads: usize) -> rayon::ThreadPool {
@@ -206,12 +221,13 @@ mod tests {
         }
     }
 
-    #[test]
-    fn an_error_from_write_stops_the_batches_after_it() {
+    /// Batches 0..10 of four items; `write` fails on the third batch. The number of items
+    /// whose work ran, and the error.
+    fn fail_third_write(threads: usize) -> (usize, Error) {
         let batches: Vec<Vec<u64>> = (0..10).map(|b| (b * 4..b * 4 + 4).collect()).collect();
         let started = AtomicUsize::new(0);
         let mut written = 0;
-        let r = pool(2).install(|| {
+        let r = pool(threads).install(|| {
             in_order(
                 &batches,
                 |b| b.as_slice(),
@@ -228,11 +244,116 @@ mod tests {
                 },
             )
         });
-        let e = r.expect_err("the write's error comes back");
+        assert_eq!(written, 3, "no batch is written after the failure");
+        (
+            started.load(Ordering::SeqCst),
+            r.expect_err("the write's error comes back"),
+        )
+    }
+
+    #[test]
+    fn an_error_from_write_stops_the_batches_after_it() {
+        // One thread runs the tasks in order: batches 0..=2 ran, batch 3 was spawned but
+        // skipped its work, nothing after it was spawned.
+        let (started, e) = fail_third_write(1);
         assert!(e.to_string().contains("disk full"), "{e}");
-        assert_eq!(written, 3);
-        // Batches 0..=3 were spawned when batch 2 failed; nothing after them ran.
-        assert!(started.load(Ordering::SeqCst) <= 16);
+        assert_eq!(started, 12);
+        // More threads may start batch 3 before the failure, never batch 4.
+        for threads in [2, 3] {
+            let (started, e) = fail_third_write(threads);
+            assert!(e.to_string().contains("disk full"), "{e}");
+            assert!(started <= 16, "{started} items started");
+        }
+    }
+
+    #[test]
+    fn nested_parallel_work_and_writes_give_the_same_results() {
+        let batches: Vec<Vec<u64>> = (0..7).map(|b| (b * 5..b * 5 + 5).collect()).collect();
+        for threads in 1..=4 {
+            let mut sums = Vec::new();
+            pool(threads)
+                .install(|| {
+                    in_order(
+                        &batches,
+                        |b| b.as_slice(),
+                        // Parallel work inside a task, as an ingest's own rayon calls.
+                        |x| (0..*x * 50).into_par_iter().map(|i| i % 7).sum::<u64>(),
+                        // And inside the write, as the tables' parallel encoding.
+                        |_, r| {
+                            let (a, b) = rayon::join(|| r.iter().sum::<u64>(), || r.len());
+                            sums.push((a, b));
+                            Ok(())
+                        },
+                    )
+                })
+                .expect("no error");
+            let expected: Vec<(u64, usize)> = batches
+                .iter()
+                .map(|b| {
+                    let s = b.iter().map(|x| (0..x * 50).map(|i| i % 7).sum::<u64>());
+                    (s.sum(), b.len())
+                })
+                .collect();
+            assert_eq!(sums, expected, "{threads} threads");
+        }
+    }
+
+    /// The text of a panic's payload.
+    fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn a_panic_in_write_or_beside_a_failed_write_reaches_the_caller() {
+        let batches: Vec<Vec<u64>> = (0..6).map(|b| (b * 3..b * 3 + 3).collect()).collect();
+        for threads in [1, 2, 3] {
+            // A panic in the write itself.
+            let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                pool(threads).install(|| {
+                    in_order(
+                        &batches,
+                        |b| b.as_slice(),
+                        slow_square,
+                        |b, _| {
+                            assert!(b[0] != 6, "write of batch 2 fails");
+                            Ok(())
+                        },
+                    )
+                })
+            }));
+            let payload = caught.expect_err("the write's panic reaches the caller");
+            assert!(
+                panic_text(&*payload).contains("batch 2"),
+                "{threads} threads"
+            );
+            // A task of batch 1 panics while the write of batch 0 fails: the panic wins.
+            let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                pool(threads).install(|| {
+                    in_order(
+                        &batches,
+                        |b| b.as_slice(),
+                        |x| {
+                            assert!(*x != 4, "item 4 fails");
+                            *x
+                        },
+                        |_, _| {
+                            // Let batch 1 run before failing, whatever the thread count.
+                            while rayon::yield_now() == Some(rayon::Yield::Executed) {}
+                            Err(Error::invalid("table", "disk full"))
+                        },
+                    )
+                })
+            }));
+            let payload = caught.expect_err("the task's panic reaches the caller");
+            assert!(
+                panic_text(&*payload).contains("item 4"),
+                "{threads} threads"
+            );
+        }
     }
 
     #[test]
@@ -253,12 +374,10 @@ mod tests {
                 })
             }));
             let payload = caught.expect_err("the panic reaches the caller");
-            let text = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            assert!(text.contains("item 7 fails"), "{text}");
+            assert!(
+                panic_text(&*payload).contains("item 7 fails"),
+                "{threads} threads"
+            );
         }
     }
 }
