@@ -17,6 +17,18 @@
 //! peak. Nothing is asserted: the figures are printed for the record.
 //!
 //! # Results
+//! 2026-12-06 (third session), `SCALE_ROUNDS=3`, after batches are handed over without a
+//! barrier (`pipeline::ordered`):
+//!
+//! ```text
+//! scale: 93 clips and a 25× replica, build --threads 2, 3 rounds (medians)
+//! set      wall   0.687 s  peak    66.1 MiB
+//! replica  wall  14.833 s  peak    80.9 MiB
+//! replica / set: peak 1.22× (target ≤ 1.3×, ≤ 1024 MiB), wall 0.86× of linear (target ≤ 1.10)
+//! merge of 8 shards  wall   2.484 s  peak   112.4 MiB: 17 % of the replica's build (target ≤ 10 %)
+//! ```
+//! The merge is as before; the build is faster, so its share grew.
+//!
 //! 2026-12-06 (second session, a slower hour for the same sandbox), `SCALE_ROUNDS=3`, after
 //! the merge's copy moved to a thread of its own beside the polytopes and the streamed
 //! hull's early drop and anchors:
