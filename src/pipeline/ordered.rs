@@ -164,6 +164,24 @@ mod tests {
             .expect("a test pool")
     }
 
+    /// [`in_order`] over `batches` on a pool of `threads`.
+    fn run(
+        threads: usize,
+        batches: &[Vec<u64>],
+        work: impl Fn(&u64) -> u64 + Sync + Send,
+        write: impl FnMut(&Vec<u64>, Vec<u64>) -> crate::error::Result<()> + Send,
+    ) -> crate::error::Result<()> {
+        pool(threads).install(|| in_order(batches, |b| b.as_slice(), work, write))
+    }
+
+    /// [`slow_square`], counting the items it started on `started`.
+    fn counted(started: &AtomicUsize) -> impl Fn(&u64) -> u64 + Sync + Send + '_ {
+        move |x| {
+            started.fetch_add(1, Ordering::SeqCst);
+            slow_square(x)
+        }
+    }
+
     /// Work whose time varies with the item, so items finish out of order.
     fn slow_square(x: &u64) -> u64 {
         let mut acc = *x;
@@ -192,24 +210,14 @@ mod tests {
             let started = AtomicUsize::new(0);
             let mut written: Vec<Vec<u64>> = Vec::new();
             let mut most_ahead = Vec::new();
-            pool(threads).install(|| {
-                in_order(
-                    &batches,
-                    |b| b.as_slice(),
-                    |x| {
-                        started.fetch_add(1, Ordering::SeqCst);
-                        slow_square(x)
-                    },
-                    |_, results| {
-                        let through_next: usize =
-                            batches.iter().take(written.len() + 2).map(Vec::len).sum();
-                        most_ahead.push((started.load(Ordering::SeqCst), through_next));
-                        written.push(results);
-                        Ok(())
-                    },
-                )
-                .map_err(|e| TestCaseError::fail(e.to_string()))
-            })?;
+            run(threads, &batches, counted(&started), |_, results| {
+                let through_next: usize =
+                    batches.iter().take(written.len() + 2).map(Vec::len).sum();
+                most_ahead.push((started.load(Ordering::SeqCst), through_next));
+                written.push(results);
+                Ok(())
+            })
+            .map_err(|e| TestCaseError::fail(e.to_string()))?;
             let expected: Vec<Vec<u64>> = batches
                 .iter()
                 .map(|b| b.iter().map(|x| x * x).collect())
@@ -227,22 +235,12 @@ mod tests {
         let batches: Vec<Vec<u64>> = (0..10).map(|b| (b * 4..b * 4 + 4).collect()).collect();
         let started = AtomicUsize::new(0);
         let mut written = 0;
-        let r = pool(threads).install(|| {
-            in_order(
-                &batches,
-                |b| b.as_slice(),
-                |x| {
-                    started.fetch_add(1, Ordering::SeqCst);
-                    slow_square(x)
-                },
-                |_, _| {
-                    written += 1;
-                    if written == 3 {
-                        return Err(Error::invalid("table", "disk full"));
-                    }
-                    Ok(())
-                },
-            )
+        let r = run(threads, &batches, counted(&started), |_, _| {
+            written += 1;
+            if written == 3 {
+                return Err(Error::invalid("table", "disk full"));
+            }
+            Ok(())
         });
         assert_eq!(written, 3, "no batch is written after the failure");
         (
@@ -271,22 +269,19 @@ mod tests {
         let batches: Vec<Vec<u64>> = (0..7).map(|b| (b * 5..b * 5 + 5).collect()).collect();
         for threads in 1..=4 {
             let mut sums = Vec::new();
-            pool(threads)
-                .install(|| {
-                    in_order(
-                        &batches,
-                        |b| b.as_slice(),
-                        // Parallel work inside a task, as an ingest's own rayon calls.
-                        |x| (0..*x * 50).into_par_iter().map(|i| i % 7).sum::<u64>(),
-                        // And inside the write, as the tables' parallel encoding.
-                        |_, r| {
-                            let (a, b) = rayon::join(|| r.iter().sum::<u64>(), || r.len());
-                            sums.push((a, b));
-                            Ok(())
-                        },
-                    )
-                })
-                .expect("no error");
+            run(
+                threads,
+                &batches,
+                // Parallel work inside a task, as an ingest's own rayon calls.
+                |x| (0..*x * 50).into_par_iter().map(|i| i % 7).sum::<u64>(),
+                // And inside the write, as the tables' parallel encoding.
+                |_, r| {
+                    let (a, b) = rayon::join(|| r.iter().sum::<u64>(), || r.len());
+                    sums.push((a, b));
+                    Ok(())
+                },
+            )
+            .expect("no error");
             let expected: Vec<(u64, usize)> = batches
                 .iter()
                 .map(|b| {
@@ -298,8 +293,18 @@ mod tests {
         }
     }
 
-    /// The text of a panic's payload.
-    fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    /// The text of the panic that `in_order` over 6 batches of 3 items (0..18) on
+    /// `threads` threads ends with (the test fails if it returns).
+    fn panic_text(
+        threads: usize,
+        work: impl Fn(&u64) -> u64 + Sync + Send,
+        write: impl FnMut(&Vec<u64>, Vec<u64>) -> crate::error::Result<()> + Send,
+    ) -> String {
+        let batches: Vec<Vec<u64>> = (0..6).map(|b| (b * 3..b * 3 + 3).collect()).collect();
+        let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            run(threads, &batches, work, write)
+        }));
+        let payload = caught.expect_err("the panic reaches the caller");
         payload
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
@@ -308,76 +313,33 @@ mod tests {
     }
 
     #[test]
-    fn a_panic_in_write_or_beside_a_failed_write_reaches_the_caller() {
-        let batches: Vec<Vec<u64>> = (0..6).map(|b| (b * 3..b * 3 + 3).collect()).collect();
+    fn a_panic_in_a_task_or_a_write_reaches_the_caller_and_nothing_hangs() {
         for threads in [1, 2, 3] {
+            let item = |x: &u64| {
+                assert!(*x != 7, "item 7 fails");
+                slow_square(x)
+            };
+            let text = panic_text(threads, item, |_, _| Ok(()));
+            assert!(text.contains("item 7 fails"), "{threads} threads: {text}");
             // A panic in the write itself.
-            let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool(threads).install(|| {
-                    in_order(
-                        &batches,
-                        |b| b.as_slice(),
-                        slow_square,
-                        |b, _| {
-                            assert!(b[0] != 6, "write of batch 2 fails");
-                            Ok(())
-                        },
-                    )
-                })
-            }));
-            let payload = caught.expect_err("the write's panic reaches the caller");
-            assert!(
-                panic_text(&*payload).contains("batch 2"),
-                "{threads} threads"
-            );
+            let write = |b: &Vec<u64>, _| {
+                assert!(b[0] != 6, "write of batch 2 fails");
+                Ok(())
+            };
+            let text = panic_text(threads, slow_square, write);
+            assert!(text.contains("batch 2"), "{threads} threads: {text}");
             // A task of batch 1 panics while the write of batch 0 fails: the panic wins.
-            let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool(threads).install(|| {
-                    in_order(
-                        &batches,
-                        |b| b.as_slice(),
-                        |x| {
-                            assert!(*x != 4, "item 4 fails");
-                            *x
-                        },
-                        |_, _| {
-                            // Let batch 1 run before failing, whatever the thread count.
-                            while rayon::yield_now() == Some(rayon::Yield::Executed) {}
-                            Err(Error::invalid("table", "disk full"))
-                        },
-                    )
-                })
-            }));
-            let payload = caught.expect_err("the task's panic reaches the caller");
-            assert!(
-                panic_text(&*payload).contains("item 4"),
-                "{threads} threads"
-            );
-        }
-    }
-
-    #[test]
-    fn a_panicking_item_reaches_the_caller_and_nothing_hangs() {
-        let batches: Vec<Vec<u64>> = (0..6).map(|b| (b * 3..b * 3 + 3).collect()).collect();
-        for threads in [1, 2, 3] {
-            let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool(threads).install(|| {
-                    in_order(
-                        &batches,
-                        |b| b.as_slice(),
-                        |x| {
-                            assert!(*x != 7, "item 7 fails");
-                            slow_square(x)
-                        },
-                        |_, _| Ok(()),
-                    )
-                })
-            }));
-            let payload = caught.expect_err("the panic reaches the caller");
-            assert!(
-                panic_text(&*payload).contains("item 7 fails"),
-                "{threads} threads"
-            );
+            let item = |x: &u64| {
+                assert!(*x != 4, "item 4 fails");
+                *x
+            };
+            let write = |_: &Vec<u64>, _| {
+                // Let batch 1 run before failing, whatever the thread count.
+                while rayon::yield_now() == Some(rayon::Yield::Executed) {}
+                Err(Error::invalid("table", "disk full"))
+            };
+            let text = panic_text(threads, item, write);
+            assert!(text.contains("item 4"), "{threads} threads: {text}");
         }
     }
 }
