@@ -315,10 +315,10 @@ pub fn default_batch_bounds() -> (usize, u64) {
 
 /// Ingest in batches of clips in name order, writing batch i (table assembly and Parquet
 /// encoding) while batch i + 1 is ingested ([`super::ordered`]); a batch's frames are
-/// freed once written, so memory depends on the batch, not on the number of clips. The tables are those of one
-/// batch of every clip, byte for byte ([`FramesWriter`]); batches are as a build's
-/// ([`default_batch_bounds`]). Records come back without their
-/// frames, contact runs and summaries (those are in the tables).
+/// freed once written, so memory depends on the batch, not on the number of clips. The
+/// tables are those of one batch of every clip, byte for byte ([`FramesWriter`]); batches
+/// are as a build's ([`default_batch_bounds`]). Records come back without their frames,
+/// contact runs and summaries (those are in the tables).
 fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<Vec<ClipStatus>> {
     let mut named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
     named.sort_by(|a, b| a.1.cmp(&b.1));

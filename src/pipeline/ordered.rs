@@ -23,6 +23,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError};
 use std::time::Duration;
 
+use super::sink::Defer;
 use crate::error::{Error, Result};
 
 /// Batches spawned ahead of the one being waited for or written.
@@ -67,7 +68,7 @@ where
     let outcome = rayon::in_place_scope_fifo(|scope| {
         // However this ends (an error, a panic here or in a task), the tasks not yet
         // started skip their work.
-        let _stop = StopOnDrop(stop_ref);
+        let _stop = Defer::new(|| stop_ref.store(true, Ordering::Relaxed));
         let spawn = |b: usize| -> Slots<R> {
             let list = items(&batches[b]);
             for (k, item) in list.iter().enumerate() {
@@ -118,15 +119,6 @@ where
 /// The error of a batch handed over with a result missing (a task skipped its work).
 fn skipped() -> Error {
     Error::invalid("worker pool", "a batch's task ended without its result")
-}
-
-/// Sets the flag when dropped.
-struct StopOnDrop<'a>(&'a AtomicBool);
-
-impl Drop for StopOnDrop<'_> {
-    fn drop(&mut self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
 }
 
 /// The next finished item, running the pool's pending tasks while none is in.
