@@ -578,3 +578,135 @@ fn subframe_events_of_the_fixtures_are_within_a_frame_and_15_ms_of_the_truth() {
     }
     print!("{out}");
 }
+
+/// Stances of one clip ingested with `mass` (default options otherwise).
+fn clip_stances(
+    bvh: &stancelib::bvh::Bvh,
+    name: &str,
+    mass: f64,
+) -> Vec<stancelib::stances::Stance> {
+    use stancelib::stances::{build_clip, StanceOptions};
+    let opts = IngestOptions {
+        mass_kg: mass,
+        ..Default::default()
+    };
+    let (summary, frames, contacts) = util::ingest_body(bvh, &opts, name);
+    build_clip(
+        name,
+        &frames,
+        &summary,
+        &contacts,
+        mass,
+        &StanceOptions::default(),
+    )
+    .0
+}
+
+// See: issue 37 item 3 — a 2 m/s jog's 40–60 ms flights, closed up by the contact gates,
+// are opened by the whole-body force (`contacts::hidden_flight`); no walk gains a flight.
+#[test]
+fn hidden_flights_open_jogs_and_leave_walks() {
+    use stancelib::stances::segment::Boundary;
+    let Some(data) = util::shared_or_skip("hidden_flights_open_jogs_and_leave_walks") else {
+        return;
+    };
+    let fp = util::forceplate_clip(&data, "hamner_multi_run_2ms");
+    let st = clip_stances(&fp.bvh, "hamner_multi_run_2ms", fp.mass);
+    let both = st
+        .iter()
+        .filter(|s| s.boundary_start == Boundary::Flight && s.boundary_end == Boundary::Flight)
+        .count();
+    let flights = st
+        .iter()
+        .filter(|s| s.boundary_end == Boundary::Flight)
+        .count();
+    // Sub-frame events of the opened flights against the plates' (matched within 0.15 s).
+    let plate = |side: &str, kind: &str| -> Vec<f64> {
+        fp.meta["plate_events"][side]
+            .as_array()
+            .expect("plate_events")
+            .iter()
+            .filter_map(|e: &Value| e[format!("{kind}_s")].as_f64())
+            .collect()
+    };
+    let mut errs = Vec::new();
+    for s in &st {
+        let side = match s.label.as_str() {
+            "L" => "left",
+            "R" => "right",
+            _ => continue,
+        };
+        if s.boundary_start == Boundary::Flight {
+            errs.extend(nearest(&plate(side, "touchdown"), s.td_clip_s));
+        }
+        if s.boundary_end == Boundary::Flight {
+            errs.extend(nearest(&plate(side, "liftoff"), s.lo_clip_s));
+        }
+    }
+    let mean_abs = errs.iter().map(|e: &f64| e.abs()).sum::<f64>() / errs.len().max(1) as f64;
+    println!(
+        "hamner_multi_run_2ms: {} stances, {both} with flights on both sides, {flights} flights; \
+         events at opened flights vs plates: n {}, mean |error| {:.1} ms, signed {:+.1} ms",
+        st.len(),
+        errs.len(),
+        mean_abs * 1e3,
+        errs.iter().sum::<f64>() / errs.len().max(1) as f64 * 1e3
+    );
+    assert!(flights >= 5 && both >= 4, "the jog's flights stay closed");
+    // The plates lag the kinematics by 7 ms here (SOURCES.md); the opened events are frame
+    // edges of the force's flight: within 3 frames on average.
+    assert!(mean_abs <= 0.03, "mean |error| {:.1} ms", mean_abs * 1e3);
+    // Walks: every force-plate walk, every shared walk and the bulk set's walking subjects.
+    let mut walks: Vec<(PathBuf, f64)> = [
+        "opencap_s4_walking1",
+        "gait2354_s01_walk1",
+        "arnold_synth_s18_walk2",
+    ]
+    .iter()
+    .map(|c| {
+        let w = util::forceplate_clip(&data, c);
+        (w.dir.join("clip.bvh"), w.mass)
+    })
+    .collect();
+    walks.extend(
+        bvh_files(&data.join("bvh").join("walk"))
+            .into_iter()
+            .map(|p| (p, 70.0)),
+    );
+    walks.extend(
+        bvh_files(&data.join("bvh-bulk").join("cmu"))
+            .into_iter()
+            .filter(|p| {
+                let n = p.file_name().unwrap().to_string_lossy();
+                n.starts_with("07_") || n.starts_with("08_")
+            })
+            .map(|p| (p, 70.0)),
+    );
+    let mut with_flight = Vec::new();
+    for (path, mass) in &walks {
+        let bvh = stancelib::bvh::parse_file(path).unwrap();
+        let name = path.display().to_string();
+        let st = clip_stances(&bvh, &name, *mass);
+        if st
+            .iter()
+            .any(|s| s.boundary_start == Boundary::Flight || s.boundary_end == Boundary::Flight)
+        {
+            with_flight.push(name);
+        }
+    }
+    println!("{} walks, {} with a flight", walks.len(), with_flight.len());
+    assert!(walks.len() >= 25, "only {} walks found", walks.len());
+    assert!(
+        with_flight.is_empty(),
+        "walks with a flight: {with_flight:?}"
+    );
+}
+
+/// The signed error of `t` against the nearest of `plate` within 0.15 s.
+fn nearest(plate: &[f64], t: f64) -> Option<f64> {
+    plate
+        .iter()
+        .map(|p| t - p)
+        .filter(|e| e.abs() <= 0.15)
+        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+}

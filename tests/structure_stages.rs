@@ -70,12 +70,14 @@ fn contact_stage_entry_points_reproduce_the_ingest_contacts() {
     assert_eq!(tracks.ground_z, frames.ground_z);
     let mut timeline = contacts::detect(&tracks, &c);
     let vz: Vec<f64> = frames.com_v.iter().map(|v| v[2]).collect();
+    let az: Vec<f64> = frames.com_a.iter().map(|a| a[2]).collect();
     let motion = ClipMotion {
         frame: &frames.frame,
         time_s: &frames.time_s,
         dt: summary.frame_time_s,
         com: &frames.com,
         com_vz: &vz,
+        com_az: &az,
         facing: &frames.facing,
     };
     let events = contacts::runs_and_flights(&tracks, &mut timeline, &motion, &c);

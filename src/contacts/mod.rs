@@ -18,6 +18,7 @@ pub mod contact_runs;
 pub mod detect;
 pub mod flight;
 pub mod floor;
+pub mod hidden_flight;
 pub mod options;
 pub mod support;
 pub mod timeline;
@@ -44,6 +45,8 @@ pub struct ClipMotion<'a> {
     pub com: &'a [V3],
     /// SG vertical COM velocity, m/s.
     pub com_vz: &'a [f64],
+    /// SG vertical COM acceleration, m/s² (the hidden-flight rule's force).
+    pub com_az: &'a [f64],
     /// Horizontal facing direction from the hips (unit, or zero).
     pub facing: &'a [V3],
 }
@@ -72,6 +75,7 @@ pub fn runs_and_flights(
     let mut warnings = Vec::new();
     if opts.support_check {
         warnings = support::cross_check(tracks, timeline, motion, opts, &mut runs_out);
+        open_hidden_flights(tracks, timeline, motion, opts, &mut runs_out);
     }
     let flights = flight::flights(&timeline.contact, &runs_out, motion);
     if opts.support_check {
@@ -87,6 +91,28 @@ pub fn runs_and_flights(
         flights,
         warnings,
     }
+}
+
+/// The hidden-flight rule ([`hidden_flight`]): opens the jog flights that the contact rule
+/// closed, after every other change to the flags (a flight of two or three frames would
+/// otherwise be filled again as a gap shorter than `min_gap_s`).
+fn open_hidden_flights(
+    tracks: &ContactTracks,
+    timeline: &mut ContactTimeline,
+    motion: &ClipMotion,
+    opts: &ContactOptions,
+    runs_out: &mut Vec<ContactRun>,
+) {
+    if opts.static_mode {
+        return;
+    }
+    let hidden = hidden_flight::find(runs_out, motion);
+    if hidden.is_empty() {
+        return;
+    }
+    hidden_flight::open(&mut timeline.contact, &hidden);
+    *runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
+    hidden_flight::clamp_events(runs_out, &hidden, motion);
 }
 
 /// Support effectors, in output order.

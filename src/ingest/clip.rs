@@ -67,12 +67,14 @@ pub(super) fn run(
     let tracks = contacts::tracks(effector, body.leg_m, dt, c);
     let mut timeline = contacts::detect(&tracks, c);
     let vz: Vec<f64> = com_v.iter().map(|v| v[2]).collect();
+    let az: Vec<f64> = com_a.iter().map(|a| a[2]).collect();
     let motion = ClipMotion {
         frame: &frame,
         time_s: &time_s,
         dt,
         com: &com_pos,
         com_vz: &vz,
+        com_az: &az,
         facing: &fwd,
     };
     let events = contacts::runs_and_flights(&tracks, &mut timeline, &motion, c);
