@@ -9,6 +9,7 @@ use stancelib::ingest::{ClipFrames, ClipSummary, ContactRun, IngestOptions};
 use stancelib::library::read::{open_library, read_parquet};
 use stancelib::query::run::run_cycles;
 use stancelib::skeleton::Skeleton;
+use stancelib::stances::segment::Boundary;
 
 use super::util::{ingest_body, ok, root, shared_or_skip, stancelib};
 
@@ -896,4 +897,100 @@ pub(super) fn recorded_jump_against_source(lib: &Path, source: &Path, out: &Path
     ]);
     let (td, _, first) = first_window(out);
     against_source_from(out, source, lib, (&first, td), 10.0)
+}
+
+// See: issue 37 item 5 — an edited run changes its cadence and contact time with speed
+// as `query run` predicts: the edit of the fixture run at 2 and 4 m/s, re-ingested and
+// built again, has the contact time and step period of the query's answer for that
+// cycle (within 5 %: the rebuilt contacts are detected from the edited feet), and the
+// paper's law keeps the recorded ones.
+#[test]
+fn edited_runs_follow_the_gait_law_of_the_query() {
+    let dir = tmp();
+    let (_, lib, id, _) = fixture_run_cycle(dir.path());
+    let rebuilt = |out: &Path, sub: &str| -> (f64, f64) {
+        let lib = library(&dir.path().join(sub), &[out.to_path_buf()]);
+        let l = open_library(&lib).unwrap();
+        let single: Vec<_> = l
+            .stances
+            .iter()
+            .filter(|s| s.label == "L" || s.label == "R")
+            .filter(|s| s.boundary_start == Boundary::Flight && s.boundary_end == Boundary::Flight)
+            .collect();
+        assert!(single.len() >= 4, "{sub}: {} running stances", single.len());
+        let mut dt: Vec<f64> = single.iter().map(|s| s.model.dt_s).collect();
+        let mut t: Vec<f64> = single.iter().map(|s| s.params.t_e).collect();
+        (median(&mut dt), median(&mut t))
+    };
+    let mut contact = Vec::new();
+    for v in [2.0, 4.0] {
+        let out = dir.path().join(format!("law_{v}.bvh"));
+        edit_cycle(&lib, &id, v, &out);
+        let q = dir.path().join(format!("q_{v}.parquet"));
+        ok(&[
+            "query",
+            "run",
+            "--lib",
+            lib.to_str().unwrap(),
+            "--speed",
+            &v.to_string(),
+            "--out",
+            q.to_str().unwrap(),
+            "--quiet",
+        ]);
+        let t = stancelib::library::read::Table::open(&q).unwrap();
+        let ids = t.df.column("stance_ids").unwrap().list().unwrap().clone();
+        let row = (0..t.height())
+            .find(|&i| ids.get_as_series(i).unwrap().str().unwrap().get(0) == Some(id.as_str()))
+            .expect("the cycle is answered");
+        let want_c = t.f64_lists("contact_time_s", Some(2)).unwrap()[row][0];
+        let want_t = t.f64_lists("step_period_s", Some(2)).unwrap()[row][0];
+        let (got_c, got_t) = rebuilt(&out, &format!("rebuilt_{v}"));
+        eprintln!(
+            "edit at {v} m/s: contact {got_c:.3} s (query {want_c:.3}), step {got_t:.3} s (query {want_t:.3})"
+        );
+        assert!(
+            (got_c / want_c - 1.0).abs() <= 0.05,
+            "contact {got_c} vs {want_c}"
+        );
+        assert!(
+            (got_t / want_t - 1.0).abs() <= 0.05,
+            "step {got_t} vs {want_t}"
+        );
+        contact.push(got_c);
+    }
+    assert!(
+        contact[1] < 0.85 * contact[0],
+        "faster is shorter contact: {contact:?}"
+    );
+    // The paper's law: the recorded cadence at both speeds.
+    let mut steps = Vec::new();
+    for v in [2.0, 4.0] {
+        let out = dir.path().join(format!("paper_{v}.bvh"));
+        edit(&[
+            "edit",
+            "run",
+            "--lib",
+            lib.to_str().unwrap(),
+            "--speed",
+            &v.to_string(),
+            "--stance",
+            &id,
+            "--gait-law",
+            "paper",
+            "--out",
+            out.to_str().unwrap(),
+            "--allow-infeasible",
+        ]);
+        steps.push(rebuilt(&out, &format!("paper_rebuilt_{v}")).1);
+    }
+    assert!(
+        (steps[0] / steps[1] - 1.0).abs() <= 0.03,
+        "paper law keeps the period: {steps:?}"
+    );
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }

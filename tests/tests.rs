@@ -43,6 +43,8 @@
 //! # Queries
 //! - `queries`: the run-at-speed sweep, recorded jumps feasible as recorded, the jump map and
 //!   the issue 12 targets on the libraries of the shared clips.
+//! - `run_predictions`: issue 37 — `query run` from each force-plate run to every speed the
+//!   same runner ran, against that runner's plates (contact time, step period, peak force, μ).
 //!
 //! # 2PAC: kinematics and trajectories
 //! - `kinematics`: kinematic polytopes of the shared clips hold their points, the COM sits
@@ -113,6 +115,7 @@ mod scale;
 mod scale_memory;
 // Queries
 mod queries;
+mod run_predictions;
 // 2PAC
 mod kinematics;
 mod twopac;

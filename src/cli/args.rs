@@ -340,6 +340,10 @@ pub struct EditRunArgs {
     /// Body-mass ratio target/recorded character.
     #[arg(long = "mass-scale", default_value_t = 1.0)]
     pub mass_scale: f64,
+    /// How contact time and step period change with speed, as `query run --gait-law`:
+    /// `auto`, `population` or `paper` (the recorded cadence kept).
+    #[arg(long = "gait-law", default_value = "auto", value_parser = ["auto", "population", "paper"])]
+    pub gait_law: String,
 }
 
 /// `stancelib edit jump`.
@@ -472,6 +476,11 @@ pub struct RunQueryArgs {
     /// speed, with the limits dashed and infeasible speeds marked.
     #[arg(long)]
     pub png: Option<PathBuf>,
+    /// How contact time and step period change with speed: `auto` (the character's own
+    /// law when its cycles span speeds ≥ 1.2× apart, else `population`: contact time ∝
+    /// v^-0.42, step period ∝ v^-0.19) or `paper` (every time kept, β_v = 1).
+    #[arg(long = "gait-law", default_value = "auto", value_parser = ["auto", "population", "paper"])]
+    pub gait_law: String,
 }
 
 impl RunQueryArgs {

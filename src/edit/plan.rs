@@ -54,6 +54,9 @@ pub struct EditStance {
     pub request: Request,
     /// The solution and verdicts.
     pub scaled: ScaledStance,
+    /// The gait law's contact-time scale `σ_c` the stance plays at (`prepared` is the
+    /// recorded stance stretched by it; 1 for jumps and the paper's runs).
+    pub time_scale: f64,
 }
 
 impl EditStance {
@@ -163,6 +166,7 @@ pub fn solve_stance(
         prepared: prepared.clone(),
         request,
         scaled,
+        time_scale: 1.0,
     })
 }
 
@@ -173,11 +177,14 @@ pub fn feet_of(label: &str) -> [bool; 2] {
 }
 
 /// The model a stance plays, at `β = (1, β_p, 1)` from its own recorded start apex and
-/// times (no detail): what its recording is compared with. `β_p` is the played one: the
+/// times (no detail, not stretched by the gait law): what its recording is compared with. `β_p` is the played one: the
 /// perpendicular scale is the query's policy (1 for a run, dropped or drift-cancelling for
 /// a jump's liftoff), not a request, so the recorded request plays it too.
 fn own_path(e: &EditStance) -> PlannedStance {
-    let (st, p) = (&e.prepared.stance, &e.prepared.stance.params);
+    // The recorded stance: a stretched one (`time_scale ≠ 1`) back on its own clock.
+    let recorded = (e.time_scale != 1.0).then(|| e.prepared.stance.time_scaled(1.0 / e.time_scale));
+    let st = recorded.as_ref().unwrap_or(&e.prepared.stance);
+    let p = &st.params;
     PlannedStance {
         source: 0,
         model: st.model.clone(),

@@ -5,7 +5,9 @@
 //! ```text
 //! run:  every run cycle of a clip that is not time-scaled (or the one named), each solved
 //!       at k = v / (v_orig·√L) refined until the cycle's speed is v (`refine_run_k`),
-//!       its stances leaned to the periodic requests (`lean`: β_h = k, β_p = 1);
+//!       its stances stretched in time by the gait law (σ_c, the distance from the law's
+//!       period σ_T·T₀: `query::run::distance_for_period`, docs stance-model §6.8a) and
+//!       leaned to the periodic requests (`lean`: β_h = k, β_p = 1);
 //!       best = feasible first, then the least |k − 1| (the least change of the recorded
 //!       speed), ties by the order of the cycles (stance id order)
 //! jump: the named pair; else, without both a height and a distance, the library's first
@@ -22,11 +24,12 @@ use super::plan::{refine_run_k, run_requests, solve_stance, EditStance, StanceTi
 use crate::error::{Error, Result};
 use crate::library::read::StanceLibrary;
 use crate::query::feasibility::{LimitForm, Limits};
+use crate::query::gait::{LawChoice, LawSource};
 use crate::query::jump::{is_landing, is_liftoff, jump, recorded_jump, Jump};
 use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
 use crate::query::pairs::jump_rank;
 use crate::query::pool::Prepared;
-use crate::query::run::{run_cycles, scale_limits};
+use crate::query::run::{clip_gaits, distance_for_period, run_cycles, scale_limits, Timing};
 use crate::query::solve::Refs;
 
 /// The limits an edit's stances are checked against (§7.5).
@@ -51,6 +54,8 @@ pub struct RunTarget {
     pub mass_scale: f64,
     /// The cycle's first stance id; `None`: the best cycle.
     pub stance: Option<String>,
+    /// How contact time and step period change with speed (`query::gait`).
+    pub gait_law: LawChoice,
 }
 
 /// The chosen run cycle: its speed factor `k` and its two solved stances.
@@ -102,24 +107,67 @@ pub fn choose_run(
             None => no_run_cycle(),
         });
     }
+    let gaits = clip_gaits(&lib.stances, &cycles);
     let solved: Vec<RunCandidate> = cycles
         .iter()
         .map(|cy| {
+            let ch = &lib.stances[cy.stances[0]].character_id;
+            let law = target
+                .gait_law
+                .law(gaits.get(ch).map_or(&[][..], Vec::as_slice));
+            let v_orig = cy.v_orig * length.sqrt();
+            let timing = Timing::of(&law, v_orig, target.speed_mps);
+            let paper = law.source == LawSource::Paper;
             let prep = cy.stances.map(|i| {
-                Prepared::with_active_fraction(pool[i].stance.scaled(length, mass), limits.active)
+                let s = pool[i].stance.scaled(length, mass);
+                let p = Prepared::with_active_fraction(s.clone(), limits.active);
+                let lim = stance_limits(&p, limits.form, &absolute, limits.mu);
+                let s = if paper {
+                    s
+                } else {
+                    s.time_scaled(timing.sigma_c)
+                };
+                (
+                    Prepared::with_active_fraction(s, limits.active),
+                    lim,
+                    p.stance.params.t_e,
+                )
             });
-            let k0 = target.speed_mps / (cy.v_orig * length.sqrt());
+            let k0 = target.speed_mps / v_orig;
             refine_run_k(target.speed_mps, k0, |k| {
-                let req = run_requests([&prep[0].stance, &prep[1].stance], k);
-                (0..2)
+                let req = run_requests([&prep[0].0.stance, &prep[1].0.stance], k);
+                let cycle: std::result::Result<Vec<EditStance>, String> = (0..2)
                     .map(|n| {
-                        let lim = stance_limits(&prep[n], limits.form, &absolute, limits.mu);
-                        let lean = leaned(&prep[n], &req[n], [k, 1.0], limits.active);
-                        let i = cy.stances[n];
+                        let (p, lim, t_e0) = &prep[n];
+                        let mut lean = leaned(p, &req[n], [k, 1.0], limits.active);
                         let refs = Refs::run(k);
-                        solve_stance(&lib.stances[i], times[i], &lean, req[n], &refs, &lim)
+                        let mut request = req[n];
+                        if !paper {
+                            // The law's period; the distance follows (§6.8a), and the
+                            // flight rule becomes "the cycle's flights exist" (below).
+                            let t = timing.sigma_t * t_e0;
+                            request.x = distance_for_period(&lean.shape, &request, &refs, t);
+                            (lean.shape.before_flight, lean.shape.after_flight) = (false, false);
+                        }
+                        let i = cy.stances[n];
+                        let mut e =
+                            solve_stance(&lib.stances[i], times[i], &lean, request, &refs, lim)?;
+                        e.time_scale = if paper { 1.0 } else { timing.sigma_c };
+                        Ok(e)
                     })
-                    .collect()
+                    .collect();
+                let cycle = cycle?;
+                if !paper {
+                    let (a, b) = (&cycle[0].scaled.solution, &cycle[1].scaled.solution);
+                    let flights = [(a.t_e - a.t_lo) + b.t_td, (b.t_e - b.t_lo) + a.t_td];
+                    if flights.iter().any(|f| *f < 0.0) {
+                        return Err(format!(
+                            "no flight at {} m/s: the gait law's contact time outlasts the step",
+                            target.speed_mps
+                        ));
+                    }
+                }
+                Ok(cycle)
             })
         })
         .collect();
@@ -337,6 +385,7 @@ pub fn jump_stances(
                 prepared: pool[s].clone(),
                 request,
                 scaled,
+                time_scale: 1.0,
             }
         })
         .collect()

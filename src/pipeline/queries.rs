@@ -19,13 +19,14 @@ use crate::library::read::{open_library, StanceLibrary};
 use crate::library::write::write_atomic;
 use crate::plot::{jump_map_png, write_png};
 use crate::query::feasibility::{check_mu, LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
+use crate::query::gait::{GaitLaw, LawChoice};
 use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
 use crate::query::map::{check_grid, jump_map, Axis, JumpMap, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};
 use crate::query::pairs::ranked_jump_pairs;
 use crate::query::pool::Prepared;
 use crate::query::run::{
-    check_scale, check_speed, check_sweep, run_at_speed, run_cycles, scale_limits, RunCycle,
-    ScaledStance,
+    check_scale, check_speed, check_sweep, clip_gaits, nearest_in_speed, run_at_speed, run_cycles,
+    scale_limits, RunCycle, ScaledStance,
 };
 use crate::query::tables::{jump_map_table, jump_pairs_table, jump_table, run_table, RunRow};
 use crate::stances::limits::S_EFF_RANGE;
@@ -148,6 +149,8 @@ pub struct RunQuery {
     pub out: PathBuf,
     /// Table 1 as a figure (PNG), when given.
     pub png: Option<PathBuf>,
+    /// How contact time and step period change with speed.
+    pub gait_law: LawChoice,
 }
 
 /// One printed line of `query run`: a cycle at one speed (its first stance's values).
@@ -167,8 +170,18 @@ pub struct RunLine {
     pub ext_max_m: Option<f64>,
     /// Contact point `cp_h` of the first stance, m.
     pub cp_h_m: Option<f64>,
+    /// Contact time of the first stance, s.
+    pub contact_s: Option<f64>,
+    /// Apex-to-apex step period of the first stance, s.
+    pub step_s: Option<f64>,
+    /// The gait law's source (`character`, `population`, `paper`).
+    pub gait_law: &'static str,
+    /// The cycle answers this speed for its character (nearest in speed).
+    pub used: bool,
     /// Feasible by the exact check.
     pub feasible: bool,
+    /// The first problem, `<stance_id>: <reason>`.
+    pub violated: Option<String>,
 }
 
 /// What `query run` found: one line per (speed, cycle), speed-major.
@@ -223,16 +236,32 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
             (*c, prep, lim)
         })
         .collect();
+    let gaits = clip_gaits(&lib.stances, &cycles);
+    let laws: BTreeMap<String, GaitLaw> = gaits
+        .iter()
+        .map(|(ch, clips)| (ch.clone(), q.gait_law.law(clips)))
+        .collect();
+    let speeds_of: Vec<(&str, f64)> = scaled
+        .iter()
+        .map(|(c, p, _)| (p[0].stance.character_id.as_str(), c.v_orig * length.sqrt()))
+        .collect();
     let mut rows = Vec::new();
     for &v in &q.speeds {
-        for (c, prep, lim) in &scaled {
+        let used = nearest_in_speed(&speeds_of, v);
+        for ((c, prep, lim), used) in scaled.iter().zip(used) {
             let cycle = [&prep[0], &prep[1]];
+            let law = laws
+                .get(&prep[0].stance.character_id)
+                .copied()
+                .unwrap_or(GaitLaw::POPULATION);
+            let v_orig = c.v_orig * length.sqrt();
             rows.push(RunRow {
                 length_scale: length,
                 mass_scale: mass,
                 stances: cycle,
-                candidate: run_at_speed(cycle, c.v_orig * length.sqrt(), v, [&lim[0], &lim[1]]),
+                candidate: run_at_speed(cycle, v_orig, v, &law, [&lim[0], &lim[1]]),
                 limits: *lim,
+                used,
             });
         }
     }
@@ -243,15 +272,17 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
             "query": "run", "lib": q.lib, "speeds_mps": q.speeds,
             "length_scale": length, "mass_scale": mass,
             "limits": form.name(), "mu": mu, "active_set": active,
+            "gait_law": q.gait_law.name(),
         }),
     )?;
     write_table(&q.out, &mut df, &kv)?;
     if let Some(png) = &q.png {
         let points = run_points(&rows, scaled.len());
         let title = format!(
-            "query run: {} cycle(s), limits {}{}",
+            "query run: {} cycle(s), limits {}, gait law {}{}",
             scaled.len(),
             form.name(),
+            q.gait_law.name(),
             if (length, mass) == (1.0, 1.0) {
                 String::new()
             } else {
@@ -285,7 +316,12 @@ fn run_line(r: &RunRow) -> RunLine {
         f_peak_n: s.map(|s| s.verdict.f_peak),
         ext_max_m: s.map(|s| s.verdict.ext_max),
         cp_h_m: s.map(|s| s.cp[0]),
+        contact_s: s.map(|s| s.solution.t_lo - s.solution.t_td),
+        step_s: s.map(|s| s.solution.t_e),
+        gait_law: r.candidate.timing.law.source.name(),
+        used: r.used,
         feasible: r.candidate.feasible(),
+        violated: r.violated(),
     }
 }
 
@@ -315,7 +351,13 @@ fn run_points(rows: &[RunRow], n_cycles: usize) -> Vec<crate::plot::runs::RunPoi
             crate::plot::runs::RunPoint {
                 cycle: i % n_cycles.max(1),
                 speed_mps: r.candidate.speed,
-                beta_h: solved.iter().map(|s| s.solution.beta[0]).collect(),
+                contact_s: solved
+                    .iter()
+                    .map(|s| s.solution.t_lo - s.solution.t_td)
+                    .collect(),
+                step_s: solved.iter().map(|s| s.solution.t_e).collect(),
+                peak_n: agg(&|s| s.verdict.f_peak, true),
+                f_max_n: r.limits[0].f_max,
                 mu_min: agg(&|s| s.verdict.mu_req, true),
                 ext_min_m: agg(&|s| s.verdict.ext_min, false),
                 ext_max_m: agg(&|s| s.verdict.ext_max, true),
@@ -374,7 +416,7 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         "the grid is empty: check --heights and --speeds"
     );
     check_grid("--heights × --speeds", heights.len(), speeds.len())?;
-    let (form, mu) = q.limits.form(LimitForm::Relative)?;
+    let (form, mu) = q.limits.form(LimitForm::Absolute)?;
     let active = q.limits.active_fraction()?;
     let (lib, pool) = load_pool(&q.lib, active)?;
     let absolute = absolute_limits(&lib);
@@ -529,6 +571,7 @@ pub fn query_stages(
             limits,
             out: dir.join("runs.parquet"),
             png: None,
+            gait_law: gait_law_choice(q.gait_law.as_deref())?,
         }),
         None => None,
     };
@@ -543,6 +586,19 @@ pub fn query_stages(
         _ => None,
     };
     Ok((run, map))
+}
+
+/// The gait law named by `[queries] gait_law` (`auto` when absent).
+///
+/// # Errors
+/// An unknown name.
+pub fn gait_law_choice(name: Option<&str>) -> anyhow::Result<LawChoice> {
+    match name {
+        None => Ok(LawChoice::Auto),
+        Some(n) => LawChoice::parse(n).ok_or_else(|| {
+            anyhow::anyhow!("gait_law: unknown law '{n}' (give {})", LawChoice::NAMES)
+        }),
+    }
 }
 
 /// The values of the range `given` as `flag`, else of `default`.
@@ -594,7 +650,7 @@ pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
     for (n, v) in [("--height", q.height_m), ("--distance", q.distance_m)] {
         anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
     }
-    let (form, mu) = q.limits.form(LimitForm::Relative)?;
+    let (form, mu) = q.limits.form(LimitForm::Absolute)?;
     let active = q.limits.active_fraction()?;
     let (lib, pool) = load_pool(&q.lib, active)?;
     let absolute = absolute_limits(&lib);

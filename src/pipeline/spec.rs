@@ -113,6 +113,9 @@ pub struct QueriesTable {
     pub length_scale: Option<f64>,
     /// Body-mass ratio of the run's target character (default 1).
     pub mass_scale: Option<f64>,
+    /// How the run's contact time and step period change with speed: `auto` (default),
+    /// `population` or `paper`.
+    pub gait_law: Option<String>,
     /// Run `map jumps` (→ `queries/jump_map/`).
     pub jump_map: Option<bool>,
     /// Map rows, `start:stop:step` in m (default 0.6:1.6:0.02).
@@ -412,7 +415,17 @@ fn check_queries(q: &QueriesTable) -> std::result::Result<(), (&'static str, Err
         }
         None if q.length_scale.is_some() => return unused("length_scale", "run_speeds"),
         None if q.mass_scale.is_some() => return unused("mass_scale", "run_speeds"),
+        None if q.gait_law.is_some() => return unused("gait_law", "run_speeds"),
         None => {}
+    }
+    if let Some(name) = &q.gait_law {
+        if crate::query::gait::LawChoice::parse(name).is_none() {
+            let msg = format!(
+                "unknown law '{name}' (give {})",
+                crate::query::gait::LawChoice::NAMES
+            );
+            return Err(("gait_law", Error::invalid("[queries] gait_law", msg)));
+        }
     }
     for (key, v) in [
         ("length_scale", q.length_scale),

@@ -1,8 +1,9 @@
-//! `query run --png`: Table 1 of the paper as a figure. Over the target speed, (a) the
-//! horizontal force scale `β_h` of each cycle's stances, (b) the friction the cycle needs,
-//! `mu_min`, against the friction limit μ, and (c) the leg extension extremes `ext_min`,
-//! `ext_max` against `χ_min`, `χ_max`. Infeasible speeds are marked with a red cross and
-//! the name of the constraint they violate.
+//! `query run --png`: how a run changes with speed (Table 1 of the paper, with the gait
+//! law's times). Over the target speed, (a) each stance's contact time and step period,
+//! (b) the cycle's peak force against `F_max`, (c) the friction the cycle needs, `mu_min`,
+//! against the friction limit μ, and (d) the leg extension extremes `ext_min`, `ext_max`
+//! against `χ_min`, `χ_max`. Infeasible speeds are marked with a red cross and the name of
+//! the constraint they violate.
 
 use std::path::Path;
 
@@ -18,8 +19,14 @@ pub struct RunPoint {
     pub cycle: usize,
     /// Target speed, m/s.
     pub speed_mps: f64,
-    /// `β_h` of each solved stance.
-    pub beta_h: Vec<f64>,
+    /// Contact time of each solved stance, s.
+    pub contact_s: Vec<f64>,
+    /// Step period (apex to apex) of each solved stance, s.
+    pub step_s: Vec<f64>,
+    /// The cycle's peak force (both stances solved), N.
+    pub peak_n: Option<f64>,
+    /// The force limit `F_max` of the cycle's first stance, N.
+    pub f_max_n: f64,
     /// Friction the cycle needs (both stances solved), –.
     pub mu_min: Option<f64>,
     /// Shortest and longest COM–contact distance, m.
@@ -134,42 +141,51 @@ fn mark_infeasible(
     Ok(())
 }
 
-/// Writes the figure of `points` to `path` (PNG, 1100 × 1100 px).
+/// Writes the figure of `points` to `path` (PNG, 1100 × 1400 px).
 ///
 /// # Errors
 /// The file cannot be written or the font cannot be used.
 pub fn runs_png(path: &Path, title: &str, points: &[RunPoint]) -> Result<(), PlotError> {
     register_font();
-    let root = BitMapBackend::new(path, (1100, 1100)).into_drawing_area();
+    let root = BitMapBackend::new(path, (1100, 1400)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
     let root = root
         .titled(title, ("sans-serif", 22))
         .map_err(|e| err(path, e))?;
-    let panels = root.split_evenly((3, 1));
+    let panels = root.split_evenly((4, 1));
     let speeds = span(points.iter().map(|p| p.speed_mps), 0.25);
     let n_cycles = points.iter().map(|p| p.cycle + 1).max().unwrap_or(0);
-    // (a) β_h, (b) mu_min, (c) extension: (caption, y label, values per point, limits).
-    let beta: &Get = &|p| p.beta_h.clone();
+    // (a) times, (b) peak force, (c) mu_min, (d) extension: (caption, y label, values per
+    // point, limits).
+    let times: &Get = &|p| p.contact_s.iter().chain(&p.step_s).copied().collect();
+    let peak: &Get = &|p| p.peak_n.into_iter().collect();
+    let lim_f: &Get = &|p| vec![p.f_max_n];
     let mu: &Get = &|p| p.mu_min.into_iter().collect();
     let ext: &Get = &|p| p.ext_min_m.into_iter().chain(p.ext_max_m).collect();
     let lim_mu: &Get = &|p| vec![p.limits.0];
     let lim_ext: &Get = &|p| vec![p.limits.1, p.limits.2];
     let none: &Get = &|_| Vec::new();
-    let specs: [(&str, &str, &Get, &Get); 3] = [
+    let specs: [(&str, &str, &Get, &Get); 4] = [
         (
-            "(a) horizontal force scale β_h per stance",
-            "β_h",
-            beta,
+            "(a) contact time (lower lines) and step period (upper lines) per stance",
+            "time (s)",
+            times,
             none,
         ),
         (
-            "(b) friction needed mu_min, limit μ dashed",
+            "(b) peak force of the cycle, limit F_max dashed",
+            "force (N)",
+            peak,
+            lim_f,
+        ),
+        (
+            "(c) friction needed mu_min, limit μ dashed",
             "mu_min",
             mu,
             lim_mu,
         ),
         (
-            "(c) leg extension ext_min, ext_max (m), limits χ_min, χ_max dashed",
+            "(d) leg extension ext_min, ext_max (m), limits χ_min, χ_max dashed",
             "COM–contact distance (m)",
             ext,
             lim_ext,

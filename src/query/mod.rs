@@ -10,6 +10,7 @@
 //! Stance frame (h, p, v), SI units; heights above the contact height `z_c`.
 
 pub mod feasibility;
+pub mod gait;
 pub mod jump;
 pub mod limits;
 pub mod map;

@@ -86,6 +86,30 @@ impl PoolStance {
     }
 }
 
+impl PoolStance {
+    /// The same force profile stretched in time by `σ` (time is a degree of freedom of
+    /// the scaling, not only the force):
+    ///
+    /// ```text
+    /// f̃(t) = f(t/σ):  Δt̃ = σ Δt,  J̃_a = σ J_a (m/s),  K̃_a = σ² K_a (m),  S̃_a = σ² S_a (m)
+    /// t̃_TD, t̃_LO, t̃_E = σ·(t_TD, t_LO, t_E)   (so the centroid split (u, w) keeps its signs)
+    /// ```
+    ///
+    /// Forces on the normalised grid, `A^F`, `A^μ` and `μ_req` are unchanged (a scale β on
+    /// top gives `β f(t/σ)`); the stance's recorded extremes and angular impulse stay
+    /// those of the recording (relative limits and `H_des` refer to what was recorded).
+    /// `σ = 1` returns an identical copy. Rebuild [`Prepared`] from the result: its `J`,
+    /// `K` and `S` follow from `Δt̃` exactly.
+    pub fn time_scaled(&self, sigma: f64) -> PoolStance {
+        let mut s = self.clone();
+        s.model.dt_s *= sigma;
+        s.params.t_td *= sigma;
+        s.params.t_lo *= sigma;
+        s.params.t_e *= sigma;
+        s
+    }
+}
+
 /// A stance with the tables every query of it reuses (built once, O(N_s)).
 #[derive(Debug, Clone)]
 pub struct Prepared {

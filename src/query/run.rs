@@ -27,6 +27,7 @@ use super::feasibility::{
     approx, contact_point_with, exact_at_contact_point, exact_feasible, Limits, QueryContext,
     Verdict,
 };
+use super::gait::{GaitLaw, LawSource};
 use super::pool::{PoolStance, Prepared};
 use super::solve::{solve, Refs, Request, Solution};
 
@@ -155,6 +156,64 @@ pub fn run_cycles(pool: &[PoolStance]) -> Vec<RunCycle> {
         .collect()
 }
 
+/// Cycles within this speed ratio of a character's nearest cycle are used for a target
+/// speed (the clip recorded nearest in speed, and any other clip as near).
+pub const NEAREST_SPEED_RATIO: f64 = 1.1;
+
+/// Which cycles answer a target speed: per character, those whose speed is within
+/// [`NEAREST_SPEED_RATIO`] of the character's cycle nearest to `speed` (in `ln v`).
+///
+/// `cycles` gives each cycle's `(character, v_orig)`; the result is one flag per cycle.
+pub fn nearest_in_speed(cycles: &[(&str, f64)], speed: f64) -> Vec<bool> {
+    let dist = |v: f64| (v / speed.max(1e-9)).ln().abs();
+    let mut best: std::collections::BTreeMap<&str, f64> = std::collections::BTreeMap::new();
+    for &(ch, v) in cycles {
+        let d = dist(v);
+        best.entry(ch).and_modify(|b| *b = b.min(d)).or_insert(d);
+    }
+    cycles
+        .iter()
+        .map(|&(ch, v)| dist(v) <= best[ch] + NEAREST_SPEED_RATIO.ln())
+        .collect()
+}
+
+/// Each character's clips summarised for its gait law ([`super::gait::fit`]): per clip,
+/// the medians over its cycles of the speed, the stances' contact times `Δt` and their
+/// apex-to-apex periods `T`.
+pub fn clip_gaits(
+    pool: &[PoolStance],
+    cycles: &[RunCycle],
+) -> std::collections::BTreeMap<String, Vec<super::gait::ClipGait>> {
+    use crate::math::stats::median;
+    let mut per_clip: std::collections::BTreeMap<(&str, &str), [Vec<f64>; 3]> =
+        std::collections::BTreeMap::new();
+    for c in cycles {
+        let a = &pool[c.stances[0]];
+        let e = per_clip
+            .entry((a.character_id.as_str(), a.clip.as_str()))
+            .or_default();
+        e[0].push(c.v_orig);
+        for &i in &c.stances {
+            e[1].push(pool[i].model.dt_s);
+            e[2].push(pool[i].params.t_e);
+        }
+    }
+    let mut out: std::collections::BTreeMap<String, Vec<super::gait::ClipGait>> =
+        std::collections::BTreeMap::new();
+    for ((ch, _), v) in per_clip {
+        let [a, b, c] = &v;
+        let m = |v: &[f64]| median(v).unwrap_or(f64::NAN);
+        out.entry(ch.to_string())
+            .or_default()
+            .push(super::gait::ClipGait {
+                speed: m(a),
+                contact_s: m(b),
+                step_s: m(c),
+            });
+    }
+    out
+}
+
 /// The request of the run-at-speed policy for one stance: `(vs, ve, x)·k`.
 pub fn policy_request(p: &PoolStance, k: f64) -> Request {
     let q = &p.params;
@@ -264,15 +323,47 @@ pub fn scale_limits(lim: &Limits, length: f64, mass: f64) -> Limits {
     }
 }
 
+/// The times of a run at the target speed (the gait law's answer for one cycle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timing {
+    /// The law used.
+    pub law: GaitLaw,
+    /// Contact-time scale `σ_c` (each stance lasts `σ_c Δt₀`).
+    pub sigma_c: f64,
+    /// Step-period scale `σ_T` (each stance's apex-to-apex period is `σ_T T₀`).
+    pub sigma_t: f64,
+}
+
+/// Speed ratios `v/v₀` below this are timed as at this ratio: a jog in place keeps a
+/// finite contact time (the power law would stretch it without bound as `v → 0`).
+pub const LAW_MIN_SPEED_RATIO: f64 = 0.25;
+
+impl Timing {
+    /// The law's scales from a cycle at `v_orig` to `speed` (m/s), the ratio floored at
+    /// [`LAW_MIN_SPEED_RATIO`].
+    pub fn of(law: &GaitLaw, v_orig: f64, speed: f64) -> Self {
+        let v = speed.max(LAW_MIN_SPEED_RATIO * v_orig);
+        let (sigma_c, sigma_t) = law.time_scales(v_orig, v);
+        Timing {
+            law: *law,
+            sigma_c,
+            sigma_t,
+        }
+    }
+}
+
 /// One candidate of `query run`: a cycle at one speed for one character.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunCandidate {
     /// Target speed, m/s.
     pub speed: f64,
-    /// `k = v / v_orig` (the policy's `β_h`).
+    /// The policy's speed factor `k` (`vs`, `ve` and `x` scale by it); `v / v_orig` under
+    /// the paper's law.
     pub k: f64,
     /// The cycle's mean speed after the character scaling, m/s.
     pub v_orig: f64,
+    /// The times asked of the cycle.
+    pub timing: Timing,
     /// Per stance of the cycle: the outcome, or why it has no solution.
     pub stances: [Result<ScaledStance, super::solve::Infeasible>; 2],
 }
@@ -293,26 +384,120 @@ impl RunCandidate {
     }
 }
 
-/// The run-at-speed policy for one cycle of (already character-scaled) prepared stances.
+/// The heading distance `x` that makes `T` a root of the master quadratic of a request
+/// whose other parameters are `req`'s (A4, with `t_TD` from A3 and A5):
 ///
-/// `v_orig` is the scaled cycle's mean speed; `lims` each stance's limits (the target
-/// character's absolute limits by default, §7.5).
+/// ```text
+/// t_TD = T/2 − s̄_v − Δz/(g T),   x = ve T − d t_TD − β_h K_h,
+/// d = ve − vs,  β_h = d/J_h (β_h,ref when J_h ≈ 0, §6.4 (ii))
+/// ```
+///
+/// Used with the time-scaled stance's shape (`J̃ = σJ`, `K̃ = σ²K`) by the gait law
+/// (`query run`, `edit run`): the period `T` is chosen, the distance follows.
+pub fn distance_for_period(
+    shape: &super::solve::StanceShape,
+    req: &Request,
+    refs: &Refs,
+    t: f64,
+) -> f64 {
+    let d = req.ve - req.vs;
+    let t_td = t / 2.0 - shape.k[2] / shape.j[2] - (req.ze - req.zs) / (GRAVITY * t);
+    let near_zero = shape.j[0].abs() <= super::solve::DEFAULT_EPS_J * shape.j_scale[0];
+    let beta_h = if near_zero {
+        refs.beta_h
+    } else {
+        d / shape.j[0]
+    };
+    req.ve * t - d * t_td - beta_h * shape.k[0]
+}
+
+/// The distance factor `x̂` of one time-scaled stance for the end-apex time `T`
+/// ([`distance_for_period`] of the `k = 1` request): the request's distance is `k·x̂` when
+/// `vs`, `ve` scale by `k`, so `T` is a root of the master quadratic of
+/// `(k vs₀, k ve₀, k x̂)` for every `k` (A4 is linear in `k`; A3 and A5 do not involve the
+/// heading axis).
+pub fn distance_factor(p: &Prepared, t: f64) -> f64 {
+    distance_for_period(
+        &p.shape,
+        &policy_request(&p.stance, 1.0),
+        &Refs::run(1.0),
+        t,
+    )
+}
+
+/// The run policy with time as a degree of freedom, for one cycle of (already
+/// character-scaled) prepared stances.
+///
+/// ```text
+/// (σ_c, σ_T) from the gait law;  each stance: Δt̃ = σ_c Δt₀, target T_i = σ_T T_i0
+/// k = v Σ T_i / Σ x̂_i(T_i)       (so Σx/ΣT = v exactly)
+/// request_i = (zs, k vs, ze, k ve, vp, vps, k x̂_i)  → solve (root nearest T_i) → check
+/// ```
+///
+/// Under [`GaitLaw::PAPER`] this is the paper's policy (`σ = 1`, `k = v/v_orig`, §6.5 rule 3
+/// as recorded). Under a law, rule 3 (the apex outside the stance) is replaced by "both
+/// flights of the cycle exist" (`(T₁ − t_LO,1) + t_TD,2 ≥ 0` and `(T₂ − t_LO,2) + t_TD,1 ≥ 0`,
+/// else [`super::solve::Infeasible::FlightRule`] on the stance after it): a jog's apex
+/// lies inside its stance (the 2 m/s force-plate jog: `t_E − t_LO` = −24 ms), and the law,
+/// not the recorded split, says how long the flight is.
+/// `v_orig` is the scaled cycle's mean speed; `lims` each stance's limits.
 pub fn run_at_speed(
     cycle: [&Prepared; 2],
     v_orig: f64,
     speed: f64,
+    law: &GaitLaw,
     lims: [&Limits; 2],
 ) -> RunCandidate {
-    let k = speed / v_orig;
-    let check = |i: usize| {
-        let p = cycle[i];
-        scale_and_check(p, &policy_request(&p.stance, k), &Refs::run(k), lims[i])
+    let timing = Timing::of(law, v_orig, speed);
+    let paper = law.source == LawSource::Paper;
+    let timed: [std::borrow::Cow<Prepared>; 2] = cycle.map(|p| {
+        if paper {
+            return std::borrow::Cow::Borrowed(p);
+        }
+        let s = p.stance.time_scaled(timing.sigma_c);
+        let mut t = Prepared::with_active_fraction(s, p.tables.active_fraction);
+        // The law sets every time; the flight rule becomes "a flight exists" (below).
+        (t.shape.before_flight, t.shape.after_flight) = (false, false);
+        std::borrow::Cow::Owned(t)
+    });
+    let t_target = cycle.map(|p| timing.sigma_t * p.stance.params.t_e);
+    let x_hat = [0, 1].map(|i| distance_factor(&timed[i], t_target[i]));
+    let k = if paper {
+        speed / v_orig
+    } else {
+        speed * (t_target[0] + t_target[1]) / (x_hat[0] + x_hat[1])
     };
-    let stances = [check(0), check(1)];
+    let check = |i: usize| {
+        let p: &Prepared = &timed[i];
+        let mut req = policy_request(&p.stance, k);
+        if !paper {
+            req.x = k * x_hat[i];
+        }
+        if !(k.is_finite() && k >= 0.0) {
+            return Err(super::solve::Infeasible::InvalidInput);
+        }
+        let sol = solve(&p.shape, &req, &Refs::run(k), Some(t_target[i]))?;
+        Ok(check_solution(p, &req, &sol, lims[i]))
+    };
+    let mut stances = [check(0), check(1)];
+    if !paper {
+        if let [Ok(a), Ok(b)] = &stances {
+            // The cycle's two flights (periodic): from each liftoff to the other stance's
+            // touchdown through their shared apex.
+            let (a, b) = (a.solution, b.solution);
+            let flights = [(a.t_e - a.t_lo) + b.t_td, (b.t_e - b.t_lo) + a.t_td];
+            for (i, f) in flights.iter().enumerate() {
+                if *f < -super::solve::DEFAULT_ADMISSIBLE_TOL {
+                    stances[1 - i] = Err(super::solve::Infeasible::FlightRule);
+                }
+            }
+        }
+    }
     RunCandidate {
         speed,
         k,
         v_orig,
+        timing,
         stances,
     }
 }

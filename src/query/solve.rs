@@ -13,7 +13,8 @@
 //! stable roots: q = −½ (b + sign(b)·√(b² − 4ac)),  T ∈ {q/a, c/q};  a = 0 → T = −c/b
 //! admissible: T > 0, β_h ≥ 0, β_p ≥ 0, β_v > 0 (tolerance 1e-12);
 //!   u = t_TD + s̄_v, w = T − u with the signs of the original stance (else u, w > 0);
-//!   flight before ⇒ t_TD ≥ 0;  flight after ⇒ t_E − t_LO ≥ 0
+//!   flight before ⇒ t_TD ≥ 0;  flight after ⇒ t_E − t_LO ≥ 0 (where the recording has
+//!   them: `StanceShape::from_boundaries`)
 //! choice: smallest |T − T_orig|, ties (or no T_orig) → smaller T
 //! ```
 //! Degenerate branches (§6.4), with `J_a ≈ 0 ⇔ |J_a| ≤ ε_J (Δt/m)(|c0_a| + Σ_i c_ia)`:
@@ -231,14 +232,21 @@ impl StanceShape {
 
     /// The shape of a model with the given boundary kinds and reference parameters
     /// (`(u, w)` from their `t_TD` and `t_E`).
+    ///
+    /// Rule 3 (a flight keeps the apex outside the stance) follows the recording, as rule 2
+    /// does (a departure): a flight boundary whose recorded apex lies inside the stance
+    /// (`t_TD < 0` or `t_E < t_LO`: a jog's short flight, where the COM already falls at
+    /// liftoff or still rises at touchdown) does not impose it, else the recorded stance
+    /// could not be solved at its own parameters.
     pub fn from_boundaries(
         m: &ForceModel,
         start: Boundary,
         end: Boundary,
         reference: &StanceParams,
     ) -> Self {
-        let mut shape =
-            Self::from_model(m, start == Boundary::Flight, end == Boundary::Flight, None);
+        let before = start == Boundary::Flight && reference.t_td >= 0.0;
+        let after = end == Boundary::Flight && reference.t_e >= reference.t_lo;
+        let mut shape = Self::from_model(m, before, after, None);
         shape.ref_signs = shape.centroid_split(reference.t_td, reference.t_e);
         shape
     }

@@ -39,6 +39,9 @@ pub struct RunRow<'a> {
     pub candidate: RunCandidate,
     /// The limits each stance was checked against.
     pub limits: [Limits; 2],
+    /// The cycle answers this speed for its character (recorded nearest in speed,
+    /// [`super::run::nearest_in_speed`]).
+    pub used: bool,
 }
 
 impl RunRow<'_> {
@@ -124,7 +127,28 @@ pub fn run_table(rows: &[RunRow]) -> PolarsResult<DataFrame> {
             DataType::String,
         )?,
         col("v_orig_mps", f(&|r| r.candidate.v_orig)),
+        col("used", rows.iter().map(|r| r.used).collect::<Vec<_>>()),
+        col(
+            "gait_law",
+            rows.iter()
+                .map(|r| r.candidate.timing.law.source.name())
+                .collect::<Vec<_>>(),
+        ),
+        col(
+            "contact_exponent",
+            f(&|r| r.candidate.timing.law.contact_exponent),
+        ),
+        col(
+            "step_exponent",
+            f(&|r| r.candidate.timing.law.step_exponent),
+        ),
+        col("sigma_contact", f(&|r| r.candidate.timing.sigma_c)),
+        col("sigma_step", f(&|r| r.candidate.timing.sigma_t)),
         col("k", f(&|r| r.candidate.k)),
+        lists("contact_time_s", &|s| s.solution.t_lo - s.solution.t_td)?,
+        lists("step_period_s", &|s| s.solution.t_e)?,
+        lists("peak_force_stance_n", &|s| s.verdict.f_peak)?,
+        lists("mu_req", &|s| s.verdict.mu_req)?,
         lists("beta_h", &|s| s.solution.beta[0])?,
         lists("beta_v", &|s| s.solution.beta[2])?,
         lists("beta_p", &|s| s.solution.beta[1])?,
@@ -234,10 +258,14 @@ pub fn jump_table(rows: &[JumpRow]) -> PolarsResult<DataFrame> {
         col("d_flight_m", o(&|j| j.d_flight)),
         col("force_change", o(&Jump::force_change)),
     ];
-    // Slack to each limit the side was checked against (≥ 0 where met).
+    // Slack to each limit the side was checked against, as the exact check applies it
+    // (`Limits::effective`: ≥ 0 exactly where met).
     let margin = |k: usize, g: &dyn Fn(&ScaledStance, &Limits) -> f64| -> Vec<Option<f64>> {
         rows.iter()
-            .map(|r| r.jump.as_ref().ok().map(|j| g(&j.sides[k].1, &r.limits[k])))
+            .map(|r| {
+                let lim = r.limits[k].effective();
+                r.jump.as_ref().ok().map(|j| g(&j.sides[k].1, &lim))
+            })
             .collect()
     };
     for (k, n) in [(0, "1"), (1, "2")] {

@@ -31,6 +31,7 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
             length_scale: a.length_scale,
             mass_scale: a.mass_scale,
             stance: a.stance,
+            gait_law: crate::query::gait::LawChoice::parse(&a.gait_law).unwrap_or_default(),
         },
         cycles: a.cycles,
     };

@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use anyhow::Context;
+
 use super::super::args::{JumpArgs, RunQueryArgs};
 use super::super::Outcome;
 use crate::pipeline::queries::{jump_query, run_query, JumpQuery, RunQuery, RunReport};
@@ -20,44 +22,58 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
         limits: a.lim.options(),
         out: a.out.clone(),
         png: a.png.clone(),
+        gait_law: crate::pipeline::queries::gait_law_choice(Some(&a.gait_law))
+            .context("--gait-law")?,
     };
     print_run(&run_query(&q)?, &q.out);
     Ok(Outcome::Clean)
 }
 
-/// The `query run` table on stdout, then its summary line.
+/// The `query run` answers on stdout (the cycles recorded nearest in speed), then the
+/// summary line.
 pub fn print_run(report: &RunReport, out: &Path) {
     crate::say!(
-        "{:>6} {:<34} {:>6} {:>6} {:>6} {:>7} {:>7} {:>7} {:>8}",
+        "{:>6} {:<30} {:>10} {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>7}  verdict",
         "v_mps",
         "cycle (first stance)",
+        "gait law",
+        "t_c_s",
+        "T_s",
         "β_h",
         "β_v",
         "μ_min",
         "F_pk_N",
         "ext_max",
-        "cp_h",
-        "feasible"
     );
-    for r in &report.lines {
+    for r in report.lines.iter().filter(|r| r.used) {
         let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
+        let verdict = match (&r.violated, r.feasible) {
+            (_, true) => "feasible".to_string(),
+            (Some(why), false) => format!("infeasible ({why})"),
+            (None, false) => "infeasible".to_string(),
+        };
         crate::say!(
-            "{:>6.2} {:<34} {:>6} {:>6} {:>6} {:>7} {:>7} {:>7} {:>8}",
+            "{:>6.2} {:<30} {:>10} {:>6} {:>6} {:>6} {:>6} {:>6} {:>7} {:>7}  {}",
             r.speed_mps,
             r.stance_id,
+            r.gait_law,
+            f(r.contact_s),
+            f(r.step_s),
             f(r.beta[0]),
             f(r.beta[1]),
             f(r.mu_min),
-            f(r.f_peak_n.map(f64::round)),
+            r.f_peak_n.map_or("-".into(), |v| format!("{v:.0}")),
             f(r.ext_max_m),
-            f(r.cp_h_m),
-            r.feasible
+            verdict
         );
     }
+    let used = report.lines.iter().filter(|r| r.used).count();
     crate::say!(
-        "query run: {} cycle(s) × {} speed(s) → {}",
+        "query run: {} cycle(s) × {} speed(s); {} answer(s) shown from the cycles recorded \
+         nearest in speed (column `used`; all rows in the table) → {}",
         report.n_cycles,
         report.n_speeds,
+        used,
         out.display()
     );
 }

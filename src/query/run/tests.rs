@@ -3,7 +3,9 @@
 //! similarity (spec stance-model §6.8, §9).
 
 use super::*;
+use crate::force_model::GRAVITY;
 use crate::query::feasibility::relative_limits;
+use crate::query::gait::GaitLaw;
 use crate::query::solve::Solution;
 use crate::query::testkit::{assert_reaches_end_apex, bell_model, pool_stance, simulate, Rng};
 
@@ -112,6 +114,137 @@ fn cycles_need_opposite_feet_flights_and_chaining() {
     assert_eq!(cycles[0].stances, [0, 1]);
 }
 
+/// `(J, K)` of `f̃(t) = f(t/σ)` by quadrature over real time (no closed form):
+/// `J_a = ∫ f̃_a/m dt`, `K_a = ∫ t f̃_a/m dt` (the first moment about touchdown), midpoint
+/// rule with `n` steps.
+fn numerical_j_k(m: &crate::force_model::ForceModel, sigma: f64, n: usize) -> ([f64; 3], [f64; 3]) {
+    let dt = sigma * m.dt_s;
+    let h = dt / n as f64;
+    let (mut j, mut k) = ([0.0; 3], [0.0; 3]);
+    for i in 0..n {
+        let t = (i as f64 + 0.5) * h;
+        for a in 0..3 {
+            let f = m.axes[a].eval(t / dt) / m.mass_kg;
+            j[a] += f * h;
+            k[a] += t * f * h;
+        }
+    }
+    (j, k)
+}
+
+// Issue 37 item 1: the closed forms of a time-scaled stance, J̃ = σJ and K̃ = σ²K, checked
+// by quadrature, and its scaled outcome by an RK4 simulation of β f((t − t_TD)/(σΔt)).
+#[test]
+fn time_scaled_stances_solve_exactly() {
+    let mut rng = Rng::new(0x5eed_0437);
+    let mut solved = 0;
+    for i in 0..60 {
+        let p = running_stance(&mut rng, "s", "L");
+        let sigma = rng.uniform(0.6, 1.5);
+        let t = Prepared::new(p.stance.time_scaled(sigma));
+        let (jn, kn) = numerical_j_k(&p.stance.model, sigma, 20_000);
+        for a in 0..3 {
+            assert!(
+                close(t.shape.j[a], sigma * p.shape.j[a], 1e-12),
+                "J scales with σ"
+            );
+            assert!(
+                close(t.shape.k[a], sigma * sigma * p.shape.k[a], 1e-12),
+                "K with σ²"
+            );
+            assert!(
+                (t.shape.j[a] - jn[a]).abs() < 1e-6 * (1.0 + jn[a].abs()),
+                "{i}: J"
+            );
+            assert!(
+                (t.shape.k[a] - kn[a]).abs() < 1e-6 * (1.0 + kn[a].abs()),
+                "{i}: K"
+            );
+        }
+        let q = p.stance.params;
+        let v = rng.uniform(2.0, 6.0);
+        let law = GaitLaw::POPULATION;
+        let lim = relative_limits(&p.stance.coef);
+        let mut other = p.clone();
+        other.stance.label = "R".into();
+        let c = run_at_speed([&p, &other], q.x / q.t_e, v, &law, [&lim, &lim]);
+        let Ok(s) = &c.stances[0] else { continue };
+        solved += 1;
+        let timed = p.stance.time_scaled(c.timing.sigma_c);
+        // The law's times, exactly.
+        assert!(close(
+            s.solution.t_lo - s.solution.t_td,
+            c.timing.sigma_c * q.t_lo - c.timing.sigma_c * q.t_td,
+            1e-9
+        ));
+        assert!(
+            close(s.solution.t_e, c.timing.sigma_t * q.t_e, 1e-9),
+            "T = σ_T T₀"
+        );
+        // β_v = g T / J̃_v (A3 with the time-scaled impulse).
+        let jv = c.timing.sigma_c * p.shape.j[2];
+        assert!(close(
+            s.solution.beta[2],
+            GRAVITY * s.solution.t_e / jv,
+            1e-9
+        ));
+        // Independent: RK4 with the time-scaled force reaches the requested end apex.
+        let mut req = policy_request(&timed, c.k);
+        req.x = c.k * distance_factor(&Prepared::new(timed.clone()), s.solution.t_e);
+        let end = simulate(&timed.model, &req, &s.solution);
+        assert_reaches_end_apex(&end, &req, 1e-6, "time-scaled stance");
+    }
+    assert!(solved >= 40, "only {solved} solved");
+}
+
+// Issue 37 item 1: the cycle's mean speed Σx/ΣT is the target speed exactly, and the law's
+// direction holds: faster means shorter contact, shorter steps and more vertical force.
+#[test]
+fn the_gait_law_hits_the_speed_and_moves_times_the_way_people_do() {
+    let mut rng = Rng::new(0x5eed_0438);
+    let mut checked = 0;
+    for _ in 0..40 {
+        let pair = [
+            running_stance(&mut rng, "a", "L"),
+            running_stance(&mut rng, "b", "R"),
+        ];
+        let q = pair.each_ref().map(|p| p.stance.params);
+        let v_orig = (q[0].x + q[1].x) / (q[0].t_e + q[1].t_e);
+        let lim = relative_limits(&pair[0].stance.coef);
+        let law = GaitLaw::POPULATION;
+        let at = |v: f64| run_at_speed([&pair[0], &pair[1]], v_orig, v, &law, [&lim, &lim]);
+        let (slow, fast) = (at(0.8 * v_orig), at(1.3 * v_orig));
+        let (Ok(s0), Ok(s1), Ok(f0), Ok(f1)) = (
+            &slow.stances[0],
+            &slow.stances[1],
+            &fast.stances[0],
+            &fast.stances[1],
+        ) else {
+            continue;
+        };
+        checked += 1;
+        // Mean speed of each answer: x = k·x̂ per stance over the solved periods.
+        for (c, a, b) in [(&slow, s0, s1), (&fast, f0, f1)] {
+            let x: f64 = [0, 1]
+                .iter()
+                .map(|&i| {
+                    let t = Prepared::new(pair[i].stance.time_scaled(c.timing.sigma_c));
+                    c.k * distance_factor(&t, [a, b][i].solution.t_e)
+                })
+                .sum();
+            let v = x / (a.solution.t_e + b.solution.t_e);
+            assert!(close(v, c.speed, 1e-9), "mean speed {v} vs {}", c.speed);
+        }
+        assert!(f0.solution.t_lo - f0.solution.t_td < s0.solution.t_lo - s0.solution.t_td);
+        assert!(f0.solution.t_e < s0.solution.t_e);
+        assert!(
+            f0.solution.beta[2] > s0.solution.beta[2],
+            "more vertical force when faster"
+        );
+    }
+    assert!(checked >= 20, "only {checked} checked");
+}
+
 fn solved(c: &RunCandidate) -> [&ScaledStance; 2] {
     c.stances.each_ref().map(|s| s.as_ref().expect("solved"))
 }
@@ -132,17 +265,26 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
             .each_ref()
             .map(|p| Prepared::new(p.stance.scaled(l, m)));
         let big_lim = scale_limits(&lim, l, m);
-        for v in [1.0, 3.0, 5.0] {
-            let a = run_at_speed([&pair[0], &pair[1]], v_orig, v, [&lim, &lim]);
+        for (v, law) in [1.0, 3.0, 5.0]
+            .into_iter()
+            .flat_map(|v| [(v, GaitLaw::PAPER), (v, GaitLaw::POPULATION)])
+        {
+            let a = run_at_speed([&pair[0], &pair[1]], v_orig, v, &law, [&lim, &lim]);
             let b = run_at_speed(
                 [&big[0], &big[1]],
                 v_orig * l.sqrt(),
                 v * l.sqrt(),
+                &law,
                 [&big_lim, &big_lim],
             );
             assert_eq!(a.feasible(), b.feasible());
             assert_eq!(a.feasible_approx(), b.feasible_approx());
             outcomes[usize::from(a.feasible())] += 1;
+            let errs = |c: &RunCandidate| c.stances.each_ref().map(|s| s.as_ref().err().copied());
+            assert_eq!(errs(&a), errs(&b), "the same stances solve");
+            if a.stances.iter().any(|s| s.is_err()) {
+                continue; // a law's slow step without a flight (FlightRule), both sizes alike
+            }
             for (x, y) in solved(&a).iter().zip(solved(&b)) {
                 let (sx, sy): (&Solution, &Solution) = (&x.solution, &y.solution);
                 for k in 0..3 {
