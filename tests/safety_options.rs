@@ -67,6 +67,17 @@ fn a_bad_queries_value_leaves_the_existing_library_byte_identical() {
             5,
             "has no effect without jump_map",
         ),
+        // Issue 37: the gait law is checked like every other query key.
+        (
+            "[queries]\ngait_law = \"paper\"\n",
+            5,
+            "has no effect without run_speeds",
+        ),
+        (
+            "[queries]\nrun_speeds = \"0:6:0.5\"\ngait_law = \"fast\"\n",
+            6,
+            "unknown law 'fast'",
+        ),
     ] {
         write_pipeline(&pipe, &lib, bad);
         let err = refused(&["run", &s(&pipe)], &[needle]);
@@ -253,30 +264,34 @@ fn jump_verdicts(height: &str, distance: &str, extra: &[&str]) -> Vec<((String, 
 }
 
 // See: issue 11 item 11 — `--mu` was ignored under relative limits (the default of
-// `query jump` and `map jumps`).
+// `query jump` and `map jumps` then; issue 37 made absolute limits the default).
 #[test]
 fn mu_acts_under_relative_limits() {
     // On the fixtures every recorded μ_req is small (the jumps push straight up), so
     // 1.05 μ_req refuses these jumps and μ = 0.3 lets some through.
     let (h, d) = ("1.1", "0");
-    let default = jump_verdicts(h, d, &[]);
     let relative = jump_verdicts(h, d, &["--limits", "relative"]);
+    let with_mu = jump_verdicts(h, d, &["--limits", "relative", "--mu", "0.3"]);
     assert_eq!(
-        default, relative,
-        "relative is the default form of query jump"
-    );
-    let with_mu = jump_verdicts(h, d, &["--mu", "0.3"]);
-    assert_eq!(
-        default.iter().map(|r| &r.0).collect::<Vec<_>>(),
+        relative.iter().map(|r| &r.0).collect::<Vec<_>>(),
         with_mu.iter().map(|r| &r.0).collect::<Vec<_>>()
     );
-    assert!(!default.is_empty());
+    assert!(!relative.is_empty());
     assert_ne!(
-        default, with_mu,
+        relative, with_mu,
         "--mu 0.3 changed no verdict under relative limits"
     );
     let count = |v: &[((String, String), bool)]| v.iter().filter(|r| r.1).count();
-    assert!(count(&with_mu) > count(&default), "{with_mu:?}");
+    assert!(count(&with_mu) > count(&relative), "{with_mu:?}");
+    // Issue 37 item 4: absolute (a person's) limits are the default, and they let the
+    // recorded jumps go 10 % higher where the ±5 % relative form refuses every one.
+    let default = jump_verdicts(h, d, &[]);
+    let absolute = jump_verdicts(h, d, &["--limits", "absolute"]);
+    assert_eq!(
+        default, absolute,
+        "absolute is the default form of query jump"
+    );
+    assert!(count(&default) > count(&relative), "{default:?}");
 }
 
 // See: issue 11 item 11 (audit) — `twopac --character` without `--lib`, and `--lib`

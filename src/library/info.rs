@@ -15,6 +15,9 @@ use super::schema::{
 };
 use crate::error::{Error, Result};
 
+/// Stances beyond a person's bounds listed by the text summary (`--json` lists all).
+pub const BEYOND_BOUNDS_SHOWN: usize = 10;
+
 /// Counts of each distinct value, sorted by value.
 pub type Counts = BTreeMap<String, usize>;
 
@@ -54,6 +57,9 @@ pub struct LibraryInfo {
     pub options: serde_json::Value,
     /// Per-character limits (manifest `limits`).
     pub limits: serde_json::Value,
+    /// Foot stances beyond what a person's legs do, `(stance_id, why)`
+    /// ([`crate::stances::limits::beyond_bounds`]): their characters' limits are capped.
+    pub beyond_bounds: Vec<(String, String)>,
 }
 
 impl LibraryInfo {
@@ -93,10 +99,28 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
     let m: serde_json::Value = serde_json::from_str(&text)
         .map_err(|e| Error::invalid(mpath.display().to_string(), e.to_string()))?;
     let s = |k: &str| m.get(k).and_then(|v| v.as_str()).map(str::to_string);
-    let clips = Table::open_columns(&lib.join(CLIPS_FILE), &[clips::STATUS, clips::CHARACTER_ID])?;
+    let clips = Table::open_columns(
+        &lib.join(CLIPS_FILE),
+        &[
+            clips::STATUS,
+            clips::CHARACTER_ID,
+            clips::CLIP,
+            clips::LEG_LENGTH,
+        ],
+    )?;
     let stances = Table::open_columns(
         &lib.join(STANCES_FILE),
-        &[S::LABEL, S::BOUNDARY_START, S::BOUNDARY_END, S::FORCE_MODEL],
+        &[
+            S::LABEL,
+            S::BOUNDARY_START,
+            S::BOUNDARY_END,
+            S::FORCE_MODEL,
+            S::STANCE_ID,
+            S::CLIP,
+            S::MASS,
+            S::F_PEAK,
+            S::EXT_MAX,
+        ],
     )?;
     let errors = Table::open_columns(&lib.join(ERRORS_FILE), &[errors::STAGE])?;
     Ok(LibraryInfo {
@@ -118,7 +142,36 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
         failures_by_stage: column_counts(&errors, errors::STAGE)?,
         options: m.get("options").cloned().unwrap_or_default(),
         limits: m.get("limits").cloned().unwrap_or_default(),
+        beyond_bounds: beyond_bounds(&clips, &stances)?,
     })
+}
+
+/// The foot stances of `stances` beyond a person's bounds (legs from `clips`).
+fn beyond_bounds(clips_t: &Table, stances: &Table) -> Result<Vec<(String, String)>> {
+    let legs: BTreeMap<String, f64> = clips_t
+        .strings(clips::CLIP)?
+        .into_iter()
+        .zip(clips_t.opt_f64(clips::LEG_LENGTH)?)
+        .filter_map(|(c, l)| l.map(|l| (c, l)))
+        .collect();
+    let (ids, clip, label) = (
+        stances.strings(S::STANCE_ID)?,
+        stances.strings(S::CLIP)?,
+        stances.strings(S::LABEL)?,
+    );
+    let (mass, f_peak, ext) = (
+        stances.f64s(S::MASS)?,
+        stances.f64s(S::F_PEAK)?,
+        stances.f64s(S::EXT_MAX)?,
+    );
+    Ok((0..ids.len())
+        .filter(|&i| !label[i].contains('H'))
+        .filter_map(|i| {
+            let leg = legs.get(&clip[i])?;
+            crate::stances::limits::beyond_bounds(f_peak[i], mass[i], ext[i], *leg)
+                .map(|why| (ids[i].clone(), why))
+        })
+        .collect())
 }
 
 fn write_counts(f: &mut fmt::Formatter<'_>, title: &str, c: &Counts) -> fmt::Result {
@@ -159,16 +212,37 @@ impl fmt::Display for LibraryInfo {
             writeln!(f, "per-character limits:")?;
             for (id, l) in chars {
                 let g = |k: &str| l.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
-                let from = l.get("source").and_then(|v| v.as_str()).unwrap_or("?");
+                let from = match l.get("source").and_then(|v| v.as_str()).unwrap_or("?") {
+                    "character" => "its own stances",
+                    "size" => "its mass and leg length (fewer than 20 stances)",
+                    other => other,
+                };
                 let n = l.get("n_stances").and_then(|v| v.as_u64()).unwrap_or(0);
                 writeln!(
                     f,
                     "  {id}: mu {:.2}, F_max {:.0} N, chi_min {:.3} m, chi_max {:.3} m \
-                     ({n} stances, from the {from})",
+                     ({n} stances; from {from})",
                     g("mu"),
                     g("f_max_n"),
                     g("chi_min_m"),
                     g("chi_max_m")
+                )?;
+            }
+        }
+        if !self.beyond_bounds.is_empty() {
+            writeln!(
+                f,
+                "stances beyond a person's bounds ({}; their characters' limits are capped there):",
+                self.beyond_bounds.len()
+            )?;
+            for (id, why) in self.beyond_bounds.iter().take(BEYOND_BOUNDS_SHOWN) {
+                writeln!(f, "  {id}: {why}")?;
+            }
+            if self.beyond_bounds.len() > BEYOND_BOUNDS_SHOWN {
+                writeln!(
+                    f,
+                    "  … {} more (`info --json` lists every one)",
+                    self.beyond_bounds.len() - BEYOND_BOUNDS_SHOWN
                 )?;
             }
         }

@@ -168,7 +168,7 @@ pub fn edit_jump(e: &JumpEdit) -> anyhow::Result<EditReport> {
             anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
         }
     }
-    let limits = t.edit_limits(LimitForm::Relative)?;
+    let limits = t.edit_limits(LimitForm::Absolute)?;
     let (lib, pool) = load_pool(&t.lib, limits.active)?;
     let times = timing(&t.lib)?;
     let chosen = choose_jump(&lib, &pool, &e.jump, limits)

@@ -142,11 +142,12 @@ fn floats(df: &DataFrame, col: &str) -> Vec<Option<f64>> {
 
 /// The facts the limits need of the stances of a stance table.
 fn stance_facts(s: &DataFrame) -> Vec<StanceFacts> {
-    let (clip, ch, b0, b1) = (
+    let (clip, ch, b0, b1, label) = (
         strings(s, S::CLIP),
         strings(s, S::CHARACTER_ID),
         strings(s, S::BOUNDARY_START),
         strings(s, S::BOUNDARY_END),
+        strings(s, S::LABEL),
     );
     let (m, fp, e0, e1) = (
         floats(s, S::MASS),
@@ -163,6 +164,7 @@ fn stance_facts(s: &DataFrame) -> Vec<StanceFacts> {
             ext_min: e0[i].unwrap_or(f64::INFINITY),
             ext_max: e1[i].unwrap_or(0.0),
             unsupported: b0[i] == "unsupported" || b1[i] == "unsupported",
+            hands: label[i].contains('H'),
             count: 1,
         })
         .collect()

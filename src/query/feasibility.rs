@@ -14,8 +14,9 @@
 //! U_h = vs Δt τ − cp_h,  U_p = vps Δt τ − cp_p,  U_v = −g t_TD Δt τ − ½ g Δt² τ² + z_TD
 //! ```
 //!
-//! and a candidate is feasible iff (every comparison `≤`, so the identity query at its own
-//! extremes is feasible):
+//! and a candidate is feasible iff (every comparison `≤` with a relative round-off
+//! tolerance [`LIMIT_REL_TOL`] on the limit, so the identity query at its own extremes is
+//! feasible):
 //!
 //! ```text
 //! (5) β_a ≥ 0   (6) F_peak ≤ F_max   (7) μ_req ≤ μ and f_v ≥ −0.05 max f_v on all of [0, 1]
@@ -96,6 +97,13 @@ pub const SINGULAR_REL: f64 = 1e-12;
 /// stay at the paper's [`crate::constraints::ACTIVE_FRACTION`].
 pub const DEFAULT_QUERY_ACTIVE_FRACTION: f64 = crate::constraints::ROBUST_ACTIVE_FRACTION;
 
+/// Relative round-off tolerance of the exact check's limits: a value within
+/// `LIMIT_REL_TOL × limit` of a limit meets it (`F_max`, `χ_max`, `μ` grow by the factor
+/// `1 + LIMIT_REL_TOL`, `χ_min` shrinks by `1 − LIMIT_REL_TOL`). The closed forms reproduce
+/// a recorded stance to ~1e-12 relative; a recorded jump solved back at its own height and
+/// distance missed its own extension limit by 6e-11 (relative) without it.
+pub const LIMIT_REL_TOL: f64 = 1e-9;
+
 /// Checks a friction limit given by the user (`--mu`, `[constraints] mu`): a positive
 /// finite number.
 ///
@@ -120,6 +128,21 @@ pub struct Limits {
     pub chi_min: f64,
     /// Longest leg extension `χ_max`, m.
     pub chi_max: f64,
+}
+
+impl Limits {
+    /// The limits as the exact check applies them: `F_max`, `χ_max`, `μ` times
+    /// `1 + LIMIT_REL_TOL`, `χ_min` times `1 − LIMIT_REL_TOL` (the margins the tables
+    /// report are to these, so a margin ≥ 0 is exactly a limit met).
+    pub fn effective(&self) -> Limits {
+        let (up, down) = (1.0 + LIMIT_REL_TOL, 1.0 - LIMIT_REL_TOL);
+        Limits {
+            mu: self.mu * up,
+            f_max: self.f_max * up,
+            chi_min: self.chi_min * down,
+            chi_max: self.chi_max * up,
+        }
+    }
 }
 
 /// Which limits a query checks (§7.5): `Absolute` per character (`query run`'s default),
@@ -291,6 +314,7 @@ impl Setup {
         let (max_fv, unilateral_ok) = (tables.max_f_v, tables.unilateral_ok);
         let nan = max_fv.is_nan();
         let dt = model.dt_s;
+        let lim = lim.effective();
         Setup {
             beta,
             force: SqrtLe::new(lim.f_max),

@@ -39,6 +39,7 @@ pub fn absolute_limits(lib: &StanceLibrary) -> BTreeMap<String, Limits> {
             ext_min: s.coef.ext_min,
             ext_max: s.coef.ext_max,
             unsupported: [s.boundary_start, s.boundary_end].contains(&Boundary::Unsupported),
+            hands: s.label.contains('H'),
             count: 1,
         })
         .collect();
@@ -59,26 +60,59 @@ pub fn absolute_limits(lib: &StanceLibrary) -> BTreeMap<String, Limits> {
         .collect()
 }
 
-/// A stance's limits under `form`: its character's absolute ones or its own relative
-/// ones, with μ replaced by `mu` when given (`--mu` acts under both forms, §7.5: "each
-/// limit takes either form").
+/// A stance's limits under `form`: its character's absolute ones, widened to the stance's
+/// own recorded extremes (what the person did is possible for the person, so the
+/// recorded stance is feasible as recorded), or its own relative ones (±5 %); μ replaced
+/// by `mu` when given (`--mu` acts under both forms, §7.5: "each limit takes either form").
+///
+/// ```text
+/// absolute: μ = max(μ_char, μ_req),  F_max = max(F_char, F_peak),
+///           χ_max = max(χ_char, ext_max),  χ_min = min(χ_char, ext_min)
+/// ```
 pub fn stance_limits(
     p: &Prepared,
     form: LimitForm,
     absolute: &BTreeMap<String, Limits>,
     mu: Option<f64>,
 ) -> Limits {
+    let c = &p.stance.coef;
     let l = match form {
-        LimitForm::Relative => relative_limits(&p.stance.coef),
-        LimitForm::Absolute => absolute
-            .get(&p.stance.character_id)
-            .copied()
-            .unwrap_or_else(|| relative_limits(&p.stance.coef)),
+        LimitForm::Relative => relative_limits(c),
+        LimitForm::Absolute => match absolute.get(&p.stance.character_id) {
+            Some(a) => Limits {
+                mu: a.mu.max(c.mu_req),
+                f_max: a.f_max.max(c.f_peak),
+                chi_min: a.chi_min.min(c.ext_min),
+                chi_max: a.chi_max.max(c.ext_max),
+            },
+            None => relative_limits(c),
+        },
     };
     Limits {
         mu: mu.unwrap_or(l.mu),
         ..l
     }
+}
+
+/// The library's foot stances beyond what a person's legs do
+/// ([`crate::stances::limits::beyond_bounds`]): `(stance_id, why)`, in library order.
+/// Their characters' limits are capped there; the stances themselves stay feasible as
+/// recorded.
+pub fn implausible(lib: &StanceLibrary) -> Vec<(String, String)> {
+    lib.stances
+        .iter()
+        .filter(|s| !s.label.contains('H'))
+        .filter_map(|s| {
+            let leg = lib.clips.get(&s.clip).and_then(|c| c.leg_m)?;
+            crate::stances::limits::beyond_bounds(
+                s.coef.f_peak,
+                s.model.mass_kg,
+                s.coef.ext_max,
+                leg,
+            )
+            .map(|why| (s.stance_id.clone(), why))
+        })
+        .collect()
 }
 
 /// Whether a clip's flights say its time base is wrong (`s_eff` outside

@@ -1,13 +1,21 @@
-//! Default constraint limits per character (spec stance-model §7.5).
+//! Default constraint limits per character (spec stance-model §7.5, with the bounds of a
+//! person's legs: a departure, `docs/stance-model.md` §7.5).
 //!
 //! # Model
 //! ```text
 //! μ = 0.7
-//! F_max = 1.05 · max F_peak,   χ_max = 1.05 · max ext_max,   χ_min = min ext_min / 1.05
-//! over the character's eligible stances; with fewer than 20, over every eligible stance of
-//! the library scaled to the character (F_peak by M = m_char/m_s, ext by L = L_char/L_s).
-//! eligible: no `unsupported` boundary, and the clip's s_eff is null or within [0.9, 1.1]
+//! F_max = min(1.05 · max F_peak, 6 m g)
+//! χ_max = min(1.05 · max ext_max, 1.5 L_leg),   χ_min = max(min ext_min / 1.05, 0.5 L_leg)
+//! over the character's eligible stances (at least 20); with fewer, the character's own
+//! size by dynamic similarity:  F_max = max(3.5 m g, 1.05 · max F_peak) (≤ 6 m g),
+//! χ_max = 1.5 L_leg,  χ_min = 0.5 L_leg (the bounds themselves)
+//! eligible: locomotion on the feet (no hand in the label, no `unsupported` boundary), and
+//! the clip's s_eff is null or within [0.9, 1.1]
 //! ```
+//! A query checks a stance against `max(character limit, the stance's own recorded
+//! extreme)` (`query::limits`): what the person did is possible for the person, so every
+//! recorded stance is feasible as recorded, and a stance that did less than its character
+//! can do has room to do more.
 
 use std::collections::BTreeMap;
 
@@ -33,6 +41,8 @@ pub struct StanceFacts {
     pub ext_max: f64,
     /// An `unsupported` boundary on either side.
     pub unsupported: bool,
+    /// A hand supports the stance (label with `LH`/`RH`): not locomotion on the feet.
+    pub hands: bool,
     /// Stances these facts stand for: 1 for one stance; [`group_facts`] folds a clip's
     /// stances of one mass and support into one entry (largest `f_peak` and `ext_max`,
     /// smallest `ext_min`).
@@ -48,7 +58,7 @@ pub struct StanceFacts {
 /// finite and positive keeps an entry of its own.
 pub fn group_facts(facts: Vec<StanceFacts>) -> Vec<StanceFacts> {
     let mut out: Vec<StanceFacts> = Vec::new();
-    let mut at: std::collections::HashMap<(String, String, u64, bool), usize> =
+    let mut at: std::collections::HashMap<(String, String, u64, (bool, bool)), usize> =
         std::collections::HashMap::new();
     for f in facts {
         if !(f.mass_kg.is_finite() && f.mass_kg > 0.0) {
@@ -59,7 +69,7 @@ pub fn group_facts(facts: Vec<StanceFacts>) -> Vec<StanceFacts> {
             f.clip.clone(),
             f.character_id.clone(),
             f.mass_kg.to_bits(),
-            f.unsupported,
+            (f.unsupported, f.hands),
         );
         match at.get(&key) {
             Some(&i) => {
@@ -89,6 +99,7 @@ impl From<&Stance> for StanceFacts {
             ext_max: s.coef.ext_max,
             unsupported: s.boundary_start == Boundary::Unsupported
                 || s.boundary_end == Boundary::Unsupported,
+            hands: s.label.contains('H'),
             count: 1,
         }
     }
@@ -98,8 +109,26 @@ impl From<&Stance> for StanceFacts {
 pub use crate::math::constants::DEFAULT_MU;
 /// Margin on the extremes of the example stances.
 pub const MARGIN: f64 = 1.05;
-/// Below this many eligible stances a character uses the library-wide values.
+/// Below this many eligible stances a character's limits come from its size (the
+/// population limits below, by dynamic similarity).
 pub const MIN_CHARACTER_STANCES: usize = 20;
+/// No character's force limit exceeds this many body weights (a stance above it is named
+/// by `query::limits::implausible`).
+pub const F_MAX_CAP_BW: f64 = 6.0;
+/// No character's `χ_max` exceeds this many leg lengths.
+pub const CHI_MAX_CAP_LEG: f64 = 1.5;
+/// No character's `χ_min` falls below this many leg lengths.
+pub const CHI_MIN_FLOOR_LEG: f64 = 0.5;
+/// The force limit of a character with few stances, body weights: about the 99th
+/// percentile of the locomotion stances' peak force in the shared and bulk sets (3.4 BW).
+pub const POPULATION_F_MAX_BW: f64 = 3.5;
+/// `χ_max` of a character with few stances, leg lengths: the bound itself (the locomotion
+/// stances' median is 1.16, their 95th percentile 1.64; a runner's stance at 4 m/s reaches
+/// 1.33 on the force plates).
+pub const POPULATION_CHI_MAX_LEG: f64 = CHI_MAX_CAP_LEG;
+/// `χ_min` of a character with few stances, leg lengths: the bound itself (the locomotion
+/// stances' 1st percentile is 0.64).
+pub const POPULATION_CHI_MIN_LEG: f64 = CHI_MIN_FLOOR_LEG;
 /// Clips whose effective time scale lies outside this range do not set limits.
 pub const S_EFF_RANGE: (f64, f64) = (0.9, 1.1);
 
@@ -118,7 +147,8 @@ pub struct CharacterLimits {
     pub chi_max_m: f64,
     /// Eligible stances of the character.
     pub n_stances: usize,
-    /// `character` or `library` (fewer than 20 stances).
+    /// `character`, or `size` (fewer than 20 stances: the population limits scaled to the
+    /// character's mass and leg length).
     pub source: String,
 }
 
@@ -130,12 +160,56 @@ pub struct ClipFacts {
     pub leg_m: f64,
 }
 
+/// Why a foot stance lies beyond what a person's legs do (peak force above
+/// [`F_MAX_CAP_BW`] body weights, COM–contact distance above [`CHI_MAX_CAP_LEG`] leg
+/// lengths), or `None`. `f_peak` N, `mass` kg, `ext_max` and `leg` m.
+pub fn beyond_bounds(f_peak: f64, mass: f64, ext_max: f64, leg: f64) -> Option<String> {
+    let bw = f_peak / (mass * crate::math::constants::GRAVITY);
+    let ext = ext_max / leg;
+    let mut why = Vec::new();
+    if bw > F_MAX_CAP_BW {
+        why.push(format!("peak force {bw:.1} body weights > {F_MAX_CAP_BW}"));
+    }
+    if ext > CHI_MAX_CAP_LEG {
+        why.push(format!(
+            "COM–contact {ext:.2} leg lengths > {CHI_MAX_CAP_LEG}"
+        ));
+    }
+    (!why.is_empty()).then(|| why.join(", "))
+}
+
 fn eligible(s: &StanceFacts, clip: Option<&ClipFacts>) -> bool {
-    let unsupported = s.unsupported;
     let s_eff_ok = clip
         .and_then(|c| c.s_eff)
         .is_none_or(|v| (S_EFF_RANGE.0..=S_EFF_RANGE.1).contains(&v));
-    !unsupported && s_eff_ok
+    !s.unsupported && !s.hands && s_eff_ok
+}
+
+/// One character's limits from its eligible stances `own` (see the module docs); `mass`
+/// in kg, `leg` in m.
+fn character_limits(own: &[&StanceFacts], mass: f64, leg: f64) -> CharacterLimits {
+    let n_own: usize = own.iter().map(|s| s.count).sum();
+    let bw = mass * crate::math::constants::GRAVITY;
+    let f_peak = own.iter().map(|s| s.f_peak).fold(0.0, f64::max);
+    let ext_max = own.iter().map(|s| s.ext_max).fold(0.0, f64::max);
+    let ext_min = own.iter().map(|s| s.ext_min).fold(f64::INFINITY, f64::min);
+    let (mut f, mut hi, mut lo) = (MARGIN * f_peak, MARGIN * ext_max, ext_min / MARGIN);
+    let source = if n_own >= MIN_CHARACTER_STANCES {
+        "character"
+    } else {
+        f = f.max(POPULATION_F_MAX_BW * bw);
+        hi = hi.max(POPULATION_CHI_MAX_LEG * leg);
+        lo = lo.min(POPULATION_CHI_MIN_LEG * leg);
+        "size"
+    };
+    CharacterLimits {
+        mu: DEFAULT_MU,
+        f_max_n: f.min(F_MAX_CAP_BW * bw),
+        chi_min_m: lo.max(CHI_MIN_FLOOR_LEG * leg),
+        chi_max_m: hi.min(CHI_MAX_CAP_LEG * leg),
+        n_stances: n_own,
+        source: source.to_string(),
+    }
 }
 
 /// Limits per `character_id` (sorted map, deterministic).
@@ -162,39 +236,7 @@ pub fn limits(
                 .copied()
                 .filter(|s| s.character_id == id)
                 .collect();
-            // Library-wide values are scaled to the character: force by M, lengths by L.
-            let n_own: usize = own.iter().map(|s| s.count).sum();
-            let (pool, scale, source) = if n_own >= MIN_CHARACTER_STANCES {
-                (&own, None, "character")
-            } else {
-                (&ok, Some((mass, leg_c)), "library")
-            };
-            let m_scale = |s: &StanceFacts| scale.map_or(1.0, |(m, _)| m / s.mass_kg);
-            let l_scale = |s: &StanceFacts| scale.map_or(1.0, |(_, l)| l / leg(s));
-            let f_peak = pool
-                .iter()
-                .map(|s| s.f_peak * m_scale(s))
-                .fold(0.0, f64::max);
-            let ext_max = pool
-                .iter()
-                .map(|s| s.ext_max * l_scale(s))
-                .fold(0.0, f64::max);
-            let ext_min = pool
-                .iter()
-                .map(|s| s.ext_min * l_scale(s))
-                .fold(f64::INFINITY, f64::min);
-            let lim = CharacterLimits {
-                mu: DEFAULT_MU,
-                f_max_n: MARGIN * f_peak,
-                chi_min_m: if ext_min.is_finite() {
-                    ext_min / MARGIN
-                } else {
-                    0.0
-                },
-                chi_max_m: MARGIN * ext_max,
-                n_stances: n_own,
-                source: source.to_string(),
-            };
+            let lim = character_limits(&own, mass, leg_c);
             (id, lim)
         })
         .collect()
@@ -228,6 +270,7 @@ mod tests {
                     ext_min: rng.uniform(0.6, 0.9),
                     ext_max: rng.uniform(0.9, 1.2),
                     unsupported: rng.next_f64() < 0.2,
+                    hands: rng.next_f64() < 0.1,
                     count: 1,
                 });
             }
@@ -246,7 +289,7 @@ mod tests {
             let n = f.len();
             let grouped = group_facts(f.clone());
             assert!(
-                grouped.len() <= 2 * clips && grouped.len() < n,
+                grouped.len() <= 4 * clips && grouped.len() < n,
                 "{clips} clips"
             );
             assert_eq!(grouped.iter().map(|g| g.count).sum::<usize>(), n);
@@ -265,5 +308,71 @@ mod tests {
                 }
             }
         }
+    }
+
+    fn fact(character: &str, mass: f64, f_peak: f64, ext: (f64, f64), hands: bool) -> StanceFacts {
+        StanceFacts {
+            clip: format!("{character}_clip"),
+            character_id: character.into(),
+            mass_kg: mass,
+            f_peak,
+            ext_min: ext.0,
+            ext_max: ext.1,
+            unsupported: false,
+            hands,
+            count: 1,
+        }
+    }
+
+    // Issue 37 item 4: a person's limits: outliers capped by body weight and leg length,
+    // hand-supported stances left out, a character with few stances limited by its own
+    // size whatever the other characters did.
+    #[test]
+    fn limits_are_a_persons() {
+        let (m, leg) = (70.0, 0.9);
+        let bw = m * crate::math::constants::GRAVITY;
+        let mut f: Vec<StanceFacts> = (0..30)
+            .map(|i| fact("a", m, (1.5 + 0.02 * i as f64) * bw, (0.8, 1.1), false))
+            .collect();
+        f.push(fact("a", m, 8.0 * bw, (0.8, 1.2), false)); // a clip-edge artefact
+        f.push(fact("a", m, 1.2 * bw, (0.1, 4.0), true)); // hanging from a bar
+        f.push(fact("b", 50.0, 2.0 * 50.0 * 9.81, (0.7, 1.0), false));
+        let clips: BTreeMap<String, ClipFacts> = ["a_clip", "b_clip"]
+            .iter()
+            .map(|c| {
+                (
+                    c.to_string(),
+                    ClipFacts {
+                        s_eff: None,
+                        leg_m: leg,
+                    },
+                )
+            })
+            .collect();
+        let l = limits(&f, &clips);
+        let (a, b) = (&l["a"], &l["b"]);
+        assert_eq!((a.source.as_str(), a.n_stances), ("character", 31));
+        assert!(
+            (a.f_max_n - F_MAX_CAP_BW * bw).abs() < 1e-9,
+            "capped at 6 BW: {a:?}"
+        );
+        assert!(
+            (a.chi_max_m - MARGIN * 1.2).abs() < 1e-12,
+            "the bar's 4 m left out: {a:?}"
+        );
+        assert!((a.chi_min_m - 0.8 / MARGIN).abs() < 1e-12);
+        assert_eq!((b.source.as_str(), b.n_stances), ("size", 1));
+        let bw_b = 50.0 * crate::math::constants::GRAVITY;
+        assert!(
+            (b.f_max_n - POPULATION_F_MAX_BW * bw_b).abs() < 1e-9,
+            "{b:?}"
+        );
+        assert!((b.chi_max_m - POPULATION_CHI_MAX_LEG * leg).abs() < 1e-12);
+        assert!((b.chi_min_m - POPULATION_CHI_MIN_LEG * leg).abs() < 1e-12);
+        // Another character's extremes never reach b.
+        f.push(fact("a", m, 5.9 * bw, (0.3, 1.45), false));
+        assert_eq!(limits(&f, &clips)["b"], *b);
+        assert!(beyond_bounds(8.0 * bw, m, 1.0, leg).is_some());
+        assert!(beyond_bounds(2.0 * bw, m, 1.0, leg).is_none());
     }
 }
