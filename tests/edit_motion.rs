@@ -939,9 +939,9 @@ fn edited_runs_follow_the_gait_law_of_the_query() {
             "--quiet",
         ]);
         let t = stancelib::library::read::Table::open(&q).unwrap();
-        let ids = t.df.column("stance_ids").unwrap().list().unwrap().clone();
-        let row = (0..t.height())
-            .find(|&i| ids.get_as_series(i).unwrap().str().unwrap().get(0) == Some(id.as_str()))
+        let row = super::util::first_stance_ids(&t)
+            .iter()
+            .position(|x| *x == id)
             .expect("the cycle is answered");
         let want_c = t.f64_lists("contact_time_s", Some(2)).unwrap()[row][0];
         let want_t = t.f64_lists("step_period_s", Some(2)).unwrap()[row][0];

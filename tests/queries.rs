@@ -11,7 +11,7 @@ use stancelib::pipeline::batch::discover;
 use stancelib::pipeline::build::{build_and_write, BuildOptions};
 use stancelib::query::jump::{is_landing, is_liftoff, recorded_jump};
 
-use crate::util::{ok, shared_or_skip, stancelib};
+use crate::util::{first_stance_ids, ok, shared_or_skip, stancelib, string_at};
 
 /// The shared library, built once per test binary into a folder that lives as long.
 fn shared_library() -> Option<&'static Path> {
@@ -129,6 +129,44 @@ fn run_sweep_reproduces_table_one_pattern() {
 /// constant in flight), and `β_h` departs from 1 by `|u_apex − ve1|/|J_h1|` (a vertical
 /// jump, with small `J_h`, amplifies it). The test checks β_v within 5 % (the two models
 /// agree on the apex height), and feasibility wherever every β is within 5 % of 1.
+/// The slack columns of a `query jump` row, one per side and limit.
+const MARGINS: [&str; 8] = [
+    "margin_force1_n",
+    "margin_mu1",
+    "margin_ext_min1_m",
+    "margin_ext_max1_m",
+    "margin_force2_n",
+    "margin_mu2",
+    "margin_ext_min2_m",
+    "margin_ext_max2_m",
+];
+
+/// `query jump --height h --distance d` on `lib` into `out`: the table and the row of the
+/// pair `(liftoff, landing)`.
+fn jump_pair_row(lib: &Path, h: f64, d: f64, pair: (&str, &str), out: &Path) -> (Table, usize) {
+    ok(&[
+        "query",
+        "jump",
+        "--lib",
+        &lib.display().to_string(),
+        "--height",
+        &h.to_string(),
+        &format!("--distance={d}"),
+        "--out",
+        &out.display().to_string(),
+        "--quiet",
+    ]);
+    let t = Table::open(out).unwrap();
+    let (up, down) = (
+        t.strings("liftoff_stance_id").unwrap(),
+        t.strings("landing_stance_id").unwrap(),
+    );
+    let row = (0..t.height())
+        .find(|&r| up[r] == pair.0 && down[r] == pair.1)
+        .expect("the recorded pair is a candidate");
+    (t, row)
+}
+
 #[test]
 fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
     let Some(lib) = shared_library() else { return };
@@ -161,33 +199,9 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
         }
         let (h, d) = recorded_jump(s1, s2);
         let out = lib.parent().unwrap().join(format!("jump{n}.parquet"));
-        ok(&[
-            "query",
-            "jump",
-            "--lib",
-            &lib.display().to_string(),
-            "--height",
-            &h.to_string(),
-            &format!("--distance={d}"),
-            "--out",
-            &out.display().to_string(),
-        ]);
-        let t = Table::open(&out).unwrap();
-        let (up, down) = (
-            t.strings("liftoff_stance_id").unwrap(),
-            t.strings("landing_stance_id").unwrap(),
-        );
-        let row = (0..t.height())
-            .find(|&i| up[i] == s1.stance_id && down[i] == s2.stance_id)
-            .expect("the recorded pair is a candidate");
+        let (t, row) = jump_pair_row(lib, h, d, (&s1.stance_id, &s2.stance_id), &out);
         let feasible = t.bools("feasible").unwrap()[row];
-        let why =
-            t.df.column("violated")
-                .unwrap()
-                .str()
-                .unwrap()
-                .get(row)
-                .map(str::to_string);
+        let why = string_at(&t, "violated", row);
         let get =
             |c: &str| t.opt_f64(c).unwrap()[row].unwrap_or_else(|| panic!("{c} null: {why:?}"));
         let [bh1, bv1, bh2, bv2] = ["beta_h1", "beta_v1", "beta_h2", "beta_v2"].map(get);
@@ -201,17 +215,7 @@ fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
             "β_v {bv1}, {bv2}"
         );
         // The reported margins agree with the verdict: all met iff feasible.
-        let margins = [
-            "margin_force1_n",
-            "margin_mu1",
-            "margin_ext_min1_m",
-            "margin_ext_max1_m",
-            "margin_force2_n",
-            "margin_mu2",
-            "margin_ext_min2_m",
-            "margin_ext_max2_m",
-        ]
-        .map(get);
+        let margins = MARGINS.map(get);
         assert_eq!(
             margins.iter().all(|&m| m >= 0.0),
             feasible,
@@ -513,7 +517,6 @@ fn recorded_jumps_can_go_higher_under_a_persons_limits() {
     let Some(lib) = nightly_library() else { return };
     let stances = stancelib::library::read::read_stances(&lib.join("stances.parquet")).unwrap();
     let clips = stancelib::library::read::read_clip_info(&lib.join("clips.parquet")).unwrap();
-    let l = lib.display().to_string();
     // Each stance's heading (unit, horizontal): a pair whose two headings differ by more
     // than 45° turned in the air, which the straight-jump model cannot compose.
     let t = Table::open(&lib.join("stances.parquet")).unwrap();
@@ -554,51 +557,16 @@ fn recorded_jumps_can_go_higher_under_a_persons_limits() {
                 .parent()
                 .unwrap()
                 .join(format!("higher_{i}_{name}.parquet"));
-            let o = out.display().to_string();
-            ok(&[
-                "query",
-                "jump",
-                "--lib",
-                &l,
-                "--height",
-                &h.to_string(),
-                &format!("--distance={d}"),
-                "--out",
-                &o,
-                "--quiet",
-            ]);
-            let t = Table::open(&out).unwrap();
-            let (up, down) = (
-                t.strings("liftoff_stance_id").unwrap(),
-                t.strings("landing_stance_id").unwrap(),
-            );
-            let row = (0..t.height())
-                .find(|&r| up[r] == s1.stance_id && down[r] == s2.stance_id)
-                .expect("the recorded pair is a candidate");
-            let why =
-                t.df.column("violated")
-                    .unwrap()
-                    .str()
-                    .unwrap()
-                    .get(row)
-                    .map(str::to_string);
-            let margins: Vec<String> = [
-                "margin_force1_n",
-                "margin_mu1",
-                "margin_ext_min1_m",
-                "margin_ext_max1_m",
-                "margin_force2_n",
-                "margin_mu2",
-                "margin_ext_min2_m",
-                "margin_ext_max2_m",
-            ]
-            .iter()
-            .filter_map(|c| {
-                t.opt_f64(c).unwrap()[row]
-                    .filter(|m| *m < 0.0)
-                    .map(|m| format!("{c} {m:.3}"))
-            })
-            .collect();
+            let (t, row) = jump_pair_row(lib, h, d, (&s1.stance_id, &s2.stance_id), &out);
+            let why = string_at(&t, "violated", row);
+            let margins: Vec<String> = MARGINS
+                .iter()
+                .filter_map(|c| {
+                    t.opt_f64(c).unwrap()[row]
+                        .filter(|m| *m < 0.0)
+                        .map(|m| format!("{c} {m:.3}"))
+                })
+                .collect();
             (t.bools("feasible").unwrap()[row], why, margins)
         };
         let (ok_own, why_own, _) = ask(h, "own");
@@ -640,17 +608,6 @@ fn recorded_jumps_can_go_higher_under_a_persons_limits() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// The first stance id of each row of a `query run` table (its cycle).
-fn first_stance_ids(t: &Table) -> Vec<String> {
-    let lists = t.df.column("stance_ids").unwrap().list().unwrap().clone();
-    (0..t.height())
-        .map(|i| {
-            let s = lists.get_as_series(i).unwrap();
-            s.str().unwrap().get(0).unwrap().to_string()
-        })
-        .collect()
-}
-
 // See: issue 37 item 3 — every recorded run cycle of the shared + bulk + force-plate
 // library is feasible at its own speed under the default gait law and limits.
 #[test]
@@ -690,13 +647,7 @@ fn every_recorded_cycle_is_feasible_at_its_own_speed() {
             .position(|x| x == first)
             .expect("the cycle is in the table");
         let feasible = o.bools("feasible").unwrap()[row];
-        let violated =
-            o.df.column("violated")
-                .unwrap()
-                .str()
-                .unwrap()
-                .get(row)
-                .map(str::to_string);
+        let violated = string_at(&o, "violated", row);
         if !feasible {
             failures.push(format!("{first} at its own {v:.3} m/s: {violated:?}"));
         }

@@ -10,7 +10,9 @@ use std::path::Path;
 
 use stancelib::library::read::Table;
 
-use crate::util::{csv_col, forceplate_clip, ok, read_csv, shared_or_skip, ForcePlateClip};
+use crate::util::{
+    csv_col, first_stance_ids, forceplate_clip, ok, read_csv, shared_or_skip, ForcePlateClip,
+};
 
 /// The runs with plates, by runner: `(clip, runner)`.
 const RUNS: [(&str, &str); 3] = [
@@ -130,11 +132,7 @@ fn query(lib: &Path, speed: f64, out: &Path) -> Predicted {
     let used = t.bools("used").unwrap();
     let feasible = t.bools("feasible").unwrap();
     let laws = t.strings("gait_law").unwrap();
-    let ids = t.df.column("stance_ids").unwrap().list().unwrap().clone();
-    let first_id = |i: usize| {
-        let s = ids.get_as_series(i).unwrap();
-        s.str().unwrap().get(0).unwrap().to_string()
-    };
+    let ids = first_stance_ids(&t);
     let lists = |c: &str| t.f64_lists(c, None).unwrap();
     let (contact, step, peak, mu) = (
         lists("contact_time_s"),
@@ -156,7 +154,7 @@ fn query(lib: &Path, speed: f64, out: &Path) -> Predicted {
         used: rows.len(),
         feasible: good.len(),
         law: rows.first().map_or("-".into(), |&i| laws[i].clone()),
-        cycles: good.iter().map(|&i| first_id(i)).collect(),
+        cycles: good.iter().map(|&i| ids[i].clone()).collect(),
         contact_s: pick(&contact),
         step_s: pick(&step),
         peak_n: pick(&peak),

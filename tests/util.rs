@@ -515,3 +515,24 @@ pub fn parquet_kv(path: &Path) -> std::collections::BTreeMap<String, String> {
         .map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default()))
         .collect()
 }
+
+/// The string column `name` of `t` at `row` (`None` where null).
+pub fn string_at(t: &stancelib::library::read::Table, name: &str, row: usize) -> Option<String> {
+    t.df.column(name)
+        .unwrap_or_else(|_| panic!("no column {name}"))
+        .str()
+        .unwrap_or_else(|_| panic!("{name} is not a string column"))
+        .get(row)
+        .map(str::to_string)
+}
+
+/// The first stance id of each row of a `query run` table: the row's cycle.
+pub fn first_stance_ids(t: &stancelib::library::read::Table) -> Vec<String> {
+    let lists = t.df.column("stance_ids").unwrap().list().unwrap().clone();
+    (0..t.height())
+        .map(|i| {
+            let s = lists.get_as_series(i).unwrap();
+            s.str().unwrap().get(0).unwrap().to_string()
+        })
+        .collect()
+}
