@@ -51,13 +51,13 @@ pub fn run_merge(a: MergeArgs) -> anyhow::Result<Outcome> {
     };
     let s = merge_into(&a.shards, &a.out, &rules, a.layout.into())
         .with_context(|| format!("merging into {}", a.out.display()))?;
-    println!(
+    crate::cli::print_line(format_args!(
         "{} shards merged: {} clips, {} failed; library in {}",
         s.shards,
         s.clips,
         s.failed,
         a.out.display()
-    );
+    ));
     Ok(match s.failed {
         0 => Outcome::Clean,
         f if f == s.clips => Outcome::AllFailed,
