@@ -120,6 +120,19 @@ pub enum ErrorKind {
         /// What is wrong, with the value found.
         msg: String,
     },
+    /// A file the tool reads cannot be read at all (a side input: a pipeline, body,
+    /// phases, contacts, points or plates file, `twopac --clip`): `problem` says why,
+    /// with the OS reason, in the error's chain (`{:#}`).
+    #[error("{}: cannot read {what}", path.display())]
+    Input {
+        /// The file.
+        path: PathBuf,
+        /// What the file is (`body file`, `--points table`).
+        what: &'static str,
+        /// Why it cannot be read.
+        #[source]
+        problem: InputProblem,
+    },
     /// An input asks for more work or memory than a documented limit allows; checked
     /// before the work starts (README "Limits").
     #[error("{field}: {found} {what}, more than the limit of {max} ({limit})")]
@@ -238,6 +251,17 @@ impl Error {
         .into()
     }
 
+    /// An input error: the file at `path`, read as `what`, cannot be read because of
+    /// `problem`.
+    pub fn input(path: impl Into<PathBuf>, what: &'static str, problem: InputProblem) -> Self {
+        ErrorKind::Input {
+            path: path.into(),
+            what,
+            problem,
+        }
+        .into()
+    }
+
     /// Attach a file path to a BVH or configuration error that has none.
     pub fn with_path(mut self, p: &std::path::Path) -> Self {
         match &mut self.kind {
@@ -248,6 +272,58 @@ impl Error {
         }
         self
     }
+}
+
+/// Why an input cannot be read; every variant that comes from the system keeps its
+/// error (the OS reason). Found by `pipeline::inputs` (the only place that inspects
+/// inputs), for BVH clips and side inputs alike.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum InputProblem {
+    /// Nothing at that path.
+    #[error("not found: {0}")]
+    NotFound(std::io::Error),
+    /// A symbolic link whose target does not exist.
+    #[error("dangling symbolic link to {}: {err}", target.display())]
+    DanglingLink {
+        /// Where the link points.
+        target: PathBuf,
+        /// The system's error on following it.
+        err: std::io::Error,
+    },
+    /// Too many levels of symbolic links.
+    #[error("symbolic link loop: {0}")]
+    LinkLoop(std::io::Error),
+    /// The path or a folder on it is not accessible.
+    #[error("permission denied: {0}")]
+    PermissionDenied(std::io::Error),
+    /// A folder that cannot be listed.
+    #[error("folder cannot be listed: {0}")]
+    UnlistableFolder(std::io::Error),
+    /// A folder where a file is expected (listed, but gone before it was read).
+    #[error("is a folder, not a file")]
+    Folder,
+    /// A FIFO, socket or device (never opened: reading one could block or never end).
+    #[error("is a {}{kind}, not a regular file: only regular files are read", if *via_link { "symbolic link to a " } else { "" })]
+    NotRegular {
+        /// What it is.
+        kind: &'static str,
+        /// Reached through a symbolic link.
+        via_link: bool,
+    },
+    /// Larger than the limit of its kind (`MAX_BVH_BYTES` for a clip, README "Inputs").
+    #[error("{bytes} bytes is more than the limit of {max} bytes ({limit})")]
+    TooLarge {
+        /// Size of the file, bytes (or bytes read before the limit was passed).
+        bytes: u64,
+        /// The limit, bytes.
+        max: u64,
+        /// The name of the constant that defines the limit (`MAX_BVH_BYTES`).
+        limit: &'static str,
+    },
+    /// Any other failure to inspect, open or read.
+    #[error("cannot read: {0}")]
+    Other(std::io::Error),
 }
 
 /// Longest excerpt of raw input echoed in an error message, characters; longer excerpts

@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 
 use stancelib::force_model::export::StanceTimes;
 use stancelib::library::forces::{read_force_stances, read_up_axis, FORCES_COLUMNS};
-use stancelib::library::plates::{read_plates, PlateFoot};
+use stancelib::library::plates::PlateFoot;
 use stancelib::library::read::Table;
+use stancelib::pipeline::plots::read_plates;
 use stancelib::plot::stance::STANCE_PLOT_PX;
 use stancelib::skeleton::units::UpAxis;
 

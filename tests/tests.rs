@@ -74,6 +74,7 @@
 //!   option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `safety_outputs`: `--out` never destroys what the tool did not write; input links,
 //!   cycles and special files; per-input errors; stale temporaries; the build lock.
+//! - `safety_side_inputs`: issue 40 items 2, 3, 8, 10: side inputs as BVH inputs, clip budget, closed stdout, atomic `synth`.
 //!
 //! # Structure (issue 13)
 //! - `structure_edges`: enumerated options parsed (any case) and refused before work;
@@ -131,6 +132,7 @@ mod safety_limits;
 mod safety_messages;
 mod safety_options;
 mod safety_outputs;
+mod safety_side_inputs;
 // Structure (issue 13)
 mod structure_edges;
 mod structure_stages;

@@ -21,21 +21,52 @@ pub fn json() -> bool {
 }
 
 /// Prints a line of a command's human-readable report on stdout, unless `--quiet` or
-/// `--json` is given.
+/// `--json` is given (through [`print_line`]: a closed stdout ends the report quietly).
 #[macro_export]
 macro_rules! say {
     ($($t:tt)*) => {
         if !$crate::cli::quiet() && !$crate::cli::json() {
-            println!($($t)*);
+            $crate::cli::print_line(format_args!($($t)*));
         }
     };
+}
+
+/// Set once stdout is gone (broken pipe) or failed: nothing more is written there.
+static STDOUT_DONE: AtomicBool = AtomicBool::new(false);
+
+/// The first failure to write stdout other than a broken pipe (reported by [`run`]).
+static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex::new(None);
+
+/// Writes one line on stdout: the only way the commands print there. When the reader of
+/// stdout is gone (`stancelib info LIB | head -1`: a broken pipe) the line and every later
+/// one are dropped quietly and the command finishes its work, as ripgrep ends quietly on
+/// a broken pipe; the exit code is the command's own (0 when its work succeeded), and
+/// outputs it writes to files are still written. Any other write error (a full disk) is
+/// kept and makes [`run`] fail with it once the command is done.
+pub fn print_line(args: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    if STDOUT_DONE.load(Ordering::Relaxed) {
+        return;
+    }
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out
+        .write_fmt(format_args!("{args}\n"))
+        .and_then(|()| out.flush())
+    {
+        STDOUT_DONE.store(true, Ordering::Relaxed);
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            if let Ok(mut first) = STDOUT_ERROR.lock() {
+                first.get_or_insert(e);
+            }
+        }
+    }
 }
 
 /// Prints `summary` on stdout as one line of JSON when `--json` is given (and not
 /// `--quiet`).
 pub fn summary_json(summary: &serde_json::Value) {
     if json() && !quiet() {
-        println!("{summary}");
+        print_line(format_args!("{summary}"));
     }
 }
 
@@ -54,11 +85,22 @@ pub enum Outcome {
 ///
 /// # Errors
 /// Fatal errors (bad configuration, unreadable inputs, unwritable output): exit code 2.
+/// Stdout that cannot be written for another reason than a broken pipe is one of them
+/// ([`print_line`]).
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     QUIET.store(cli.quiet, Ordering::Relaxed);
     JSON.store(cli.json, Ordering::Relaxed);
     crate::pipeline::batch::set_progress(!cli.quiet);
-    match cli.command {
+    let outcome = dispatch(cli.command)?;
+    match STDOUT_ERROR.lock().ok().and_then(|mut e| e.take()) {
+        Some(e) => Err(anyhow::Error::new(e).context("cannot write to stdout")),
+        None => Ok(outcome),
+    }
+}
+
+/// Run one command.
+fn dispatch(command: Command) -> anyhow::Result<Outcome> {
+    match command {
         Command::Info(a) => cmd::info::run(a),
         Command::Frames(a) => cmd::frames::run(a),
         Command::Run(a) => cmd::run::run(a),

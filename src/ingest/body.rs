@@ -54,7 +54,8 @@ impl BodyModel {
     /// chooses them.
     ///
     /// # Errors
-    /// The skeleton maps onto no body (`ErrorKind::Skeleton`).
+    /// More point samples than [`super::MAX_POINT_SAMPLES`] (`ErrorKind::Limit`); the
+    /// skeleton maps onto no body (`ErrorKind::Skeleton`).
     pub fn new(
         bvh: &Bvh,
         unit_m: f64,
@@ -63,6 +64,7 @@ impl BodyModel {
         landmarks: &BTreeMap<String, String>,
     ) -> Result<BodyModel> {
         let skel = Skeleton::from_bvh(bvh);
+        super::check_point_samples(skel.n_points(), bvh.motion.n_frames())?;
         let rest_file = fk::rest_pose(&skel);
         let lm = match landmarks::map(&skel, &rest_file, landmarks)? {
             Mapping::Found(lm) => lm,

@@ -35,6 +35,16 @@ pub use crate::contacts::ContactRun;
 /// Default body mass, kg (spec com-from-bvh §5).
 pub const DEFAULT_MASS_KG: f64 = 70.0;
 
+/// Largest clip ingested, in point samples: points (joints and End Sites) × frames
+/// (2²⁶ = 67,108,864). Forward kinematics holds every point of every frame at once, 24
+/// bytes each (three f64), so this bounds that array to 1.5 GiB per clip. Ordinary clips
+/// stay far below: CMU clips (38 points, 120 Hz) take about 20 bytes of file per point
+/// sample, so a clip of the largest file read (`MAX_BVH_BYTES`, 1 GiB) is about 55 million.
+/// Joints without channels cost a few bytes of file each but 24 bytes per frame, so a
+/// small file can ask for gigabytes (100,000 `CHANNELS 0` joints × 2,500 frames: 6 GB);
+/// such a clip is an error of its own, checked before the skeleton is used.
+pub const MAX_POINT_SAMPLES: usize = 1 << 26;
+
 /// Options of the ingest stage.
 #[derive(serde::Serialize, Debug, Clone, PartialEq)]
 pub struct IngestOptions {
@@ -164,9 +174,30 @@ pub enum ClipOutcome {
     },
 }
 
+/// Refuses a clip whose forward kinematics would hold more than [`MAX_POINT_SAMPLES`]
+/// point samples (`n_points` × `n_frames`).
+///
+/// # Errors
+/// [`crate::ErrorKind::Limit`] naming both counts and the limit.
+pub fn check_point_samples(n_points: usize, n_frames: usize) -> Result<()> {
+    let samples = n_points as f64 * n_frames as f64;
+    if samples > MAX_POINT_SAMPLES as f64 {
+        return Err(crate::error::Error::limit(
+            format!("{n_points} points (joints and End Sites) × {n_frames} frames"),
+            "point samples (24 bytes each)",
+            samples,
+            MAX_POINT_SAMPLES,
+            "MAX_POINT_SAMPLES",
+        ));
+    }
+    Ok(())
+}
+
 /// Ingest one parsed clip.
 ///
 /// # Errors
+/// More point samples than [`MAX_POINT_SAMPLES`] (`ErrorKind::Limit`, checked before the
+/// skeleton is used);
 /// A partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that
 /// names no joint (`ErrorKind::Skeleton`); a frame time so short that the smoothing window
 /// exceeds `MAX_SAVGOL_WINDOW` (`ErrorKind::Smoothing`, checked before any per-frame
@@ -182,6 +213,7 @@ pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
         ..Default::default()
     };
     let skel = Skeleton::from_bvh(bvh);
+    check_point_samples(skel.n_points(), m.n_frames())?;
     let rest = fk::rest_pose(&skel);
     let lm = match landmarks::map(&skel, &rest, &opts.landmarks)? {
         Mapping::NotABody => {

@@ -14,8 +14,6 @@
 //! File: the BVH file's own axes, newtons (force on the body), seconds of clip time
 //! (frame 0 at t = 0). Output: world axes, right-handed, Z up, newtons.
 
-use std::path::Path;
-
 use crate::error::{Error, Result};
 use crate::skeleton::units::UpAxis;
 
@@ -57,15 +55,6 @@ pub struct PlateSample {
     pub time_s: f64,
     /// Force on the body, world axes (Z up), N.
     pub f_world: [f64; 3],
-}
-
-/// Reads a plate CSV file (see [`parse_plates`]).
-///
-/// # Errors
-/// The file cannot be read, or as [`parse_plates`].
-pub fn read_plates(path: &Path, foot: PlateFoot, up: UpAxis) -> Result<Vec<PlateSample>> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, "cannot read", e))?;
-    parse_plates(&text, foot, up).map_err(|e| e.with_path(path))
 }
 
 /// Parses plate CSV text: `foot`'s force at each row, mapped by `up` to the world frame.
@@ -137,6 +126,7 @@ pub fn parse_plates(text: &str, foot: PlateFoot, up: UpAxis) -> Result<Vec<Plate
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
 
     const CSV: &str = "time_s,fx_n,fy_n,fz_n,left_fx_n,left_fy_n,left_fz_n,left_copx_m,\
 right_fx_n,right_fy_n,right_fz_n\n\

@@ -40,6 +40,49 @@ pub fn parquet_rows(path: &Path) -> Result<usize> {
     Ok(n)
 }
 
+/// A Parquet file already opened (by the caller's input checks): its row count from the
+/// footer, then, if the caller goes on, its rows. Nothing is read again by path.
+pub struct OpenedParquet {
+    path: PathBuf,
+    reader: ParquetReader<std::fs::File>,
+}
+
+impl OpenedParquet {
+    /// Wraps `file`, opened from `path` (named in errors).
+    pub fn new(path: &Path, file: std::fs::File) -> Self {
+        OpenedParquet {
+            path: path.to_path_buf(),
+            reader: ParquetReader::new(file),
+        }
+    }
+
+    /// The number of rows, from the footer (no row is decoded).
+    ///
+    /// # Errors
+    /// Not valid Parquet.
+    pub fn rows(&mut self) -> Result<usize> {
+        let path = &self.path;
+        self.reader
+            .num_rows()
+            .map_err(|e| Error::io(path, "cannot read parquet", e))
+    }
+
+    /// Every row, as a [`Table`].
+    ///
+    /// # Errors
+    /// Not valid Parquet.
+    pub fn read(self) -> Result<Table> {
+        let df = self
+            .reader
+            .finish()
+            .map_err(|e| Error::io(&self.path, "cannot read parquet", e))?;
+        Ok(Table {
+            path: self.path,
+            df,
+        })
+    }
+}
+
 /// A table read from a file: typed column access whose errors name the file and column.
 pub struct Table {
     /// The file it came from.

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use super::build::{DEFAULT_BATCH_BYTES_PER_THREAD, DEFAULT_BATCH_CLIPS_PER_THREAD};
-use super::inputs::open_input;
+use super::inputs::{bvh_too_large, open_input};
 pub use super::inputs::{check_input, discover, none_readable, InputProblem, MAX_BVH_BYTES};
 use super::names::clip_names;
 use crate::error::{Error, ErrorKind, Result};
@@ -66,7 +66,7 @@ pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecor
     // Hash the rest of a file whose parse stopped early, so the hash is of the whole file.
     let _ = std::io::copy(&mut rdr, &mut std::io::sink());
     if rdr.bytes > MAX_BVH_BYTES {
-        return input_error(rec, path, &InputProblem::TooLarge { bytes: rdr.bytes });
+        return input_error(rec, path, &bvh_too_large(rdr.bytes));
     }
     rec.content_sha256 = hex(&rdr.hasher.finalize());
     // The ingest error keeps its kind; the record's message names the file before it.

@@ -9,10 +9,10 @@ use std::time::Instant;
 use anyhow::Context;
 use rayon::prelude::*;
 
-use super::inputs::{read_text, split_out};
+use super::inputs::{open_side_input, read_side_text, split_out, SideInput};
 use super::twopac_tables::equilibrium_table;
 use crate::error::Error;
-use crate::library::read::{parquet_rows, Table};
+use crate::library::read::OpenedParquet;
 use crate::library::schema::com_state::{ACCELERATION, POSITION};
 use crate::library::write::write_atomic;
 use crate::plot::write_png;
@@ -55,9 +55,13 @@ pub struct EquilibriumReport {
 /// COM positions (m) and accelerations (m/s²), one per row.
 type ComStates = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 
-/// The COM positions and accelerations of `P.parquet` (`ax_mps2`, `ay_mps2`, `az_mps2` default 0).
+/// The COM positions and accelerations of `P.parquet` (`ax_mps2`, `ay_mps2`, `az_mps2` default 0),
+/// opened as a side input ([`SideInput::Points`]); the row count is checked from the
+/// footer before any row is decoded.
 fn read_points(path: &Path) -> anyhow::Result<ComStates> {
-    let rows = parquet_rows(path)?;
+    let file = open_side_input(path, SideInput::Points)?.into_file();
+    let mut table = OpenedParquet::new(path, file);
+    let rows = table.rows()?;
     if rows > MAX_COM_STATES {
         let e = Error::limit(
             "--points",
@@ -68,7 +72,7 @@ fn read_points(path: &Path) -> anyhow::Result<ComStates> {
         );
         return Err(anyhow::Error::from(e).context(path.display().to_string()));
     }
-    let t = Table::open(path)?;
+    let t = table.read()?;
     let xyz = |names: [&str; 3], optional: bool| -> anyhow::Result<Vec<[f64; 3]>> {
         let mut cols = Vec::with_capacity(3);
         for n in names {
@@ -91,7 +95,7 @@ fn read_points(path: &Path) -> anyhow::Result<ComStates> {
 /// An unreadable or invalid contacts file, an unreadable points table or one without
 /// `x_m`, `y_m`, `z_m` (float64, no nulls), an unwritable output.
 pub fn run_equilibrium(job: &EquilibriumJob) -> anyhow::Result<EquilibriumReport> {
-    let text = read_text(&job.contacts)?;
+    let text = read_side_text(&job.contacts, SideInput::Contacts)?;
     let file = parse_contacts(&text).with_context(|| job.contacts.display().to_string())?;
     let (com, acc) = read_points(&job.points)?;
     let form = EqualityForm::new(&file.contacts, file.mass_kg)

@@ -1,11 +1,16 @@
-//! Inputs of a batch: the folder walk (links followed, each folder and file once) and the
-//! check that an input is a regular file within [`MAX_BVH_BYTES`] before it is opened.
-//! Whatever cannot be read becomes a per-input error with its reason ([`InputProblem`]).
+//! Every file the tool reads: the folder walk of a batch (links followed, each folder and
+//! file once), the check that a BVH input is a regular file within [`MAX_BVH_BYTES`] before
+//! it is opened, and the same check for the side inputs ([`SideInput`]: pipeline, body,
+//! phases, contacts, points and plates files, `twopac --clip`), each kind with its own
+//! size bound. Whatever cannot be read becomes an error with its reason
+//! ([`InputProblem`]): per input in a batch, [`crate::ErrorKind::Input`] for a side input.
 
 use std::collections::HashSet;
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use crate::error::Result;
+pub use crate::error::InputProblem;
+use crate::error::{Error, Result};
 
 /// Largest BVH file read, bytes (1 GiB). The biggest clips in common use are a few MB
 /// (CMU: about 90 kB per second of 120 Hz capture of a 31-joint skeleton, so 1 GiB is
@@ -98,53 +103,6 @@ fn once_per_file(mut found: Vec<PathBuf>) -> Vec<PathBuf> {
     found
 }
 
-/// Why an input cannot be read; every variant that comes from the system keeps its
-/// error (the OS reason).
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum InputProblem {
-    /// Nothing at that path.
-    #[error("not found: {0}")]
-    NotFound(std::io::Error),
-    /// A symbolic link whose target does not exist.
-    #[error("dangling symbolic link to {}: {err}", target.display())]
-    DanglingLink {
-        /// Where the link points.
-        target: PathBuf,
-        /// The system's error on following it.
-        err: std::io::Error,
-    },
-    /// Too many levels of symbolic links.
-    #[error("symbolic link loop: {0}")]
-    LinkLoop(std::io::Error),
-    /// The path or a folder on it is not accessible.
-    #[error("permission denied: {0}")]
-    PermissionDenied(std::io::Error),
-    /// A folder that cannot be listed.
-    #[error("folder cannot be listed: {0}")]
-    UnlistableFolder(std::io::Error),
-    /// A folder where a file is expected (listed, but gone before it was read).
-    #[error("is a folder, not a file")]
-    Folder,
-    /// A FIFO, socket or device (never opened: reading one could block or never end).
-    #[error("is a {}{kind}, not a regular file: only regular files are read", if *via_link { "symbolic link to a " } else { "" })]
-    NotRegular {
-        /// What it is.
-        kind: &'static str,
-        /// Reached through a symbolic link.
-        via_link: bool,
-    },
-    /// Larger than [`MAX_BVH_BYTES`].
-    #[error("{bytes} bytes is more than the limit of {MAX_BVH_BYTES} bytes (MAX_BVH_BYTES)")]
-    TooLarge {
-        /// Size of the file, bytes (or bytes read before the limit was passed).
-        bytes: u64,
-    },
-    /// Any other failure to inspect, open or read.
-    #[error("cannot read: {0}")]
-    Other(std::io::Error),
-}
-
 impl InputProblem {
     /// The problem behind an error of the system on `path`.
     fn from_io(path: &Path, err: std::io::Error) -> InputProblem {
@@ -207,11 +165,42 @@ pub fn file_kind(t: &std::fs::FileType) -> &'static str {
 /// # Errors
 /// Why it cannot be read.
 pub fn check_input(path: &Path) -> std::result::Result<u64, InputProblem> {
-    let meta = std::fs::metadata(path).map_err(|e| InputProblem::from_io(path, e))?;
-    check_meta(path, &meta)
+    check_bounded(path, BVH_BOUND)
 }
 
-fn check_meta(path: &Path, meta: &std::fs::Metadata) -> std::result::Result<u64, InputProblem> {
+/// A size limit: bytes, and the name of the constant that defines it.
+#[derive(Debug, Clone, Copy)]
+struct Bound {
+    max: u64,
+    limit: &'static str,
+}
+
+const BVH_BOUND: Bound = Bound {
+    max: MAX_BVH_BYTES,
+    limit: "MAX_BVH_BYTES",
+};
+
+impl Bound {
+    fn too_large(self, bytes: u64) -> InputProblem {
+        InputProblem::TooLarge {
+            bytes,
+            max: self.max,
+            limit: self.limit,
+        }
+    }
+}
+
+/// [`check_input`] under `bound`.
+fn check_bounded(path: &Path, bound: Bound) -> std::result::Result<u64, InputProblem> {
+    let meta = std::fs::metadata(path).map_err(|e| InputProblem::from_io(path, e))?;
+    check_meta(path, &meta, bound)
+}
+
+fn check_meta(
+    path: &Path,
+    meta: &std::fs::Metadata,
+    bound: Bound,
+) -> std::result::Result<u64, InputProblem> {
     if meta.is_dir() {
         return Err(match std::fs::read_dir(path) {
             Err(e) => InputProblem::UnlistableFolder(e),
@@ -224,17 +213,22 @@ fn check_meta(path: &Path, meta: &std::fs::Metadata) -> std::result::Result<u64,
             via_link: std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()),
         });
     }
-    if meta.len() > MAX_BVH_BYTES {
-        return Err(InputProblem::TooLarge { bytes: meta.len() });
+    if meta.len() > bound.max {
+        return Err(bound.too_large(meta.len()));
     }
     Ok(meta.len())
 }
 
-/// Open an input checked by [`check_input`], and check the opened file again (it may
-/// have been replaced in between). On Linux the file is opened non-blocking, so a FIFO
-/// put in its place cannot block the open.
+/// Open a BVH input checked by [`check_input`] (see [`open_bounded`]).
 pub(super) fn open_input(path: &Path) -> std::result::Result<std::fs::File, InputProblem> {
-    check_input(path)?;
+    open_bounded(path, BVH_BOUND)
+}
+
+/// Open an input checked under `bound`, and check the opened file again (it may have been
+/// replaced in between). On Linux the file is opened non-blocking, so a FIFO put in its
+/// place cannot block the open.
+fn open_bounded(path: &Path, bound: Bound) -> std::result::Result<std::fs::File, InputProblem> {
+    check_bounded(path, bound)?;
     let mut o = std::fs::OpenOptions::new();
     o.read(true);
     #[cfg(target_os = "linux")]
@@ -244,7 +238,7 @@ pub(super) fn open_input(path: &Path) -> std::result::Result<std::fs::File, Inpu
     }
     let file = o.open(path).map_err(|e| InputProblem::from_io(path, e))?;
     let meta = file.metadata().map_err(InputProblem::Other)?;
-    check_meta(path, &meta)?;
+    check_meta(path, &meta, bound)?;
     Ok(file)
 }
 
@@ -275,13 +269,192 @@ pub fn none_readable(files: &[PathBuf]) -> Option<String> {
     Some(text)
 }
 
-/// Reads a UTF-8 text file (a phases or contacts file), naming it on failure.
+/// Largest pipeline or body file read (TOML), bytes (1 MiB). These files list a few dozen
+/// keys and landmark names (those in `pipelines/` and `fixtures/body/` are under 1 kB),
+/// and the TOML parser holds several bytes of memory per file byte, so a larger file is
+/// no configuration: it is refused before it is read (a 3 GB sparse file once asked for
+/// 3 GB at once).
+pub const MAX_TOML_BYTES: u64 = 1 << 20;
+
+/// Largest phases or contacts file read (JSON), bytes (64 MiB). The files in
+/// `fixtures/twopac/` are under 5 kB; a phases file within its own limits
+/// (`twopac::trajectory::MAX_PHASES`, `twopac::equilibrium::MAX_CONTACTS`) and with
+/// ordinary polytopes stays far below this. The parsed values take about as much memory
+/// as the text, which is read whole.
+pub const MAX_JSON_BYTES: u64 = 64 << 20;
+
+/// Largest `--points` table read (Parquet), bytes (256 MiB). Its limit of
+/// `twopac::equilibrium::MAX_COM_STATES` rows of six float64 columns is 48 MB
+/// uncompressed; the rest leaves room for other columns and less compact encodings, and
+/// bounds what the reader decodes (every column is read).
+pub const MAX_POINTS_BYTES: u64 = 256 << 20;
+
+/// Largest force-plate file read (CSV), bytes (256 MiB). Two plates at 1 kHz take about
+/// 120 bytes per row (17 columns), so this is over half an hour of one recording, longer
+/// than any clip it goes with (those in `../shared/data/forceplate` are under 100 kB).
+/// The text is read whole and its samples take 32 bytes per row.
+pub const MAX_PLATES_BYTES: u64 = 256 << 20;
+
+/// A file the tool reads besides the BVH inputs of a batch. Every kind is read through
+/// [`open_side_input`] with the rules of a BVH input: regular files only (a FIFO, socket
+/// or device is never opened), at most the kind's size bound ([`SideInput::max_bytes`]),
+/// and an unreadable file is an error naming it and the OS reason.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SideInput {
+    /// `run`'s pipeline file (TOML, [`MAX_TOML_BYTES`]).
+    Pipeline,
+    /// A body file: `--body` or a pipeline's `body` (TOML, [`MAX_TOML_BYTES`]).
+    Body,
+    /// `twopac --phases` (JSON, [`MAX_JSON_BYTES`]).
+    Phases,
+    /// `equilibrium --contacts` (JSON, [`MAX_JSON_BYTES`]).
+    Contacts,
+    /// `equilibrium --points` (Parquet, [`MAX_POINTS_BYTES`]).
+    Points,
+    /// `plot stance --plates` (CSV, [`MAX_PLATES_BYTES`]).
+    Plates,
+    /// `twopac --clip` (BVH, [`MAX_BVH_BYTES`] as every clip).
+    Clip,
+}
+
+impl SideInput {
+    /// What the file is, for messages (`body file`).
+    pub fn what(self) -> &'static str {
+        match self {
+            SideInput::Pipeline => "pipeline file",
+            SideInput::Body => "body file",
+            SideInput::Phases => "phases file",
+            SideInput::Contacts => "contacts file",
+            SideInput::Points => "points table",
+            SideInput::Plates => "plates file",
+            SideInput::Clip => "clip",
+        }
+    }
+
+    /// The largest file of this kind read, bytes.
+    pub fn max_bytes(self) -> u64 {
+        self.bound().max
+    }
+
+    fn bound(self) -> Bound {
+        let (max, limit) = match self {
+            SideInput::Pipeline | SideInput::Body => (MAX_TOML_BYTES, "MAX_TOML_BYTES"),
+            SideInput::Phases | SideInput::Contacts => (MAX_JSON_BYTES, "MAX_JSON_BYTES"),
+            SideInput::Points => (MAX_POINTS_BYTES, "MAX_POINTS_BYTES"),
+            SideInput::Plates => (MAX_PLATES_BYTES, "MAX_PLATES_BYTES"),
+            SideInput::Clip => return BVH_BOUND,
+        };
+        Bound { max, limit }
+    }
+
+    fn error(self, path: &Path, problem: InputProblem) -> Error {
+        Error::input(path, self.what(), problem)
+    }
+}
+
+/// A side input opened by [`open_side_input`]: reads stop one byte past its kind's bound,
+/// so a file that grows after it was checked is caught by [`SideFile::finish`].
+#[derive(Debug)]
+pub struct SideFile {
+    path: PathBuf,
+    kind: SideInput,
+    inner: std::io::Take<std::fs::File>,
+}
+
+impl Read for SideFile {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        self.inner.read(buf)
+    }
+}
+
+impl SideFile {
+    /// After reading to the end: an error when more than the kind's bound was read (the
+    /// file grew after it was opened).
+    ///
+    /// # Errors
+    /// [`InputProblem::TooLarge`].
+    pub fn finish(&self) -> Result<()> {
+        if self.inner.limit() == 0 {
+            let bound = self.kind.bound();
+            return Err(self.kind.error(&self.path, bound.too_large(bound.max + 1)));
+        }
+        Ok(())
+    }
+
+    /// The opened file, for readers that seek (Parquet); its size was checked on the
+    /// opened file.
+    pub fn into_file(self) -> std::fs::File {
+        self.inner.into_inner()
+    }
+}
+
+/// Open the side input at `path` of kind `kind`, as a BVH input is opened: it must be a
+/// regular file (links followed; a FIFO, socket or device is never opened, so nothing
+/// blocks) of at most `kind.max_bytes()`, checked before the open and again on the opened
+/// file. The one way every side input is opened.
 ///
 /// # Errors
-/// A missing or unreadable file, or one that is not UTF-8.
-pub fn read_text(path: &Path) -> anyhow::Result<String> {
-    use anyhow::Context;
-    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+/// [`crate::ErrorKind::Input`] naming the file, what it was read as, and why it cannot be
+/// read (with the OS reason).
+pub fn open_side_input(path: &Path, kind: SideInput) -> Result<SideFile> {
+    let bound = kind.bound();
+    let file = open_bounded(path, bound).map_err(|p| kind.error(path, p))?;
+    Ok(SideFile {
+        path: path.to_path_buf(),
+        kind,
+        inner: file.take(bound.max + 1),
+    })
+}
+
+/// Reads a UTF-8 side input (pipeline, body, phases, contacts, plates file) whole, through
+/// [`open_side_input`].
+///
+/// # Errors
+/// As [`open_side_input`]; a read error or text that is not UTF-8 (as
+/// [`InputProblem::Other`]).
+pub fn read_side_text(path: &Path, kind: SideInput) -> Result<String> {
+    let mut f = open_side_input(path, kind)?;
+    let mut bytes = Vec::new();
+    f.read_to_end(&mut bytes)
+        .map_err(|e| kind.error(path, InputProblem::Other(e)))?;
+    f.finish()?;
+    String::from_utf8(bytes).map_err(|e| {
+        let e = std::io::Error::new(std::io::ErrorKind::InvalidData, e);
+        kind.error(path, InputProblem::Other(e))
+    })
+}
+
+/// Parses a BVH side input (`twopac --clip`) through [`open_side_input`].
+///
+/// # Errors
+/// As [`open_side_input`]; as [`crate::bvh::parse_reader`], with the path.
+pub fn read_side_bvh(path: &Path) -> Result<crate::bvh::Bvh> {
+    let mut f = open_side_input(path, SideInput::Clip)?;
+    let parsed = crate::bvh::parse_reader(&mut f).map_err(|e| e.with_path(path));
+    f.finish()?;
+    parsed
+}
+
+/// Reads and parses a pipeline file through [`read_side_text`].
+///
+/// # Errors
+/// As [`read_side_text`] and [`super::spec::parse_pipeline`].
+pub fn read_pipeline(path: &Path) -> Result<super::spec::PipelineFile> {
+    super::spec::parse_pipeline(path, &read_side_text(path, SideInput::Pipeline)?)
+}
+
+/// Reads and parses a body file through [`read_side_text`].
+///
+/// # Errors
+/// As [`read_side_text`] and [`super::spec::parse_body`].
+pub fn read_body(path: &Path) -> Result<super::spec::BodyFile> {
+    super::spec::parse_body(path, &read_side_text(path, SideInput::Body)?)
+}
+
+/// A BVH input that grew past [`MAX_BVH_BYTES`] while it was read.
+pub(super) fn bvh_too_large(bytes: u64) -> InputProblem {
+    BVH_BOUND.too_large(bytes)
 }
 
 /// `(folder, file name)` of an output file path given as `--out`.

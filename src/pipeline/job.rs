@@ -11,11 +11,10 @@ use anyhow::Context;
 
 use super::batch::discover;
 use super::build::{BuildOptions, BuildPlan};
+use super::inputs::{read_body, read_pipeline};
 use super::output::OutputRules;
 use super::queries::{query_stages, MapQuery, RunQuery};
-use super::spec::{
-    expand_inputs, load_body, load_pipeline, relative_to, resolve, resolve_fit, Overrides,
-};
+use super::spec::{expand_inputs, relative_to, resolve, resolve_fit, Overrides};
 use crate::force_model::ForceModelKind;
 use crate::library::layout::Layout;
 
@@ -63,12 +62,12 @@ pub struct PipelineJob {
 /// # Errors
 /// An invalid pipeline or body file, a bad `[queries]` value, inputs that match nothing.
 pub fn pipeline_job(path: &Path, cl: &CommandLine<'_>) -> anyhow::Result<PipelineJob> {
-    let pipe = load_pipeline(path)?;
+    let pipe = read_pipeline(path)?;
     let body_path = cl
         .body
         .map(Path::to_path_buf)
         .or_else(|| pipe.body.as_deref().map(|b| relative_to(path, b)));
-    let body = body_path.as_deref().map(load_body).transpose()?;
+    let body = body_path.as_deref().map(read_body).transpose()?;
     let opts = BuildOptions {
         ingest: resolve(body.as_ref(), Some(&pipe), cl.overrides),
         stances: resolve_fit(Some(&pipe), cl.force_model),

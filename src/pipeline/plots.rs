@@ -6,15 +6,17 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
+use super::inputs::{read_side_text, SideInput};
 use crate::force_model::export::{kinematic_force, sample_forces};
 use crate::library::clip_view::{read_clip_view, ClipView};
 use crate::library::forces::{
     read_clip_accelerations, read_force_stances, read_up_axis, select_stances,
 };
-use crate::library::plates::{read_plates, PlateFoot};
+use crate::library::plates::{parse_plates, PlateFoot, PlateSample};
 use crate::library::schema::{CLIPS_FILE, FRAMES_FILE, STANCES_FILE};
 use crate::plot::stance::{stance_png, time_window, StancePlot, WorldForces};
 use crate::plot::write_png;
+use crate::skeleton::units::UpAxis;
 
 /// A `plot stance` job.
 #[derive(Debug, Clone)]
@@ -45,6 +47,19 @@ pub struct StancePlotReport {
 ///
 /// # Errors
 /// An `active_set` outside [0, 1], an unreadable library or plate file, an unknown stance
+/// Reads a force-plate CSV file (`--plates`) as a side input ([`SideInput::Plates`]: a
+/// regular file within `MAX_PLATES_BYTES`), then parses it ([`parse_plates`]).
+///
+/// # Errors
+/// As [`read_side_text`]; as [`parse_plates`], with the path.
+pub fn read_plates(
+    path: &Path,
+    foot: PlateFoot,
+    up: UpAxis,
+) -> crate::error::Result<Vec<PlateSample>> {
+    parse_plates(&read_side_text(path, SideInput::Plates)?, foot, up).map_err(|e| e.with_path(path))
+}
+
 /// id (nothing is written), an unwritable output.
 pub fn plot_stance(job: &StancePlotJob) -> anyhow::Result<StancePlotReport> {
     anyhow::ensure!(

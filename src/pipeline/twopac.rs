@@ -325,7 +325,7 @@ pub struct Recorded {
 /// # Errors
 /// The clip cannot be read or ingested, is not a body, or has no contact phase.
 pub fn clip_phases(clip: &Path) -> anyhow::Result<(PhasesFile, Recorded)> {
-    let bvh = crate::bvh::parse_file(clip).with_context(|| clip.display().to_string())?;
+    let bvh = super::inputs::read_side_bvh(clip)?;
     let mut opts = crate::ingest::IngestOptions::default();
     opts.contacts.static_mode = true;
     let outcome = crate::ingest::ingest(&bvh, &opts).with_context(|| clip.display().to_string())?;

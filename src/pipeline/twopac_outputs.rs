@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use super::inputs::read_text;
+use super::inputs::{read_side_text, SideInput};
 use super::twopac::{clip_phases, plot_data, resolve, rows, timings, PolytopeSource, Recorded};
 use super::twopac_tables::{
     form_name, phases_table, trajectory_table, transitions_table, validation_table, windows_table,
@@ -107,7 +107,7 @@ fn load(job: &TwopacJob) -> anyhow::Result<(PhasesFile, PathBuf, Option<Recorded
                 .phases
                 .clone()
                 .context("give --phases FILE or --clip CLIP.bvh")?;
-            let text = read_text(&path)?;
+            let text = read_side_text(&path, SideInput::Phases)?;
             let file = parse_phases(&text).with_context(|| path.display().to_string())?;
             (file, path, None)
         }

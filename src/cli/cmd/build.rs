@@ -8,9 +8,10 @@ use super::super::args::{BuildArgs, MergeArgs};
 use super::super::Outcome;
 use crate::pipeline::batch::discover;
 use crate::pipeline::build::{build_library, BuildOptions, BuildPlan, BuildSummary};
+use crate::pipeline::inputs::read_body;
 use crate::pipeline::merge::merge_into;
 use crate::pipeline::output::OutputRules;
-use crate::pipeline::spec::{load_body, resolve, resolve_fit};
+use crate::pipeline::spec::{resolve, resolve_fit};
 
 /// Run `build`.
 ///
@@ -18,7 +19,7 @@ use crate::pipeline::spec::{load_body, resolve, resolve_fit};
 /// Bad options or body file, missing inputs, an unwritable library folder.
 pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
     let cli = a.body.overrides()?;
-    let body = a.body.body.as_deref().map(load_body).transpose()?;
+    let body = a.body.body.as_deref().map(read_body).transpose()?;
     let opts = BuildOptions {
         ingest: resolve(body.as_ref(), None, &cli),
         stances: resolve_fit(None, a.fit.force_model),
@@ -50,13 +51,13 @@ pub fn run_merge(a: MergeArgs) -> anyhow::Result<Outcome> {
     };
     let s = merge_into(&a.shards, &a.out, &rules, a.layout.into())
         .with_context(|| format!("merging into {}", a.out.display()))?;
-    println!(
+    crate::cli::print_line(format_args!(
         "{} shards merged: {} clips, {} failed; library in {}",
         s.shards,
         s.clips,
         s.failed,
         a.out.display()
-    );
+    ));
     Ok(match s.failed {
         0 => Outcome::Clean,
         f if f == s.clips => Outcome::AllFailed,

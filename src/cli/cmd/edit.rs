@@ -58,16 +58,16 @@ pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
 
 /// Prints what was written; `SomeFailed` when frames did not converge.
 fn report(r: &EditReport) -> Outcome {
-    println!(
+    crate::cli::print_line(format_args!(
         "edit: {} frame(s) at {:.1} Hz → {} (+ {}, {})",
         r.n_frames,
         r.fps_hz,
         r.bvh.display(),
         r.plan.display(),
         r.png.display()
-    );
+    ));
     for v in &r.violated {
-        println!("edit: infeasible, written anyway: {v}");
+        crate::cli::print_line(format_args!("edit: infeasible, written anyway: {v}"));
     }
     if r.unconverged == 0 {
         return Outcome::Clean;

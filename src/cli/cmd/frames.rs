@@ -7,7 +7,8 @@ use super::super::Outcome;
 use crate::ingest::IngestOptions;
 use crate::library::{ClipStatus, Status};
 use crate::pipeline::batch::{discover, frames_into};
-use crate::pipeline::spec::{load_body, resolve};
+use crate::pipeline::inputs::read_body;
+use crate::pipeline::spec::resolve;
 
 /// Run `frames`.
 ///
@@ -15,7 +16,7 @@ use crate::pipeline::spec::{load_body, resolve};
 /// Bad options or body file, missing inputs, an unwritable output folder.
 pub fn run(a: FramesArgs) -> anyhow::Result<Outcome> {
     let cli = a.body.overrides()?;
-    let body = a.body.body.as_deref().map(load_body).transpose()?;
+    let body = a.body.body.as_deref().map(read_body).transpose()?;
     let opts = resolve(body.as_ref(), None, &cli);
     let files = discover(&a.inputs)?;
     execute(&files, &a.out, &opts, a.body.threads)

@@ -6,6 +6,7 @@ use anyhow::Context;
 
 use super::super::args::SynthArgs;
 use super::super::Outcome;
+use crate::library::atomic::write_text_atomic;
 use crate::skeleton::units::parse_unit;
 use crate::synth::{
     generate, SynthMotion, SynthOptions, SynthUp, MAX_DURATION_S, MAX_FRAME_RATE_HZ, MAX_UNIT_M,
@@ -13,7 +14,8 @@ use crate::synth::{
 };
 
 /// Write `<out>` (BVH) and `<out stem>.truth.csv` (frame, time_s, com_x/y/z in metres Z up,
-/// contact_left_foot, contact_right_foot, force per kg x/y/z).
+/// contact_left_foot, contact_right_foot, force per kg x/y/z), each atomically (a
+/// temporary beside it, then renamed: a failed write keeps an earlier file).
 ///
 /// # Errors
 /// An unknown unit; a rate, duration or unit out of range; an unwritable output.
@@ -46,7 +48,8 @@ pub fn run(a: SynthArgs) -> anyhow::Result<Outcome> {
         ..Default::default()
     };
     let clip = generate(&opts);
-    std::fs::write(&a.out, &clip.bvh).with_context(|| format!("writing {}", a.out.display()))?;
+    // Atomic, as every output: a failed write (a full disk) keeps an earlier file whole.
+    write_text_atomic(&a.out, &clip.bvh).with_context(|| format!("writing {}", a.out.display()))?;
     let mut csv = String::from("frame,time_s,com_x,com_y,com_z,contact_left_foot,contact_right_foot,force_x_per_kg,force_y_per_kg,force_z_per_kg\n");
     let dt = 1.0 / opts.frame_rate_hz;
     for (f, c) in clip.com.iter().enumerate() {
@@ -66,7 +69,7 @@ pub fn run(a: SynthArgs) -> anyhow::Result<Outcome> {
         );
     }
     let truth = a.out.with_extension("truth.csv");
-    std::fs::write(&truth, csv).with_context(|| format!("writing {}", truth.display()))?;
+    write_text_atomic(&truth, &csv).with_context(|| format!("writing {}", truth.display()))?;
     crate::say!("wrote {} and {}", a.out.display(), truth.display());
     Ok(Outcome::Clean)
 }
