@@ -177,10 +177,6 @@ fn parse_toml<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result
     })
 }
 
-fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|e| Error::io(path, "cannot read", e))
-}
-
 /// Parse a body file.
 ///
 /// # Errors
@@ -260,14 +256,6 @@ pub fn unit_value(u: &UnitValue) -> Option<f64> {
         UnitValue::Number(v) => (v.is_finite() && *v > 0.0).then_some(*v),
         UnitValue::Name(s) => parse_unit(s),
     }
-}
-
-/// Read and parse a body file.
-///
-/// # Errors
-/// As [`parse_body`].
-pub fn load_body(path: &Path) -> Result<BodyFile> {
-    parse_body(path, &read(path)?)
 }
 
 /// Parse a pipeline file.
@@ -456,14 +444,6 @@ fn check_queries(q: &QueriesTable) -> std::result::Result<(), (&'static str, Err
         "map_heights"
     };
     check_grid("[queries] map_heights × map_speeds", h.len(), u.len()).map_err(|e| (key, e))
-}
-
-/// Read and parse a pipeline file.
-///
-/// # Errors
-/// As [`parse_pipeline`].
-pub fn load_pipeline(path: &Path) -> Result<PipelineFile> {
-    parse_pipeline(path, &read(path)?)
 }
 
 /// Values given on the command line (each wins over the files).
