@@ -41,6 +41,10 @@ struct PlateGait {
     /// Friction demand: max |F_t|/F_v over the stance's samples with F_v ≥ 0.2 max F_v
     /// (the queries' 20 % active set).
     mu: f64,
+    /// The largest peak force of any stance, N.
+    peak_max_n: f64,
+    /// The largest friction demand of any stance (20 % active set).
+    mu_max: f64,
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -94,7 +98,11 @@ fn plate_gait(clip: &ForcePlateClip) -> PlateGait {
     }
     tds.sort_by(f64::total_cmp);
     let mut steps: Vec<f64> = tds.windows(2).map(|w| w[1] - w[0]).collect();
+    let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    let (peak_max_n, mu_max) = (max(&peak), max(&mu));
     PlateGait {
+        peak_max_n,
+        mu_max,
         speed,
         contact_s: median(&mut contact),
         step_s: median(&mut steps),
@@ -197,6 +205,20 @@ fn runs_at_another_speed_match_the_same_runner_on_the_plates() {
             "--quiet",
         ]);
         let own_truth = clips.iter().find(|(n, ..)| n == src).map(|c| c.3).unwrap();
+        // Issue 37 item 4: the character's limits hold what its plates measured.
+        let manifest: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(lib.join("manifest.json")).unwrap())
+                .unwrap();
+        for (id, l) in manifest["limits"].as_object().expect("limits") {
+            let (f_max, mu) = (l["f_max_n"].as_f64().unwrap(), l["mu"].as_f64().unwrap());
+            eprintln!(
+                "{src} {id}: F_max {f_max:.0} N ≥ plates' largest peak {:.0} N; μ {mu} ≥ plates' largest μ {:.3}",
+                own_truth.peak_max_n, own_truth.mu_max
+            );
+            if f_max < own_truth.peak_max_n || mu < own_truth.mu_max {
+                failures.push(format!("{src} {id}: limits below what the plates measured"));
+            }
+        }
         let own = query(
             &lib,
             own_truth.speed,

@@ -214,7 +214,7 @@ impl fmt::Display for LibraryInfo {
                 let g = |k: &str| l.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
                 let from = match l.get("source").and_then(|v| v.as_str()).unwrap_or("?") {
                     "character" => "its own stances",
-                    "size" => "its mass and leg length (fewer than 20 stances)",
+                    "size" => "the floor of a person's capacity (3.5 body weights)",
                     other => other,
                 };
                 let n = l.get("n_stances").and_then(|v| v.as_u64()).unwrap_or(0);
