@@ -251,6 +251,18 @@ fn list_json_has_the_counts_of_the_text() {
         let id = j["liftoff"].as_str().unwrap();
         assert_eq!(text.matches(&format!("{id} →")).count(), 1, "{id}\n{text}");
     }
+    // `list --help` documents every key the JSON has.
+    let help = ok(&["list", "--help"]);
+    let obj = v.as_object().unwrap();
+    let mut keys: Vec<&String> = obj.keys().collect();
+    for arr in ["characters", "run_cycles", "jumps"] {
+        keys.extend(obj[arr][0].as_object().unwrap().keys());
+    }
+    for k in keys {
+        // Arrays are written `key[]`.
+        let named = help.contains(&format!("`{k}`")) || help.contains(&format!("`{k}[]`"));
+        assert!(named, "`{k}` not in list --help:\n{help}");
+    }
 }
 
 // See: issue 38 item 2 — not a library: exit 2, the path named.

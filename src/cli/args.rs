@@ -257,6 +257,17 @@ pub enum Command {
     /// provenance.
     Info(InfoArgs),
     /// A catalogue of a library: its characters, recorded run cycles and recorded jumps.
+    ///
+    /// Prints, in this order: the characters (id, clips, leg length, mass, stances), the
+    /// run cycles (clip, stances, recorded speed, feasible at that speed under the default
+    /// `query run`; cycles of clips whose time base is wrong are marked and left out, as
+    /// `query run` does) and the recorded jumps (liftoff → landing, height, distance).
+    ///
+    /// With `--json`, one object: `library`; `characters[]` {`character_id`, `n_clips`,
+    /// `clips`, `leg_length_m`, `mass_kg`, `n_stances`}; `run_cycles[]` {`clip`,
+    /// `character_id`, `stance_ids`, `v_orig_mps`, `time_scaled`, `feasible_at_own_speed`
+    /// (null when left out)}; `jumps[]` {`clip`, `character_id`, `liftoff`, `landing`,
+    /// `height_m`, `distance_m`}.
     List(ListArgs),
     /// Per-frame COM, contacts and per-clip diagnostics of BVH clips, as Parquet.
     Frames(FramesArgs),
@@ -838,18 +849,7 @@ pub struct InfoArgs {
     pub lib: PathBuf,
 }
 
-/// `stancelib list`.
-///
-/// Prints, in this order: the characters (id, clips, leg length, mass, stances), the run
-/// cycles (clip, stances, recorded speed, feasible at that speed under the default
-/// `query run`; cycles of clips whose time base is wrong are marked and left out, as
-/// `query run` does) and the recorded jumps (liftoff → landing, height, distance).
-///
-/// With `--json`, one object: `library`; `characters[]` {`character_id`, `n_clips`,
-/// `clips`, `leg_length_m`, `mass_kg`, `n_stances`}; `run_cycles[]` {`clip`,
-/// `character_id`, `stance_ids`, `v_orig_mps`, `time_scaled`, `feasible_at_own_speed`
-/// (null when left out)}; `jumps[]` {`clip`, `character_id`, `liftoff`, `landing`,
-/// `height_m`, `distance_m`}.
+/// `stancelib list` (its help is the doc of [`Command::List`]).
 #[derive(Debug, Args)]
 pub struct ListArgs {
     /// Library folder (from `build` or `run`).
