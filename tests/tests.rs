@@ -63,6 +63,7 @@
 //! - `analyst`: issue 17 — the README's demo commands run and its column tables are the
 //!   written schemas; manifest date and command line, query outputs naming their library,
 //!   `info`, negative numbers, `--help` limits, `--quiet` and `--json`.
+//! - `catalogue`: issue 38 item 2 — `list`: characters, run cycles (against `query run`), jumps.
 //!
 //! # Safety (issue 11)
 //! - `safety_inputs`: reader and numeric items: SG window bound, no silent NaN, 100k-joint
@@ -125,6 +126,7 @@ mod edit_checks;
 mod edit_motion;
 // Command line and documentation
 mod analyst;
+mod catalogue;
 mod cli;
 // Safety
 mod safety_inputs;

@@ -160,7 +160,7 @@ pub struct Cli {
     #[arg(long, global = true)]
     pub quiet: bool,
     /// Print the command's summary as one JSON object on stdout instead of text
-    /// (`frames`, `build`, `run`, `info`).
+    /// (`frames`, `build`, `run`, `info`, `list`).
     #[arg(long, global = true)]
     pub json: bool,
 }
@@ -256,6 +256,19 @@ pub enum Command {
     /// What a library holds: clips, characters, stances, failures, options, limits,
     /// provenance.
     Info(InfoArgs),
+    /// A catalogue of a library: its characters, recorded run cycles and recorded jumps.
+    ///
+    /// Prints, in this order: the characters (id, clips, leg length, mass, stances), the
+    /// run cycles (clip, stances, recorded speed, feasible at that speed under the default
+    /// `query run`; cycles of clips whose time base is wrong are marked and left out, as
+    /// `query run` does) and the recorded jumps (liftoff → landing, height, distance).
+    ///
+    /// With `--json`, one object: `library`; `characters[]` {`character_id`, `n_clips`,
+    /// `clips`, `leg_length_m`, `mass_kg`, `n_stances`}; `run_cycles[]` {`clip`,
+    /// `character_id`, `stance_ids`, `v_orig_mps`, `time_scaled`, `feasible_at_own_speed`
+    /// (null when left out)}; `jumps[]` {`clip`, `character_id`, `liftoff`, `landing`,
+    /// `height_m`, `distance_m`}.
+    List(ListArgs),
     /// Per-frame COM, contacts and per-clip diagnostics of BVH clips, as Parquet.
     Frames(FramesArgs),
     /// Run a declarative pipeline file (pipelines/*.toml).
@@ -832,6 +845,13 @@ pub struct PlotStanceArgs {
 /// `stancelib info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
+    /// Library folder (from `build` or `run`).
+    pub lib: PathBuf,
+}
+
+/// `stancelib list` (its help is the doc of [`Command::List`]).
+#[derive(Debug, Args)]
+pub struct ListArgs {
     /// Library folder (from `build` or `run`).
     pub lib: PathBuf,
 }

@@ -102,6 +102,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
 fn dispatch(command: Command) -> anyhow::Result<Outcome> {
     match command {
         Command::Info(a) => cmd::info::run(a),
+        Command::List(a) => cmd::list::run(a),
         Command::Frames(a) => cmd::frames::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Build(a) => cmd::build::run(a),

@@ -1,10 +1,11 @@
 //! Batch orchestration at the I/O edge: input discovery, clip names, per-file ingest in
 //! parallel with a progress bar, the streaming library build, shards and their merge, the
-//! output-folder policy, the declarative pipeline and body files, and the `twopac` stage
-//! with its output tables.
+//! output-folder policy, the declarative pipeline and body files, the `twopac` stage
+//! with its output tables, and a library's catalogue (`list`).
 
 pub mod batch;
 pub mod build;
+pub mod catalogue;
 pub mod edit;
 pub mod edit_outputs;
 pub mod equilibrium;

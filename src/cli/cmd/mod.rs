@@ -6,6 +6,7 @@ pub mod equilibrium;
 pub mod forces;
 pub mod frames;
 pub mod info;
+pub mod list;
 pub mod map;
 pub mod plot;
 pub mod query;
