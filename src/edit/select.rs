@@ -24,12 +24,12 @@ use super::plan::{refine_run_k, run_requests, solve_stance, EditStance, StanceTi
 use crate::error::{Error, Result};
 use crate::library::read::StanceLibrary;
 use crate::query::feasibility::{LimitForm, Limits};
-use crate::query::gait::{LawChoice, LawSource};
+use crate::query::gait::{GaitLaw, LawChoice, LawSource};
 use crate::query::jump::{is_landing, is_liftoff, jump, recorded_jump, Jump};
 use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
 use crate::query::pairs::jump_rank;
 use crate::query::pool::Prepared;
-use crate::query::run::{clip_gaits, distance_for_period, run_cycles, scale_limits, Timing};
+use crate::query::run::{character_laws, distance_for_period, run_cycles, scale_limits, Timing};
 use crate::query::solve::Refs;
 
 /// The limits an edit's stances are checked against (§7.5).
@@ -107,14 +107,12 @@ pub fn choose_run(
             None => no_run_cycle(),
         });
     }
-    let gaits = clip_gaits(&lib.stances, &cycles);
+    let laws = character_laws(&lib.stances, &cycles, target.gait_law);
     let solved: Vec<RunCandidate> = cycles
         .iter()
         .map(|cy| {
             let ch = &lib.stances[cy.stances[0]].character_id;
-            let law = target
-                .gait_law
-                .law(gaits.get(ch).map_or(&[][..], Vec::as_slice));
+            let law = laws.get(ch).copied().unwrap_or(GaitLaw::POPULATION);
             let v_orig = cy.v_orig * length.sqrt();
             let timing = Timing::of(&law, v_orig, target.speed_mps);
             let paper = law.source == LawSource::Paper;

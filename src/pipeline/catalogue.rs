@@ -41,7 +41,7 @@ use crate::query::gait::{GaitLaw, LawChoice};
 use crate::query::jump::{is_landing, is_liftoff, recorded_jump};
 use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
 use crate::query::pool::Prepared;
-use crate::query::run::{clip_gaits, run_at_speed, run_cycles, scale_limits, RunCycle};
+use crate::query::run::{character_laws, run_at_speed, run_cycles, RunCycle};
 
 /// One character of a library.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -194,22 +194,16 @@ fn cycles(lib: &StanceLibrary) -> Vec<CatalogueCycle> {
     let all = run_cycles(&lib.stances);
     let left_out = |c: &RunCycle| time_scaled(lib, &lib.stances[c.stances[0]].clip);
     let kept: Vec<RunCycle> = all.iter().filter(|c| !left_out(c)).copied().collect();
-    let limits: BTreeMap<String, Limits> = absolute_limits(lib)
-        .into_iter()
-        .map(|(k, l)| (k, scale_limits(&l, 1.0, 1.0)))
-        .collect();
-    let laws: BTreeMap<String, GaitLaw> = clip_gaits(&lib.stances, &kept)
-        .iter()
-        .map(|(ch, clips)| (ch.clone(), LawChoice::Auto.law(clips)))
-        .collect();
+    let limits: BTreeMap<String, Limits> = absolute_limits(lib);
+    let laws = character_laws(&lib.stances, &kept, LawChoice::Auto);
     all.par_iter()
         .map(|c| {
             let [a, b] = c.stances.map(|i| &lib.stances[i]);
             let skip = left_out(c);
             let feasible = (!skip).then(|| {
-                let prep = c.stances.map(|i| {
-                    Prepared::with_active_fraction(lib.stances[i].scaled(1.0, 1.0), active)
-                });
+                let prep = c
+                    .stances
+                    .map(|i| Prepared::with_active_fraction(lib.stances[i].clone(), active));
                 let lim =
                     [0, 1].map(|k| stance_limits(&prep[k], LimitForm::Absolute, &limits, None));
                 let law = laws

@@ -25,8 +25,8 @@ use crate::query::map::{check_grid, jump_map, Axis, JumpMap, DEFAULT_HEIGHTS, DE
 use crate::query::pairs::ranked_jump_pairs;
 use crate::query::pool::Prepared;
 use crate::query::run::{
-    check_scale, check_speed, check_sweep, clip_gaits, nearest_in_speed, run_at_speed, run_cycles,
-    scale_limits, RunCycle, ScaledStance,
+    character_laws, check_scale, check_speed, check_sweep, nearest_in_speed, run_at_speed,
+    run_cycles, scale_limits, RunCycle, ScaledStance,
 };
 use crate::query::tables::{jump_map_table, jump_pairs_table, jump_table, run_table, RunRow};
 use crate::stances::limits::S_EFF_RANGE;
@@ -236,11 +236,7 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
             (*c, prep, lim)
         })
         .collect();
-    let gaits = clip_gaits(&lib.stances, &cycles);
-    let laws: BTreeMap<String, GaitLaw> = gaits
-        .iter()
-        .map(|(ch, clips)| (ch.clone(), q.gait_law.law(clips)))
-        .collect();
+    let laws = character_laws(&lib.stances, &cycles, q.gait_law);
     let speeds_of: Vec<(&str, f64)> = scaled
         .iter()
         .map(|(c, p, _)| (p[0].stance.character_id.as_str(), c.v_orig * length.sqrt()))

@@ -214,6 +214,18 @@ pub fn clip_gaits(
     out
 }
 
+/// Each character's gait law under `choice`, from its clips' cycles ([`clip_gaits`]).
+pub fn character_laws(
+    pool: &[PoolStance],
+    cycles: &[RunCycle],
+    choice: super::gait::LawChoice,
+) -> std::collections::BTreeMap<String, GaitLaw> {
+    clip_gaits(pool, cycles)
+        .iter()
+        .map(|(ch, clips)| (ch.clone(), choice.law(clips)))
+        .collect()
+}
+
 /// The request of the run-at-speed policy for one stance: `(vs, ve, x)·k`.
 pub fn policy_request(p: &PoolStance, k: f64) -> Request {
     let q = &p.params;
