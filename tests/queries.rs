@@ -707,3 +707,53 @@ fn fixture_jumps_are_feasible_as_recorded_under_both_limit_forms() {
     }
     assert!(checked >= 4, "only {checked} recorded jumps checked");
 }
+
+// See: issue 37 (each "no" says which limit and by how much) and issue 38 item 1 — the
+// terminal verdict of an infeasible answer names the constraint with its value, the limit
+// and the margin in units.
+#[test]
+fn infeasible_answers_say_which_limit_and_by_how_much() {
+    let lib = crate::util::fixture_library().display().to_string();
+    let out = tempfile::tempdir().unwrap();
+    let o = out.path().join("j.parquet").display().to_string();
+    // The fixtures' vertical jumps at an apex 18 cm above the recorded 1.12 m, under the
+    // ±5 % relative limits: the push-off needs more force than 1.05 × its own peak.
+    let printed = ok(&[
+        "query",
+        "jump",
+        "--lib",
+        &lib,
+        "--height",
+        "1.3",
+        "--distance",
+        "0",
+        "--limits",
+        "relative",
+        "--out",
+        &o,
+    ]);
+    let line = printed
+        .lines()
+        .find(|l| l.contains("jump_100hz_m_zup:LR:35") && l.contains("jump_100hz_m_zup:LR:125"))
+        .expect("the recorded pair is printed");
+    assert!(
+        line.contains("infeasible: liftoff: force")
+            && line.contains(" N > ")
+            && line.contains("(by "),
+        "{line}"
+    );
+    // The margin printed is the table's (margin_force1_n is its negative).
+    let t = Table::open(std::path::Path::new(&o)).unwrap();
+    let (up, down) = (
+        t.strings("liftoff_stance_id").unwrap(),
+        t.strings("landing_stance_id").unwrap(),
+    );
+    let row = (0..t.height())
+        .find(|&r| up[r] == "jump_100hz_m_zup:LR:35" && down[r] == "jump_100hz_m_zup:LR:125")
+        .unwrap();
+    let margin = t.opt_f64("margin_force1_n").unwrap()[row].unwrap();
+    assert!(
+        margin < 0.0 && line.contains(&format!("(by {:.0} N)", -margin)),
+        "{line} vs {margin}"
+    );
+}

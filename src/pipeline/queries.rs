@@ -317,7 +317,7 @@ fn run_line(r: &RunRow) -> RunLine {
         gait_law: r.candidate.timing.law.source.name(),
         used: r.used,
         feasible: r.candidate.feasible(),
-        violated: r.violated(),
+        violated: r.explain(),
     }
 }
 
@@ -634,6 +634,9 @@ pub struct JumpLine {
     pub beta: Option<[[f64; 2]; 2]>,
     /// Feasible by the exact check.
     pub feasible: bool,
+    /// Why not, with the deciding value, limit and margin
+    /// ([`crate::query::tables::JumpRow::explain`]).
+    pub why: Option<String>,
 }
 
 /// Runs `query jump`: ranks every pair (feasible first, then the least force change),
@@ -674,6 +677,7 @@ pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
                 })
             }),
             feasible: r.jump.as_ref().is_ok_and(|j| j.feasible()),
+            why: r.explain(),
         })
         .collect())
 }

@@ -27,6 +27,42 @@ pub fn violation_name(v: Violation) -> &'static str {
     }
 }
 
+/// The deciding constraint of an infeasible scaled stance, with its value, its limit (as
+/// the exact check applies it, [`Limits::effective`]) and the margin in units:
+/// `force 1812 N > 1750 N (by 62 N)`. `None` when feasible.
+pub fn violation_detail(verdict: &Verdict, lim: &Limits) -> Option<String> {
+    let l = lim.effective();
+    let v = verdict.violated?;
+    let name = violation_name(v);
+    Some(match v {
+        Violation::Force => format!(
+            "{name} {:.0} N > {:.0} N (by {:.0} N)",
+            verdict.f_peak,
+            l.f_max,
+            verdict.f_peak - l.f_max
+        ),
+        Violation::Friction => format!(
+            "{name} μ {:.3} > {:.3} (by {:.3})",
+            verdict.mu_req,
+            l.mu,
+            verdict.mu_req - l.mu
+        ),
+        Violation::ExtensionMin => format!(
+            "{name} {:.3} m < {:.3} m (by {:.3} m)",
+            verdict.ext_min,
+            l.chi_min,
+            l.chi_min - verdict.ext_min
+        ),
+        Violation::ExtensionMax => format!(
+            "{name} {:.3} m > {:.3} m (by {:.3} m)",
+            verdict.ext_max,
+            l.chi_max,
+            verdict.ext_max - l.chi_max
+        ),
+        Violation::Beta | Violation::Unilateral => name.to_string(),
+    })
+}
+
 /// One `query run` row: a cycle at one speed for one character.
 pub struct RunRow<'a> {
     /// Length scale `L` of the target character.
@@ -63,6 +99,23 @@ impl RunRow<'_> {
                         .verdict
                         .violated
                         .map(|v| format!("{id}: {}", violation_name(v))),
+                }
+            })
+    }
+
+    /// First problem with its value, limit and margin (`<stance_id>: force 1812 N > 1750 N
+    /// (by 62 N)`, [`violation_detail`]), or the solver's reason; `None` when feasible.
+    pub fn explain(&self) -> Option<String> {
+        self.candidate
+            .stances
+            .iter()
+            .zip(self.stances)
+            .zip(&self.limits)
+            .find_map(|((s, p), lim)| {
+                let id = &p.stance.stance_id;
+                match s {
+                    Err(e) => Some(format!("{id}: {e}")),
+                    Ok(s) => violation_detail(&s.verdict, lim).map(|d| format!("{id}: {d}")),
                 }
             })
     }
@@ -201,6 +254,21 @@ pub struct JumpRow<'a> {
 }
 
 impl JumpRow<'_> {
+    /// First problem with its value, limit and margin (`liftoff: force 1812 N > 1750 N
+    /// (by 62 N)`, [`violation_detail`]), or the solver's reason; `None` when feasible.
+    pub fn explain(&self) -> Option<String> {
+        match &self.jump {
+            Err(e) => Some(e.clone()),
+            Ok(j) => ["liftoff", "landing"]
+                .iter()
+                .zip(&j.sides)
+                .zip(&self.limits)
+                .find_map(|((n, (_, s)), lim)| {
+                    violation_detail(&s.verdict, lim).map(|d| format!("{n}: {d}"))
+                }),
+        }
+    }
+
     /// First problem, `liftoff: force`, or the solver's reason.
     pub fn violated(&self) -> Option<String> {
         match &self.jump {

@@ -49,7 +49,7 @@ pub fn print_run(report: &RunReport, out: &Path) {
         let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
         let verdict = match (&r.violated, r.feasible) {
             (_, true) => "feasible".to_string(),
-            (Some(why), false) => format!("infeasible ({why})"),
+            (Some(why), false) => format!("infeasible: {why}"),
             (None, false) => "infeasible".to_string(),
         };
         crate::say!(
@@ -92,7 +92,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
     };
     let lines = jump_query(&q)?;
     crate::say!(
-        "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8}",
+        "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6}  verdict",
         "rank",
         "liftoff",
         "landing",
@@ -101,13 +101,17 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         "β_v1",
         "β_h2",
         "β_v2",
-        "feasible"
     );
     let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
     for (i, r) in lines.iter().take(a.top).enumerate() {
         let b = |k: usize, ax: usize| f(r.beta.map(|b| b[k][ax]));
+        let verdict = match (&r.why, r.feasible) {
+            (_, true) => "feasible".to_string(),
+            (Some(why), false) => format!("infeasible: {why}"),
+            (None, false) => "infeasible".to_string(),
+        };
         crate::say!(
-            "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6} {:>8}",
+            "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6}  {}",
             i + 1,
             r.liftoff,
             r.landing,
@@ -116,7 +120,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
             b(0, 1),
             b(1, 0),
             b(1, 1),
-            r.feasible
+            verdict
         );
     }
     let n_ok = lines.iter().filter(|r| r.feasible).count();
