@@ -118,18 +118,16 @@ pub fn choose_run(
             let paper = law.source == LawSource::Paper;
             let prep = cy.stances.map(|i| {
                 let s = pool[i].stance.scaled(length, mass);
-                let p = Prepared::with_active_fraction(s.clone(), limits.active);
-                let lim = stance_limits(&p, limits.form, &absolute, limits.mu);
+                let t_e0 = s.params.t_e;
                 let s = if paper {
                     s
                 } else {
                     s.time_scaled(timing.sigma_c)
                 };
-                (
-                    Prepared::with_active_fraction(s, limits.active),
-                    lim,
-                    p.stance.params.t_e,
-                )
+                // Stretching in time leaves the coefficients the limits read unchanged.
+                let p = Prepared::with_active_fraction(s, limits.active);
+                let lim = stance_limits(&p, limits.form, &absolute, limits.mu);
+                (p, lim, t_e0)
             });
             let k0 = target.speed_mps / v_orig;
             refine_run_k(target.speed_mps, k0, |k| {

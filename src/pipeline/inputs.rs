@@ -291,7 +291,7 @@ pub const MAX_POINTS_BYTES: u64 = 256 << 20;
 
 /// Largest force-plate file read (CSV), bytes (256 MiB). Two plates at 1 kHz take about
 /// 120 bytes per row (17 columns), so this is over half an hour of one recording, longer
-/// than any clip it goes with (those in `../shared/data/forceplate` are under 100 kB).
+/// than any clip it goes with (the force-plate recordings the tests use are under 100 kB).
 /// The text is read whole and its samples take 32 bytes per row.
 pub const MAX_PLATES_BYTES: u64 = 256 << 20;
 

@@ -94,27 +94,6 @@ pub fn stance_limits(
     }
 }
 
-/// The library's foot stances beyond what a person's legs do
-/// ([`crate::stances::limits::beyond_bounds`]): `(stance_id, why)`, in library order.
-/// Their characters' limits are capped there; the stances themselves stay feasible as
-/// recorded.
-pub fn implausible(lib: &StanceLibrary) -> Vec<(String, String)> {
-    lib.stances
-        .iter()
-        .filter(|s| !s.label.contains('H'))
-        .filter_map(|s| {
-            let leg = lib.clips.get(&s.clip).and_then(|c| c.leg_m)?;
-            crate::stances::limits::beyond_bounds(
-                s.coef.f_peak,
-                s.model.mass_kg,
-                s.coef.ext_max,
-                leg,
-            )
-            .map(|why| (s.stance_id.clone(), why))
-        })
-        .collect()
-}
-
 /// Whether a clip's flights say its time base is wrong (`s_eff` outside
 /// [`S_EFF_RANGE`]): its cycles are left out of the run queries.
 pub fn time_scaled(lib: &StanceLibrary, clip: &str) -> bool {

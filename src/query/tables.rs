@@ -34,33 +34,18 @@ pub fn violation_detail(verdict: &Verdict, lim: &Limits) -> Option<String> {
     let l = lim.effective();
     let v = verdict.violated?;
     let name = violation_name(v);
-    Some(match v {
-        Violation::Force => format!(
-            "{name} {:.0} N > {:.0} N (by {:.0} N)",
-            verdict.f_peak,
-            l.f_max,
-            verdict.f_peak - l.f_max
-        ),
-        Violation::Friction => format!(
-            "{name} μ {:.3} > {:.3} (by {:.3})",
-            verdict.mu_req,
-            l.mu,
-            verdict.mu_req - l.mu
-        ),
-        Violation::ExtensionMin => format!(
-            "{name} {:.3} m < {:.3} m (by {:.3} m)",
-            verdict.ext_min,
-            l.chi_min,
-            l.chi_min - verdict.ext_min
-        ),
-        Violation::ExtensionMax => format!(
-            "{name} {:.3} m > {:.3} m (by {:.3} m)",
-            verdict.ext_max,
-            l.chi_max,
-            verdict.ext_max - l.chi_max
-        ),
-        Violation::Beta | Violation::Unilateral => name.to_string(),
-    })
+    // (value, limit, sign of the comparison it fails, unit, decimals)
+    let (value, limit, op, unit, digits) = match v {
+        Violation::Force => (verdict.f_peak, l.f_max, '>', " N", 0),
+        Violation::Friction => (verdict.mu_req, l.mu, '>', "", 3),
+        Violation::ExtensionMin => (verdict.ext_min, l.chi_min, '<', " m", 3),
+        Violation::ExtensionMax => (verdict.ext_max, l.chi_max, '>', " m", 3),
+        Violation::Beta | Violation::Unilateral => return Some(name.to_string()),
+    };
+    let by = (value - limit).abs();
+    Some(format!(
+        "{name} {value:.digits$}{unit} {op} {limit:.digits$}{unit} (by {by:.digits$}{unit})"
+    ))
 }
 
 /// One `query run` row: a cycle at one speed for one character.

@@ -108,7 +108,7 @@ pub use crate::math::constants::DEFAULT_MU;
 /// Margin on the extremes of the example stances.
 pub const MARGIN: f64 = 1.05;
 /// No character's force limit exceeds this many body weights (a stance above it is named
-/// by `query::limits::implausible`).
+/// by `info`, [`beyond_bounds`]).
 pub const F_MAX_CAP_BW: f64 = 6.0;
 /// `χ_max` of every character, leg lengths: what a leg reaches (the locomotion stances'
 /// median is 1.16, their 95th percentile 1.64 with climbing and hanging; a runner's stance
