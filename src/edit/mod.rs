@@ -74,6 +74,7 @@
 //! characters); the closed forms of the force model (`force_model::model`).
 
 pub mod detail;
+pub mod fidelity;
 pub mod lean;
 pub mod path;
 pub mod plan;
@@ -107,17 +108,34 @@ pub const DEFAULT_MAX_REACH: f64 = 0.999;
 pub const DEFAULT_MAX_TOE_PIVOT_DEG: f64 = 50.0;
 /// Largest turn of the pelvis (root) about each of its axes to let a support leg reach,
 /// degrees ([`posture`]): a foot still out of reach on its upright toe (the end of a push
-/// faster than recorded) is reached by moving the COM relative to the stance hip instead
+/// faster than recorded) is reached by moving the stance hip relative to the COM instead
 /// of leaving the floor. 10° of rotation, hip hike or pitch is within a runner's own
-/// cycle-to-cycle pelvis motion.
+/// cycle-to-cycle pelvis motion. The trunk keeps its orientation (its lean is the
+/// recording's; issue 37).
 pub const DEFAULT_MAX_PELVIS_TURN_DEG: f64 = 10.0;
-/// Largest extra forward or backward lean of the trunk (about its first joint) for the same
-/// purpose, degrees: runners lean further forward as they go faster.
-pub const DEFAULT_MAX_TRUNK_LEAN_DEG: f64 = 15.0;
 /// Ramp of a solved posture change in and out, s ([`posture::envelope`]): the change grows
 /// from zero over this time before the frames that need it and decays over it after, so
 /// that a lean of 10° turns at most a few degrees per frame at 120 Hz.
 pub const DEFAULT_POSTURE_RAMP_S: f64 = 0.1;
+/// Where a leg starts to share its extension with the foot, as a fraction of thigh plus
+/// shank ([`pose`]'s toe pivot): a support ankle asked farther from the hip than this (or
+/// than the reference leg's own extension, if longer) is reached partly by the knee and
+/// partly by the heel rising about the toe tip, the knee's share approaching the reach
+/// [`DEFAULT_MAX_REACH`] smoothly (`tanh`) instead of snapping straight in one frame.
+/// Without it a jump 1.1 × higher than recorded straightened the knee from 27° to locked in
+/// one 120 Hz frame at the end of its push and the root accelerated at 17 g there (the
+/// recording: under 5 g). 0.95 leaves 36° of knee flexion where the sharing begins, about
+/// what a vertical push has left a tenth of a second before liftoff.
+pub const DEFAULT_SOFT_REACH: f64 = 0.95;
+/// How long before its touchdown and after its liftoff a swinging foot is held on its
+/// planted path, s ([`pose`]): between, it follows the body (the reference pose placed by
+/// the planned COM), so a flight higher than recorded keeps the recorded bent knees instead
+/// of stretching the legs to feet held at the recorded height above the floor (a jump
+/// 1.2 × higher than recorded held both knees locked through its whole flight). The hold
+/// fades in and out with a smoothstep over this time, so the foot leaves and meets the floor
+/// on the plan; 0.1 s is about the time a running foot takes to rise or sink through its
+/// last 5 cm.
+pub const DEFAULT_SWING_HOLD_S: f64 = 0.1;
 /// Resting band of a planted foot point, m: from the first to the last frame of a stance
 /// where the ankle or the toe tip is within this of its lowest height in the stance, its
 /// horizontal motion is the capture's slide and is removed from the planted foot
@@ -167,10 +185,12 @@ pub struct EditOptions {
     pub max_toe_pivot_deg: f64,
     /// [`DEFAULT_MAX_PELVIS_TURN_DEG`].
     pub max_pelvis_turn_deg: f64,
-    /// [`DEFAULT_MAX_TRUNK_LEAN_DEG`].
-    pub max_trunk_lean_deg: f64,
     /// [`DEFAULT_POSTURE_RAMP_S`].
     pub posture_ramp_s: f64,
+    /// [`DEFAULT_SOFT_REACH`].
+    pub soft_reach: f64,
+    /// [`DEFAULT_SWING_HOLD_S`].
+    pub swing_hold_s: f64,
 }
 
 impl Default for EditOptions {
@@ -182,8 +202,9 @@ impl Default for EditOptions {
             max_reach: DEFAULT_MAX_REACH,
             max_toe_pivot_deg: DEFAULT_MAX_TOE_PIVOT_DEG,
             max_pelvis_turn_deg: DEFAULT_MAX_PELVIS_TURN_DEG,
-            max_trunk_lean_deg: DEFAULT_MAX_TRUNK_LEAN_DEG,
             posture_ramp_s: DEFAULT_POSTURE_RAMP_S,
+            soft_reach: DEFAULT_SOFT_REACH,
+            swing_hold_s: DEFAULT_SWING_HOLD_S,
         }
     }
 }

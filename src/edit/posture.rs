@@ -1,42 +1,45 @@
-//! Whole-body posture for reach: when a support foot's goal is beyond the leg's reach from
-//! the hip where the planned COM puts it, the pelvis and the trunk turn a little so that the
-//! COM moves relative to the stance hip (a runner faster than recorded leans into the push
-//! instead of leaving the floor early).
+//! Pelvis posture for reach: when a support foot's goal is beyond the leg's reach from the
+//! hip where the planned COM puts it, the pelvis turns a little under a trunk that keeps its
+//! orientation, so that the stance hip moves towards the foot relative to the COM (a runner
+//! faster than recorded drops and turns the hip into the push instead of leaving the floor
+//! early). The trunk's lean stays the recording's.
 //!
 //! # Model
 //! ```text
-//! degrees of freedom x ∈ [−1, 1]⁴ (scaled by their bounds b):
-//!   pelvis (root) pitch, roll, yaw    θ_d = x_d · b_pelvis   about the root
-//!   trunk pitch                       θ_3 = x_3 · b_trunk    about the trunk's first joint
+//! degrees of freedom x ∈ [−1, 1]³ (scaled by the bound b):
+//!   pelvis (root) pitch, roll, yaw    θ_d = x_d · b    about the root:  R_p = R_up(θ₂) R_fwd(θ₁) R_lat(θ₀)
+//!   the trunk (first joint above the root) turned back by R_p⁻¹: its world orientation is kept
 //!   axes: lateral l = horizontal unit of (H_L − H_R), up z, forward l × z (free pose)
 //! shortfall of support leg k after the root correction (COM on the plan):
 //!   s_k(x) = |G_k − H_k(x) − (c_plan − c(x))| − R_k
 //!   (G_k: the ankle goal after the toe pivot, H_k: hip, R_k: reach, c: COM of the pose)
 //! J_kd = ∂s_k/∂x_d by finite differences of FK + foot IK + COM (once per frame)
-//! x = x_base + y,  y = argmin |y|² + |J y − t|²/λ²  (damped least squares, λ = DAMPING_M)
+//! x = y,  y = argmin |y|² + |J y − t|²/λ²  (damped least squares, λ = DAMPING_M)
 //!   rows: legs with s_k − J_k y > 0,  t_k = −margin − (s_k − J_k y)  (margin: solve tol, 10 µm)
 //!   box x ∈ [−1, 1]: a DOF past its bound is fixed there and the rest re-solved
-//! in time: x_base(i) = P_i − N_i per DOF,  P_i = max_j x_j⁺ κ(t_i − t_j),  N_i likewise for x⁻,
+//! in time: x(i) = P_i − N_i per DOF,  P_i = max_j x_j⁺ κ(t_i − t_j),  N_i likewise for x⁻,
 //!   κ(τ) = 1 − smoothstep(|τ|/T_ramp)   (the solved postures, ramped in and out over T_ramp)
 //! ```
 //! The minimum-norm update leaves the reference posture untouched wherever the leg reaches
-//! (`y = 0` when no row is active) and otherwise changes the most effective joints most.
-//! On the CMU run at 1.1 × its speed the left push-offs then end within 0.91 frames of the
-//! plan (2.0 frames early with the leg alone) and every frame converges (10 did not);
-//! method and figures in `docs/edited-motion.md`.
+//! (`y = 0` when no row is active) and otherwise changes the most effective turns most.
+//! Until issue 37 a fourth degree of freedom leaned the trunk forward (15°) and the pelvis
+//! pitch carried the trunk with it: the CMU run edited to 4 and 5 m/s leaned 35–39° (p95;
+//! recorded at most 17.4°), and the push-offs that did not reach at 5 m/s did not reach
+//! with the lean either; method and figures in `docs/edited-motion.md`.
 //!
 //! # Frames and units
 //! Axes and rotations in file axes; shortfalls, the Jacobian's rows and the damping in metres
-//! (per unit of `x`); bounds in radians.
+//! (per unit of `x`); the bound in radians.
 
 use super::rotation::{self as rot, Quat};
 use crate::math::v3::{cross, dot, norm, V3};
 
-/// Number of posture degrees of freedom (pelvis pitch, roll, yaw; trunk pitch). A sideways
-/// trunk lean was tried as a fifth: it moves the COM along the leg by a twentieth of the
-/// others (0.5 mm per bound against 7–15 mm) and, once the others reach their bounds, the
-/// least-squares step threw it from one bound to the other between frames (14° a frame).
-pub const N_DOF: usize = 4;
+/// Number of posture degrees of freedom (pelvis pitch, roll, yaw). A trunk lean was a fourth
+/// until issue 37 (see the module docs), and a sideways trunk lean was tried as a fifth: it
+/// moves the COM along the leg by a twentieth of the others (0.5 mm per bound against
+/// 7–15 mm) and, once the others reach their bounds, the least-squares step threw it from
+/// one bound to the other between frames (14° a frame).
+pub const N_DOF: usize = 3;
 /// A posture change, each degree of freedom as a fraction of its bound.
 pub type Posture = [f64; N_DOF];
 /// No change.
@@ -58,20 +61,20 @@ pub struct PostureFrame {
     root: usize,
     /// Trunk joint, its parent's and its own world rotation in the free pose.
     trunk: Option<(usize, Quat, Quat)>,
-    /// Bounds: pelvis, trunk (rad).
-    bounds: [f64; 2],
+    /// Bound of each pelvis turn (rad).
+    bound: f64,
 }
 
 impl PostureFrame {
     /// The frame of a free pose: hips `hips` (left, right; file), up axis `up` (file, unit),
     /// the root, the trunk joint with its parent's and its own world rotation, and the
-    /// bounds of the pelvis and trunk turns (rad).
+    /// bound of the pelvis turns (rad).
     pub fn new(
         hips: [V3; 2],
         up: V3,
         root: usize,
         trunk: Option<(usize, Quat, Quat)>,
-        bounds: [f64; 2],
+        bound: f64,
     ) -> PostureFrame {
         let d: V3 = std::array::from_fn(|i| hips[0][i] - hips[1][i]);
         let h = dot(d, up);
@@ -95,33 +98,27 @@ impl PostureFrame {
             axes: [lat, fwd, up],
             root,
             trunk,
-            bounds,
+            bound,
         }
     }
 
     /// Applies posture `x` to the free pose's local rotations `q` (in place): the root
     /// turned by `R_p = R_up(θ₂) R_fwd(θ₁) R_lat(θ₀)` about its own position, the trunk joint
-    /// by `R_t = R_lat(θ₃)` in world axes after it
-    /// (`q_t = (R_p W_parent)⁻¹ R_t R_p W_t`).
+    /// keeping its world rotation (`q_t = (R_p W_parent)⁻¹ W_t`).
     pub fn apply(&self, x: &Posture, q: &mut [Quat]) {
         if x.iter().all(|&v| v == 0.0) {
             return;
         }
         let [lat, fwd, up] = self.axes;
-        let [bp, bt] = self.bounds;
+        let b = self.bound;
         let rp = rot::mul(
-            rot::axis_angle(up, x[2] * bp),
-            rot::mul(
-                rot::axis_angle(fwd, x[1] * bp),
-                rot::axis_angle(lat, x[0] * bp),
-            ),
+            rot::axis_angle(up, x[2] * b),
+            rot::mul(rot::axis_angle(fwd, x[1] * b), rot::axis_angle(lat, x[0] * b)),
         );
         q[self.root] = rot::normalize(rot::mul(rp, q[self.root]));
         if let Some((j, w_parent, w_own)) = self.trunk {
-            let rt = rot::axis_angle(lat, x[3] * bt);
             let parent = rot::mul(rp, w_parent);
-            let own = rot::mul(rt, rot::mul(rp, w_own));
-            q[j] = rot::normalize(rot::mul(rot::conj(parent), own));
+            q[j] = rot::normalize(rot::mul(rot::conj(parent), w_own));
         }
     }
 }
@@ -170,7 +167,7 @@ pub fn dls_step(rows: &[Row], lambda: f64, lo: &Posture, hi: &Posture) -> Postur
 /// `z = (J Jᵀ + μ I)⁻¹ t` for one or two rows (Cramer's rule); zeros for more rows or a
 /// singular system.
 fn solve_small(j: &[Posture], t: &[f64], mu: f64) -> Vec<f64> {
-    let g = |a: usize, b: usize| dot5(&j[a], &j[b]);
+    let g = |a: usize, b: usize| dot_n(&j[a], &j[b]);
     match j.len() {
         1 => {
             let a = g(0, 0) + mu;
@@ -189,7 +186,7 @@ fn solve_small(j: &[Posture], t: &[f64], mu: f64) -> Vec<f64> {
     }
 }
 
-fn dot5(a: &Posture, b: &Posture) -> f64 {
+fn dot_n(a: &Posture, b: &Posture) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -239,10 +236,10 @@ mod tests {
 
     #[test]
     fn dls_step_meets_one_row_with_the_minimum_norm_change() {
-        let j = [0.02, -0.01, 0.0, 0.03];
+        let j = [0.02, -0.01, 0.03];
         let y = dls_step(&[(j, -0.01)], 0.0, &[-1.0; N_DOF], &[1.0; N_DOF]);
         // Undamped, one row, no bound active: J·y = t, and y is parallel to J.
-        assert!((dot5(&j, &y) + 0.01).abs() < 1e-12, "{y:?}");
+        assert!((dot_n(&j, &y) + 0.01).abs() < 1e-12, "{y:?}");
         let s = y[0] / j[0];
         for d in 0..N_DOF {
             assert!((y[d] - s * j[d]).abs() < 1e-12, "{y:?}");
@@ -251,25 +248,25 @@ mod tests {
 
     #[test]
     fn dls_step_moves_a_clamped_share_to_the_other_dofs() {
-        let j = [0.02, 0.0, 0.0, 0.02];
+        let j = [0.02, 0.0, 0.02];
         // Unbounded the step would be 1.0 on each DOF (over the 0.5 bound).
-        let hi = [0.5, 1.0, 1.0, 1.0];
+        let hi = [0.5, 1.0, 1.0];
         let y = dls_step(&[(j, -0.04)], 0.0, &[-1.0; N_DOF], &[1.0; N_DOF]);
         assert!(
-            (y[0] + 1.0).abs() < 1e-12 && (y[3] + 1.0).abs() < 1e-12,
+            (y[0] + 1.0).abs() < 1e-12 && (y[2] + 1.0).abs() < 1e-12,
             "{y:?}"
         );
         let y = dls_step(&[(j, 0.03)], 0.0, &[-1.0; N_DOF], &hi);
         assert_eq!(y[0], 0.5);
-        assert!((dot5(&j, &y) - 0.03).abs() < 1e-12, "{y:?}");
+        assert!((dot_n(&j, &y) - 0.03).abs() < 1e-12, "{y:?}");
     }
 
     #[test]
     fn envelope_ramps_in_and_out_and_keeps_the_solved_peak() {
         let dt = 0.01;
         let mut xs = vec![POSTURE_ZERO; 41];
-        xs[20] = [0.5, -0.2, 0.0, 0.0];
-        xs[21] = [0.3, 0.0, 0.0, 0.0];
+        xs[20] = [0.5, -0.2, 0.0];
+        xs[21] = [0.3, 0.0, 0.0];
         let e = envelope(&xs, dt, 0.1);
         assert_eq!(e[20], xs[20]);
         assert!(e[21][0] >= xs[21][0]);
@@ -282,5 +279,27 @@ mod tests {
                 "frame {i}"
             );
         }
+    }
+
+    #[test]
+    fn pelvis_turns_under_a_trunk_that_keeps_its_world_orientation() {
+        // Root 0, trunk 1 (child of the root), Z up, hips along ±y: lateral +y.
+        let up = [0.0, 0.0, 1.0];
+        let q_root = rot::axis_angle([0.0, 0.0, 1.0], 0.3);
+        let q_trunk = rot::axis_angle([0.0, 1.0, 0.0], 0.2);
+        let w_trunk = rot::mul(q_root, q_trunk);
+        let fr = PostureFrame::new(
+            [[0.0, 0.1, 0.0], [0.0, -0.1, 0.0]],
+            up,
+            0,
+            Some((1, q_root, w_trunk)),
+            10f64.to_radians(),
+        );
+        let mut q = vec![q_root, q_trunk];
+        fr.apply(&[0.7, -0.4, 1.0], &mut q);
+        // The root turned; the trunk's world rotation is the free pose's.
+        assert!(rot::angle_deg(q[0], q_root) > 5.0);
+        let w = rot::mul(q[0], q[1]);
+        assert!(rot::angle_deg(w, w_trunk) < 1e-9, "{}", rot::angle_deg(w, w_trunk));
     }
 }

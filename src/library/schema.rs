@@ -754,6 +754,27 @@ pub mod edit_plan {
     pub const ITERATIONS: &str = "iterations";
     /// `violated`: `<stance_id>: <constraint>` when the frame's stance breaks one.
     pub const VIOLATED: &str = "violated";
+    /// `pelvis_turn_pitch_deg`, `_roll_deg`, `_yaw_deg`: The turn of the pelvis under the
+    /// trunk that let a support leg reach (`edit::posture`; 0 where the reference pose
+    /// reaches), deg.
+    pub const PELVIS_TURN: [&str; 3] = [
+        "pelvis_turn_pitch_deg",
+        "pelvis_turn_roll_deg",
+        "pelvis_turn_yaw_deg",
+    ];
+    /// `source_clip_s`: Clip time of the source pose the frame is taken from, s (in a
+    /// flight between two stances, that of the edge weighing more in the blend).
+    pub const SOURCE_TIME: &str = "source_clip_s";
+    /// `trunk_lean_deg`: Trunk lean of the written pose (mid-hip to neck base against
+    /// vertical, in the pelvis's sagittal plane; forward +), deg (`edit::fidelity`).
+    pub const TRUNK_LEAN: &str = "trunk_lean_deg";
+    /// `knee_flexion_left_deg`: Left knee flexion of the written pose, deg (0 = straight).
+    pub const KNEE_LEFT: &str = "knee_flexion_left_deg";
+    /// `knee_flexion_right_deg`: Right knee flexion of the written pose, deg.
+    pub const KNEE_RIGHT: &str = "knee_flexion_right_deg";
+    /// `root_accel_mps2`: Root acceleration from the written frames' second difference,
+    /// m/s² (0 on the first and last frame).
+    pub const ROOT_ACCEL: &str = "root_accel_mps2";
 
     /// The column of axis `a` (0 = x, 1 = y, 2 = z) of the 3-vector `prefix`, in m.
     pub fn axis_column(prefix: &str, a: usize) -> String {

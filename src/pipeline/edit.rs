@@ -10,6 +10,7 @@ use anyhow::Context;
 use super::edit_outputs::{plan_table, plot_of, sidecars, EditOutputs};
 use super::queries::{load_pool, query_kv, write_table, LimitOptions};
 use crate::bvh::{parse_file, write_file, Bvh};
+use crate::edit::fidelity::{check, FidelityOptions};
 use crate::edit::plan::{place, EditStance, PlanKind, StanceTiming};
 use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
@@ -81,6 +82,10 @@ pub struct EditReport {
     pub violated: Vec<String>,
     /// Frames whose COM or foot stayed off by more than the tolerance.
     pub unconverged: usize,
+    /// The posture and smoothness figures against the source ([`crate::edit::fidelity`]).
+    pub fidelity: String,
+    /// One line per posture or smoothness check that fails.
+    pub unfaithful: Vec<String>,
 }
 
 impl EditTarget {
@@ -272,6 +277,16 @@ fn compute(
     );
     let footprints = path.stances.iter().map(|s| s.contact_point()).collect();
     let violated = stances.iter().filter_map(EditStance::violated).collect();
+    let fidelity = check(
+        &reference.body,
+        &reference.motion,
+        &edited.motion,
+        &edited.frames,
+        match kind {
+            PlanKind::Run => FidelityOptions::run(),
+            PlanKind::Jump | PlanKind::PairedJump => FidelityOptions::jump(),
+        },
+    );
     Ok(EditOutputs {
         bvh,
         edited,
@@ -280,6 +295,7 @@ fn compute(
         order,
         footprints,
         violated,
+        fidelity,
     })
 }
 
@@ -318,5 +334,7 @@ fn finish(
         png,
         violated: e.violated,
         unconverged: e.edited.frames.iter().filter(|f| !f.converged).count(),
+        fidelity: e.fidelity.summary(),
+        unfaithful: e.fidelity.failures(),
     })
 }

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use polars::prelude::{Column, DataFrame, PolarsResult};
 
 use crate::bvh::Bvh;
+use crate::edit::fidelity::{Fidelity, Gauge};
 use crate::edit::path::Phase;
 use crate::edit::plan::EditStance;
 use crate::edit::pose::{EditedMotion, Reference};
@@ -34,6 +35,8 @@ pub struct EditOutputs {
     pub footprints: Vec<[f64; 3]>,
     /// `<stance_id>: <constraint>` of every stance that breaks one.
     pub violated: Vec<String>,
+    /// Posture and smoothness against the source ([`crate::edit::fidelity`]).
+    pub fidelity: Fidelity,
 }
 
 /// The sidecar paths of `FILE.bvh`: `FILE.plan.parquet`, `FILE.png`.
@@ -111,6 +114,25 @@ pub fn plan_table(e: &EditOutputs) -> PolarsResult<DataFrame> {
             .map(|x| stance(&x.phase).and_then(EditStance::violated))
             .collect::<Vec<_>>(),
     ));
+    let bound = crate::edit::DEFAULT_MAX_PELVIS_TURN_DEG;
+    for (d, name) in col::PELVIS_TURN.iter().enumerate() {
+        cols.push(Column::new(
+            (*name).into(),
+            f.iter().map(|x| x.posture[d] * bound).collect::<Vec<_>>(),
+        ));
+    }
+    cols.push(Column::new(
+        col::SOURCE_TIME.into(),
+        f.iter().map(|x| x.source_time_s).collect::<Vec<_>>(),
+    ));
+    let g = &e.fidelity.frames;
+    let gauge = |name: &str, v: &dyn Fn(&Gauge) -> f64| {
+        Column::new(name.into(), g.iter().map(v).collect::<Vec<_>>())
+    };
+    cols.push(gauge(col::TRUNK_LEAN, &|g| g.lean_deg));
+    cols.push(gauge(col::KNEE_LEFT, &|g| g.knee_deg[0]));
+    cols.push(gauge(col::KNEE_RIGHT, &|g| g.knee_deg[1]));
+    cols.push(gauge(col::ROOT_ACCEL, &|g| g.root_accel_mps2));
     DataFrame::new_infer_height(cols)
 }
 

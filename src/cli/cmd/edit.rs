@@ -1,6 +1,8 @@
 //! `stancelib edit run` and `stancelib edit jump`: the options as typed requests, the edit
 //! stage ([`crate::pipeline::edit`]), a summary on stdout. Exit 1 when some frames did not
-//! converge (they are written and flagged in the plan table).
+//! converge (they are written and flagged in the plan table) or the posture leaves the
+//! recorded range, a knee locks through a flight or the root jerks (`edit::fidelity`; each
+//! named on stderr).
 
 use super::super::args::{EditCommon, EditJumpArgs, EditRunArgs};
 use super::super::Outcome;
@@ -69,15 +71,22 @@ fn report(r: &EditReport) -> Outcome {
     for v in &r.violated {
         crate::cli::print_line(format_args!("edit: infeasible, written anyway: {v}"));
     }
-    if r.unconverged == 0 {
-        return Outcome::Clean;
+    crate::cli::print_line(format_args!("edit: {}", r.fidelity));
+    for u in &r.unfaithful {
+        eprintln!("edit: {u}");
     }
-    eprintln!(
-        "edit: {} of {} frame(s) did not converge (COM or foot more than {} m off; column `{}`)",
-        r.unconverged,
-        r.n_frames,
-        crate::edit::DEFAULT_COM_TOL_M,
-        crate::library::schema::edit_plan::CONVERGED
-    );
-    Outcome::SomeFailed
+    if r.unconverged > 0 {
+        eprintln!(
+            "edit: {} of {} frame(s) did not converge (COM or foot more than {} m off; column `{}`)",
+            r.unconverged,
+            r.n_frames,
+            crate::edit::DEFAULT_COM_TOL_M,
+            crate::library::schema::edit_plan::CONVERGED
+        );
+    }
+    if r.unconverged == 0 && r.unfaithful.is_empty() {
+        Outcome::Clean
+    } else {
+        Outcome::SomeFailed
+    }
 }
