@@ -85,6 +85,8 @@ pub struct FitTable {
     pub vertical_degree: Option<u32>,
     pub ratio_degree_h: Option<u32>,
     pub ratio_degree_p: Option<u32>,
+    pub leg_line_weight: Option<f64>,
+    pub roll_fraction: Option<f64>,
     pub stage_b: Option<bool>,
     pub stage_b_time_refinement: Option<bool>,
     pub max_harmonics: Option<u32>,
@@ -533,6 +535,8 @@ pub fn resolve_fit(
         o.fit.ratio.ratio_degree_p = deg(f.ratio_degree_p, o.fit.ratio.ratio_degree_p);
         o.fit.max_harmonics = f.max_harmonics.map_or(o.fit.max_harmonics, |v| v as usize);
         o.fit.energy = f.energy.unwrap_or(o.fit.energy);
+        o.fit.ratio.leg_line_weight = f.leg_line_weight.unwrap_or(o.fit.ratio.leg_line_weight);
+        o.fit.ratio.roll_fraction = f.roll_fraction.unwrap_or(o.fit.ratio.roll_fraction);
         o.fit.samples = f.samples.map_or(o.fit.samples, |v| v as usize);
     }
     if let Some(m) = cli_model {
