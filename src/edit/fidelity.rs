@@ -16,8 +16,8 @@
 //! checks:
 //!   lean    λ_min − tol_λ ≤ λ ≤ λ_max + tol_λ
 //!   knees   κ_min − tol_κ ≤ κ ≤ κ_max + tol_κ          (both legs pooled)
-//!   flight  a leg with κ < κ_lock on every frame of a flight whose source poses bend it
-//!           (κ ≥ κ_lock on some frame) is locked
+//!   flight  a leg with κ < κ_lock on every frame of a whole flight (between two stances)
+//!           whose source poses bend it (κ ≥ κ_lock on some frame) is locked
 //!   spike   a_i > a_max on a frame whose source time has no source frame above a_max
 //!           within one frame (the capture's own jitter stays where it was)
 //! ```
@@ -221,18 +221,41 @@ pub fn gauge(body: &BodyModel, motion: &Motion) -> Vec<Gauge> {
             root_rel_accel_mps2: 0.0,
         });
         let c = body.com(&pts);
-        roots.push((pts[root], std::array::from_fn::<f64, 3, _>(|k| pts[root][k] - c[k])));
+        roots.push((
+            pts[root],
+            std::array::from_fn::<f64, 3, _>(|k| pts[root][k] - c[k]),
+        ));
     }
     let dt2 = motion.frame_time_s * motion.frame_time_s;
     let second = |p: &dyn Fn(usize) -> V3, i: usize| -> f64 {
         let (a, b, c) = (p(i - 1), p(i), p(i + 1));
         norm(std::array::from_fn(|k| c[k] - 2.0 * b[k] + a[k])) / dt2
     };
-    for i in 1..n.saturating_sub(1) {
-        out[i].root_accel_mps2 = second(&|j| roots[j].0, i);
-        out[i].root_rel_accel_mps2 = second(&|j| roots[j].1, i);
+    for (i, g) in out.iter_mut().enumerate().take(n.saturating_sub(1)).skip(1) {
+        g.root_accel_mps2 = second(&|j| roots[j].0, i);
+        g.root_rel_accel_mps2 = second(&|j| roots[j].1, i);
     }
     out
+}
+
+/// The knee flexion range (both legs, deg) of the source `motion` between clip times `t0`
+/// and `t1` (s; the frames nearest them, past the lead-in rows), `[+∞, −∞]` when empty.
+pub fn recorded_knee_range(body: &BodyModel, motion: &Motion, t0: f64, t1: f64) -> [f64; 2] {
+    let g = gauge(body, motion);
+    let last = g.len().saturating_sub(1);
+    let frame = |t: f64| {
+        ((t / motion.frame_time_s).round().max(0.0) as usize).clamp(body.leadin.min(last), last)
+    };
+    let span = if g.is_empty() || t0 > t1 {
+        &g[..0]
+    } else {
+        &g[frame(t0)..=frame(t1)]
+    };
+    span.iter()
+        .flat_map(|g| g.knee_deg)
+        .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], k| {
+            [lo.min(k), hi.max(k)]
+        })
 }
 
 /// The checks of an edit: its written `motion` and `frames` against the source `reference`
@@ -248,24 +271,30 @@ pub fn check(
     let source = gauge(body, reference);
     let dt_src = reference.frame_time_s;
     let last = source.len().saturating_sub(1);
-    let src_frame = |t: f64| ((t / dt_src).round().max(0.0) as usize).clamp(body.leadin.min(last), last);
-    let (t0, t1) = frames.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
-        (a.min(f.source_time_s), b.max(f.source_time_s))
-    });
+    let src_frame =
+        |t: f64| ((t / dt_src).round().max(0.0) as usize).clamp(body.leadin.min(last), last);
+    let (t0, t1) = frames
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
+            (a.min(f.source_time_s), b.max(f.source_time_s))
+        });
     let recorded = if t0 <= t1 {
         &source[src_frame(t0)..=src_frame(t1)]
     } else {
         &source[..0]
     };
     let range = |g: &[Gauge], v: &dyn Fn(&Gauge) -> [f64; 2]| {
-        g.iter().flat_map(v).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], x| {
-            [lo.min(x), hi.max(x)]
-        })
+        g.iter()
+            .flat_map(v)
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], x| {
+                [lo.min(x), hi.max(x)]
+            })
     };
     let lean = |g: &Gauge| [g.lean_deg; 2];
     let knee = |g: &Gauge| g.knee_deg;
     let (lean_rec, knee_rec) = (range(recorded, &lean), range(recorded, &knee));
-    let outside = |v: f64, r: [f64; 2], tol: f64, low: bool| (low && v < r[0] - tol) || v > r[1] + tol;
+    let outside =
+        |v: f64, r: [f64; 2], tol: f64, low: bool| (low && v < r[0] - tol) || v > r[1] + tol;
     let lean_outside = edited
         .iter()
         .filter(|g| outside(g.lean_deg, lean_rec, options.lean_tol_deg, true))
@@ -294,7 +323,9 @@ pub fn check(
         .map(|(first, n)| {
             let span = first..first + n;
             let max = |v: &mut dyn Iterator<Item = [f64; 2]>| {
-                v.fold([f64::NEG_INFINITY; 2], |m, k| [m[0].max(k[0]), m[1].max(k[1])])
+                v.fold([f64::NEG_INFINITY; 2], |m, k| {
+                    [m[0].max(k[0]), m[1].max(k[1])]
+                })
             };
             FlightKnees {
                 frames: (first, n),
@@ -333,21 +364,40 @@ pub fn check(
 /// between two stances switches from one edge's source time to the other's).
 fn source_window(frames: &[FramePose], i: usize, dt_src: f64) -> (usize, usize) {
     let t = frames[i].source_time_s;
-    let near = |j: usize| frames[j].source_time_s.clamp(t - 2.0 * dt_src, t + 2.0 * dt_src);
-    let ts = [i.checked_sub(1).map(near), Some(t), frames.get(i + 1).map(|_| near(i + 1))];
-    let (t0, t1) = ts.into_iter().flatten().fold((t, t), |(a, b), x| (a.min(x), b.max(x)));
+    let near = |j: usize| {
+        frames[j]
+            .source_time_s
+            .clamp(t - 2.0 * dt_src, t + 2.0 * dt_src)
+    };
+    let ts = [
+        i.checked_sub(1).map(near),
+        Some(t),
+        frames.get(i + 1).map(|_| near(i + 1)),
+    ];
+    let (t0, t1) = ts
+        .into_iter()
+        .flatten()
+        .fold((t, t), |(a, b), x| (a.min(x), b.max(x)));
     (
         (t0 / dt_src).floor().max(0.0) as usize,
         (t1 / dt_src).ceil().max(0.0) as usize,
     )
 }
 
-/// The flights of an edit: runs of consecutive [`Phase::Flight`] frames between the same
-/// two stances, as (first frame, number of frames).
+/// The whole flights of an edit: runs of consecutive [`Phase::Flight`] frames between the
+/// same two stances, as (first frame, number of frames). The half flights before a run's
+/// first stance and after its last (the edit starts and ends at an apex) are left out:
+/// their legs have just left or are about to meet the floor, straight where the push ends.
 fn flight_spans(frames: &[FramePose]) -> Vec<(usize, usize)> {
     let mut out: Vec<(usize, usize)> = Vec::new();
     for (i, f) in frames.iter().enumerate() {
-        if !matches!(f.phase, Phase::Flight { .. }) {
+        if !matches!(
+            f.phase,
+            Phase::Flight {
+                before: Some(_),
+                after: Some(_)
+            }
+        ) {
             continue;
         }
         match out.last_mut() {
@@ -362,7 +412,9 @@ impl FlightKnees {
     /// The legs locked through the whole flight while the source bends them.
     pub fn locked_legs(&self, lock_deg: f64) -> Vec<usize> {
         (0..2)
-            .filter(|&s| self.locked_frames[s] == self.frames.1 && self.source_max_deg[s] >= lock_deg)
+            .filter(|&s| {
+                self.locked_frames[s] == self.frames.1 && self.source_max_deg[s] >= lock_deg
+            })
             .collect()
     }
 }

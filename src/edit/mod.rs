@@ -127,6 +127,19 @@ pub const DEFAULT_POSTURE_RAMP_S: f64 = 0.1;
 /// recording: under 5 g). 0.95 leaves 36° of knee flexion where the sharing begins, about
 /// what a vertical push has left a tenth of a second before liftoff.
 pub const DEFAULT_SOFT_REACH: f64 = 0.95;
+/// Least knee flexion the reach of [`pose`] gives a leg, degrees (0: the knee straightens
+/// up to [`DEFAULT_MAX_REACH`]); beyond it the heel rises about the toe tip instead
+/// ([`DEFAULT_MAX_TOE_PIVOT_DEG`]), and only a foot still out of reach on its toe
+/// straightens the knee further. `edit jump` keeps 0 (a jump higher than recorded pushes
+/// further than the recorded push); `edit run` sets it per edit to the source's least
+/// knee flexion over the cycle less [`RUN_KNEE_SLACK_DEG`] (issue 37: the fixture run
+/// edited to 5 m/s landed with its knee at 5° where the recording bends it 32.5° or more).
+pub const DEFAULT_MIN_KNEE_FLEXION_DEG: f64 = 0.0;
+/// How far a run edit's knee may straighten beyond the source's least flexion over the
+/// cycle, degrees ([`DEFAULT_MIN_KNEE_FLEXION_DEG`]): half the tolerance of the posture
+/// check (`fidelity::DEFAULT_KNEE_TOL_DEG`), the other half left to the frames where the
+/// foot is out of reach even on its toe.
+pub const RUN_KNEE_SLACK_DEG: f64 = 5.0;
 /// How long before its touchdown and after its liftoff a swinging foot is held on its
 /// planted path, s ([`pose`]): between, it follows the body (the reference pose placed by
 /// the planned COM), so a flight higher than recorded keeps the recorded bent knees instead
@@ -191,6 +204,8 @@ pub struct EditOptions {
     pub soft_reach: f64,
     /// [`DEFAULT_SWING_HOLD_S`].
     pub swing_hold_s: f64,
+    /// [`DEFAULT_MIN_KNEE_FLEXION_DEG`].
+    pub min_knee_flexion_deg: f64,
 }
 
 impl Default for EditOptions {
@@ -205,6 +220,7 @@ impl Default for EditOptions {
             posture_ramp_s: DEFAULT_POSTURE_RAMP_S,
             soft_reach: DEFAULT_SOFT_REACH,
             swing_hold_s: DEFAULT_SWING_HOLD_S,
+            min_knee_flexion_deg: DEFAULT_MIN_KNEE_FLEXION_DEG,
         }
     }
 }

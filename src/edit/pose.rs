@@ -13,7 +13,12 @@
 //!            turned by its own Δψ, then slerped)
 //! feet       ankle* = c_plan + yaw(Δψ)(ankle_src − c_src − D),  foot orientation = yaw(Δψ)·src
 //!            D: the source foot's slide while resting (Reference::foot_drift)
-//!            swinging: goal = A_ref + h·(ankle* − A_ref),  h = 1 − smoothstep(τ / T_hold)
+//!            swinging: ankle* ← ankle* + z·Δz_COM (the planned COM's rise above the
+//!            source's since the liftoff or until the touchdown), then
+//!            goal = ankle*_h + (A_ref + h·(ankle* − A_ref))_z,  h = 1 − smoothstep(τ / T_hold)
+//!            (horizontally on the planted paths' blend, vertically following the body
+//!            away from the contacts; before a foot's first or after its last stance
+//!            A_ref + h·(ankle* − A_ref) in full)
 //!            (A_ref: where the reference pose puts the ankle, τ: time to the foot's nearest
 //!            own touchdown or liftoff; ankle* between two stances: their smoothstep blend)
 //!            beyond the soft reach ρ(|ankle* − H|): turn the foot about its toe tip T,
@@ -543,9 +548,8 @@ fn wrap_pi(a: f64) -> f64 {
 /// ankle position (file) and world orientation.
 fn anchored(
     r: &Reference,
-    path: &ComPath,
+    c_plan: V3,
     s: &StanceSource,
-    k: usize,
     yaw: f64,
     t_src: f64,
     side: usize,
@@ -555,7 +559,6 @@ fn anchored(
     let [dx, dy] = s.drift_at(side, t_src, r.motion.frame_time_s);
     let planted = sub(p, [s.anchor[0] + dx, s.anchor[1] + dy, s.anchor[2]]);
     let rel = rot::rotate(rot::axis_angle([0.0, 0.0, 1.0], yaw), planted);
-    let c_plan = path.stances[k].contact_point();
     (
         body.to_file(add(c_plan, rel)),
         rot::mul(rot::axis_angle(up_file(body), yaw), q),
@@ -568,12 +571,16 @@ fn up_file(body: &BodyModel) -> V3 {
     u.map(|v| v / n)
 }
 
-/// Where foot `side` goes at `t` and how strongly it is held there ([`hold`]): anchored to
-/// its stance while in one (held fully); in a swing, the blend (smooth weight over the
-/// swing) of its motion after the last liftoff, anchored to that stance, and before the
-/// next touchdown, anchored to that one, each moved by the planned COM's departure from
-/// the source COM since that liftoff (until that touchdown), held only near those
-/// contacts. The foot leaves and reaches the floor exactly as the source foot does, and
+/// Where foot `side` goes at `t` and how strongly it is held there ([`Pull`], [`hold`]):
+/// anchored to its stance
+/// while in one (held fully); in a swing, the blend (smooth weight over the swing) of its
+/// motion after the last liftoff, anchored to that stance, and before the next
+/// touchdown, anchored to that one, each raised by the planned COM's vertical departure
+/// from the source COM since that liftoff (until that touchdown), held vertically only
+/// near those contacts (horizontally throughout: following the body horizontally, a run
+/// slower than recorded dragged the lifted foot backwards, its re-ingested liftoffs 1.6–1.9
+/// frames late at 2 m/s); before its first or after its last stance, held near that
+/// contact only. The foot leaves and reaches the floor exactly as the source foot does, and
 /// moves off it with the body: a jump higher than recorded rises faster than the recorded
 /// foot leaves the floor, and held at the recorded foot's height the straight legs pointed
 /// at goals beyond their reach (the vertical jump 1.1 × higher: the root at 11 g in the
@@ -585,7 +592,7 @@ fn foot_goal(
     t: f64,
     side: usize,
     hold_s: f64,
-) -> Option<(V3, Quat, f64)> {
+) -> Option<(V3, Quat, Pull)> {
     let st = &path.stances;
     let has = |k: usize| src[st[k].source].feet[side];
     let yaw_of = |k: usize| yaw_of(path, src, k);
@@ -604,45 +611,95 @@ fn foot_goal(
             let s = &src[st[k].source];
             let (p, q) = anchored(
                 r,
-                path,
+                st[k].contact_point(),
                 s,
-                k,
                 yaw_of(k),
                 s.td_clip_s + (t - td) * rate(k),
                 side,
             );
-            return Some((p, q, 1.0));
+            return Some((p, q, [1.0; 2]));
         }
     }
     let b = (0..st.len())
         .rev()
         .find(|&k| has(k) && st[k].contact_window().1 <= t);
     let a = (0..st.len()).find(|&k| has(k) && st[k].contact_window().0 >= t);
-    // The source foot's motion about the contact it left (b) or meets (a), plus the
-    // planned COM's departure from the source COM's motion since (until) that contact.
-    let swing_from = |k: usize, edge: f64, edge_src: f64| {
-        let s = &src[st[k].source];
-        let t_src = edge_src + (t - edge) * rate(k);
-        let (p, q) = anchored(r, path, s, k, yaw_of(k), t_src, side);
-        let planned = sub(path.com(t).0, path.com(edge).0);
-        let recorded = sub(r.com_at(t_src), r.com_at(edge_src));
-        let yaw = rot::axis_angle([0.0, 0.0, 1.0], yaw_of(k));
-        let excess = r.body.to_file(sub(planned, rot::rotate(yaw, recorded)));
-        (add(p, excess), q)
+    // A run is periodic: after a foot's last stance it swings towards that stance one
+    // cycle (two stances of one source) on: (stance, time shift s, horizontal shift m).
+    // Held near its liftoff and then following the body instead, a run slower than
+    // recorded dragged the lifted foot backwards (the last liftoffs re-ingested 1.8 frames
+    // late at 2 m/s). Before a foot's first stance the source's swing after that stance's
+    // liftoff is not the swing before it (on `cmu_09_01` it lies at the clip's end, and
+    // the leg straightened and the foot turned 25° in a frame), so the foot is held only.
+    let edge_b = b.map(|k| (k, 0.0, [0.0; 2]));
+    let edge_a = match (a, b) {
+        (Some(k), _) => Some((k, 0.0, [0.0; 2])),
+        (None, Some(k)) => k
+            .checked_sub(2)
+            .filter(|&j| st[j].source == st[k].source)
+            .map(|j| {
+                (
+                    k,
+                    st[k].t0 - st[j].t0,
+                    [0, 1].map(|i| st[k].origin[i] - st[j].origin[i]),
+                )
+            }),
+        _ => None,
     };
-    let from_b = b.map(|k| swing_from(k, st[k].contact_window().1, src[st[k].source].lo_clip_s));
-    let from_a = a.map(|k| swing_from(k, st[k].contact_window().0, src[st[k].source].td_clip_s));
-    let lo = b.map(|k| st[k].contact_window().1);
-    let td = a.map(|k| st[k].contact_window().0);
-    let held = hold(lo.map_or(f64::INFINITY, |lo| t - lo).min(td.map_or(f64::INFINITY, |td| td - t)), hold_s);
-    match (from_b, from_a, lo, td) {
-        (Some(pb), Some(pa), Some(lo), Some(td)) => {
+    // The source foot's motion about the contact it left (b) or meets (a), plus the
+    // planned COM's vertical departure from the source COM's since (until) that contact
+    // (horizontally the footprints' blend below carries the new distance: the horizontal
+    // departure too dragged a run slower than recorded's lifted foot backwards at the
+    // speed difference, its re-ingested liftoffs 1.6–1.9 frames late at 2 m/s).
+    let swing_from = |(k, dt, o): (usize, f64, [f64; 2]), end: usize| {
+        let s = &src[st[k].source];
+        let (td, lo) = st[k].contact_window();
+        let (edge, edge_src) = if end == 1 {
+            (lo + dt, s.lo_clip_s)
+        } else {
+            (td + dt, s.td_clip_s)
+        };
+        let t_src = edge_src + (t - edge) * rate(k);
+        let c = st[k].contact_point();
+        let (p, q) = anchored(
+            r,
+            [c[0] + o[0], c[1] + o[1], c[2]],
+            s,
+            yaw_of(k),
+            t_src,
+            side,
+        );
+        // A cycle away the planned and source paths rise alike (periodic).
+        let rise = if dt == 0.0 {
+            let planned = sub(path.com(t).0, path.com(edge).0);
+            let recorded = sub(r.com_at(t_src), r.com_at(edge_src));
+            let yaw = rot::axis_angle([0.0, 0.0, 1.0], yaw_of(k));
+            sub(planned, rot::rotate(yaw, recorded))[2]
+        } else {
+            0.0
+        };
+        (add(p, r.body.to_file([0.0, 0.0, rise])), q, edge)
+    };
+    let from_b = edge_b.map(|e| swing_from(e, 1));
+    let from_a = edge_a.map(|e| swing_from(e, 0));
+    let lo = from_b.map(|f| f.2);
+    let td = from_a.map(|f| f.2);
+    let held = hold(
+        lo.map_or(f64::INFINITY, |lo| t - lo)
+            .min(td.map_or(f64::INFINITY, |td| td - t)),
+        hold_s,
+    );
+    match (from_b, from_a) {
+        (Some(pb), Some(pa)) => {
+            let (lo, td) = (pb.2, pa.2);
             let w = smooth(if td > lo { (t - lo) / (td - lo) } else { 1.0 });
             let p = std::array::from_fn(|i| pb.0[i] + w * (pa.0[i] - pb.0[i]));
-            Some((p, rot::slerp(pb.1, pa.1, w), held))
+            Some((p, rot::slerp(pb.1, pa.1, w), [1.0, held]))
         }
-        // Before the first or after the last stance of this foot: held near that contact.
-        (Some(p), None, ..) | (None, Some(p), ..) => Some((p.0, p.1, held)),
+        // Before the first or after the last stance of a foot with no stance a cycle on
+        // (a jump, a single cycle): held near that contact, horizontally too (the source
+        // foot's path far from its only contact, time-warped, stretched the leg).
+        (Some(p), None) | (None, Some(p)) => Some((p.0, p.1, [held; 2])),
         _ => None,
     }
 }
@@ -737,26 +794,30 @@ fn reference_pose(
 }
 
 /// One IK pass of the feet (step 2 of [`pose_frame`]): each pulled ankle goes part way
-/// (`w`) from where FK puts it towards its goal, by two-bone IK and the goal orientation;
+/// ([`Pull`]) from where FK puts it towards its goal, by two-bone IK and the goal
+/// orientation;
 /// `ws` is left with FK of the result. Returns the largest distance of a planted (support)
 /// foot from its goal (m) and each pulled ankle's goal after the toe pivot (file).
 fn place_feet(
     r: &Reference,
     ws: &mut PoseWorkspace,
-    pulls: &[Option<(V3, Quat, f64)>; 2],
+    pulls: &[Option<(V3, Quat, Pull)>; 2],
     planted: [bool; 2],
     opts: &EditOptions,
 ) -> (f64, [Option<V3>; 2]) {
     let body = &r.body;
     let max_reach = opts.max_reach;
+    let up = up_file(body);
     let goal: [Option<(V3, Quat)>; 2] = std::array::from_fn(|side| {
-        pulls[side].map(|(p, q, w)| {
+        pulls[side].map(|(p, q, [wh, wv])| {
             let ankle = r.legs[side][2];
             let (fp, fq) = (ws.file[ankle], ws.world_q[ankle]);
-            let pos = std::array::from_fn(|i| fp[i] + w * (p[i] - fp[i]));
-            let q = rot::slerp(fq, q, w);
-            if !planted[side] && std::env::var("DBG_NOPIVOT_SWING").is_ok() { (pos, q) } else {
-            toe_pivot(r, ws, side, (pos, q), opts) }
+            // Part way from the reference foot: `wh` horizontally, `wv` vertically and in
+            // orientation.
+            let d = sub(p, fp);
+            let dv = dot(d, up);
+            let pos = std::array::from_fn(|i| fp[i] + wh * (d[i] - dv * up[i]) + wv * dv * up[i]);
+            toe_pivot(r, ws, side, (pos, rot::slerp(fq, q, wv)), opts)
         })
     });
     for (side, g) in goal.iter().enumerate() {
@@ -782,11 +843,15 @@ fn place_feet(
     (err, goal.map(|g| g.map(|(p, _)| p)))
 }
 
+/// How far a foot is pulled from the reference pose's towards its goal: horizontally,
+/// vertically (and in orientation); 1 is onto it.
+type Pull = [f64; 2];
+
 /// What one frame's root/IK iteration aims at: the planned COM (m), the foot pulls
 /// ([`foot_goal`]) and which legs are planted (support).
 struct FrameGoal {
     com: V3,
-    pulls: [Option<(V3, Quat, f64)>; 2],
+    pulls: [Option<(V3, Quat, Pull)>; 2],
     planted: [bool; 2],
 }
 
@@ -886,8 +951,8 @@ fn lead_in_frame(
         com: com_plan,
         pulls: [0, 1].map(|side| {
             planted[side].then(|| {
-                let (p, q) = anchored(r, path, s, 0, yaw, clip_t, side);
-                (p, q, 1.0)
+                let (p, q) = anchored(r, path.stances[0].contact_point(), s, yaw, clip_t, side);
+                (p, q, [1.0; 2])
             })
         }),
         planted,
@@ -959,8 +1024,8 @@ fn solve_frame(
                     goals: &goals,
                     com_pose,
                 };
-            reach_update(r, opts, g, &at, &mut reach, ws)
-        });
+                reach_update(r, opts, g, &at, &mut reach, ws)
+            });
         if err_m <= opts.com_solve_tol_m && !moved {
             settled = true;
             break;
@@ -1117,14 +1182,23 @@ fn reach_jacobian(
 
 /// Leg `side` as FK left it in `ws` (the reference leg, before IK): its hip (file) and
 /// where its soft reach starts and ends (file units; [`soft_reach`]): from
-/// `opts.soft_reach` of thigh plus shank, or the leg's own extension if longer, to
-/// `opts.max_reach` of it.
+/// `opts.soft_reach` of thigh plus shank, or the leg's own extension if longer, to the
+/// knee's reach `R = min(max_reach·(l₁ + l₂), √(l₁² + l₂² + 2 l₁ l₂ cos κ_min))`
+/// (`κ_min = opts.min_knee_flexion_deg`; the toe pivot takes the rest).
 fn leg_reach(r: &Reference, ws: &PoseWorkspace, side: usize, opts: &EditOptions) -> (V3, f64, f64) {
     let [hip, knee, ankle] = r.legs[side];
     let (h, k, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
-    let full = norm(sub(h, k)) + norm(sub(a, k));
-    let hard = opts.max_reach * full;
-    (h, (opts.soft_reach * full).max(norm(sub(a, h))).min(hard), hard)
+    let (l1, l2) = (norm(sub(h, k)), norm(sub(a, k)));
+    let full = l1 + l2;
+    let bent = (l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * opts.min_knee_flexion_deg.to_radians().cos())
+        .max(0.0)
+        .sqrt();
+    let hard = (opts.max_reach * full).min(bent);
+    (
+        h,
+        (opts.soft_reach * full).max(norm(sub(a, h))).min(hard),
+        hard,
+    )
 }
 
 /// The foot goal `(ankle, orientation)` (file frame) of leg `side`, turned about its
