@@ -335,18 +335,30 @@ pub(super) fn assert_bounds_except(f: &Figures, misses: &[(&str, f64)]) {
     bound("joint_step_deg", f.joint_step_max_deg, 30.0);
 }
 
-/// Runs an edit that may finish with frames reported as not converged (exit 1: a support
-/// foot out of reach); any other outcome fails.
-pub(super) fn edit(args: &[&str]) {
+/// Runs an edit that may finish with frames reported as not converged or a posture check
+/// failed (exit 1) or as infeasible and written anyway (exit 3, `--allow-infeasible`);
+/// any other outcome fails. Returns the exit code.
+pub(super) fn edit(args: &[&str]) -> i32 {
     let (code, out, err) = stancelib(args);
     assert!(
-        code == 0 || code == 1,
+        matches!(code, 0 | 1 | 3),
         "stancelib {args:?}: exit {code}\n{out}\n{err}"
     );
-    if code == 1 {
-        eprintln!("reported: {err}");
-        assert!(err.contains("did not converge"), "{err}");
+    if code != 0 {
+        eprintln!("reported (exit {code}): {err}");
     }
+    match code {
+        1 => assert!(
+            err.contains("did not converge")
+                || err.contains("outside")
+                || err.contains("locked")
+                || err.contains("root acceleration"),
+            "{err}"
+        ),
+        3 => assert!(err.contains("infeasible"), "{err}"),
+        _ => {}
+    }
+    code
 }
 
 /// Mean speed of the run cycles rebuilt from a written BVH.
@@ -524,8 +536,9 @@ fn infeasible_run_is_refused_naming_the_constraint_and_writes_nothing() {
     ] {
         assert!(!p.exists(), "{} written", p.display());
     }
-    // --allow-infeasible writes it, and the sidecar names the constraint per stance frame.
-    edit(&[
+    // --allow-infeasible writes it (exit 3), and the sidecar names the constraint per
+    // stance frame.
+    let code = edit(&[
         "edit",
         "run",
         "--lib",
@@ -536,6 +549,7 @@ fn infeasible_run_is_refused_naming_the_constraint_and_writes_nothing() {
         out.to_str().unwrap(),
         "--allow-infeasible",
     ]);
+    assert_eq!(code, 3, "an infeasible edit written anyway exits 3");
     let df = read_parquet(&out.with_extension("plan.parquet")).unwrap();
     let v = df
         .column("violated")

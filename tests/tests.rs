@@ -55,6 +55,9 @@
 //! # Edited motion
 //! - `edit_checks`: issue 14 — the remaining checks: a jump higher than recorded lifts off and
 //!   lands on time on its toes, every frame converged; a real run's support foot holds still.
+//!   Issue 37 item 5 — edited runs have the query's contact time and cadence and stay in the
+//!   recorded posture; higher jumps keep bent knees in flight, no root spike. Issue 38 item
+//!   1 — edits print verdict, deciding constraint, cycle or pair, and exit by the verdict.
 //! - `edit_motion`: issue 14 — `edit run`/`edit jump` BVH re-ingested: COM on the plan,
 //!   planted feet, contact timing, speed, jump apex, flight curvature, joint steps, identity.
 //!

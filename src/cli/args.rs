@@ -188,6 +188,11 @@ fn limits_help(command: &str) -> Option<String> {
         crate::twopac::validate::MAX_SAMPLES,
         crate::twopac::polytope::MAX_ROWS
     );
+    let fps = format!(
+        "--fps {} to {} Hz (MIN_FPS, MAX_FPS)",
+        crate::edit::MIN_FPS,
+        crate::edit::MAX_FPS
+    );
     let lines: Vec<String> = match command {
         "frames" | "build" | "run" => vec![bvh, threads],
         "run-query" => vec![
@@ -208,6 +213,11 @@ fn limits_help(command: &str) -> Option<String> {
             crate::twopac::equilibrium::MAX_CONTACTS,
             crate::twopac::equilibrium::MAX_COM_STATES
         )],
+        "edit-run" => vec![
+            format!("--cycles 1 to {} (MAX_CYCLES)", crate::edit::MAX_CYCLES),
+            fps,
+        ],
+        "edit-jump" => vec![fps],
         "synth" => vec![format!(
             "--rate {} to {} Hz, --duration at most {} s",
             crate::synth::MIN_FRAME_RATE_HZ,
@@ -223,20 +233,45 @@ fn limits_help(command: &str) -> Option<String> {
     ))
 }
 
+/// The exit codes of the edits (`stancelib edit`, `edit run`, `edit jump`), for their
+/// `--help`.
+pub const EDIT_EXIT_HELP: &str = "Exit codes (the same for runs and jumps):
+  0  feasible, every frame converged, posture and smoothness as recorded: written
+  1  feasible and written, but some frames did not converge (COM or support foot off the
+     plan) or the motion leaves the recording's posture or smoothness (trunk lean, knee
+     flexion, a knee locked through a flight, a root acceleration spike); each on stderr
+  2  fatal: bad options, unreadable library or source, no solution, or infeasible without
+     --allow-infeasible (nothing written; the deciding constraint is named)
+  3  infeasible, written with --allow-infeasible (the deciding constraint on stderr, the
+     plan's `violated` column); frames that did not converge are also reported
+Every edit prints the cycle or jump pair used, what it achieves (a run's speed, contact
+times and step periods; a jump's apex and distance), and its verdict: the deciding
+constraint with value, limit and margin in units (infeasible), or the constraint nearest
+to breaking (feasible).";
+
+/// The exit-code section of `command`'s `--help` (the edits), if any.
+fn exit_help(command: &str) -> Option<String> {
+    matches!(command, "edit" | "edit-run" | "edit-jump").then(|| EDIT_EXIT_HELP.to_string())
+}
+
 /// The clap command of [`Cli`], with every subcommand accepting negative numbers as
 /// values (`--speed -3`, `--distance -0.5`) and listing its limits in `--help`.
 pub fn command() -> clap::Command {
     fn adjust(c: clap::Command, parent: &str) -> clap::Command {
         let name = c.get_name().to_string();
-        // `query run` and `run` share a name: key the query one by its parent.
-        let key = if parent == "query" && name == "run" {
-            "run-query".to_string()
-        } else {
-            name.clone()
+        // `query run`, `edit run` and `run` share a name: key the first two by their parent.
+        let key = match (parent, name.as_str()) {
+            ("query", "run") => "run-query".to_string(),
+            ("edit", n) => format!("edit-{n}"),
+            _ => name.clone(),
         };
         let mut c = c.allow_negative_numbers(true);
-        if let Some(h) = limits_help(&key) {
-            c = c.after_help(h);
+        let help: Vec<String> = [limits_help(&key), exit_help(&key)]
+            .into_iter()
+            .flatten()
+            .collect();
+        if !help.is_empty() {
+            c = c.after_help(help.join("\n\n"));
         }
         c.mut_subcommands(|s| adjust(s, &name))
     }
@@ -323,9 +358,15 @@ pub struct EditCommon {
     /// Source BVH to take poses from, instead of the path recorded in `clips.parquet`.
     #[arg(long)]
     pub source: Option<PathBuf>,
-    /// Write the motion even when the request breaks a constraint (the sidecar says which).
+    /// Write the motion even when the request breaks a constraint (exit 3; the deciding
+    /// constraint on stderr, the sidecar says which per frame).
     #[arg(long = "allow-infeasible")]
     pub allow_infeasible: bool,
+    /// Keep the cycles or jump pairs of clips the queries leave out (a copy of another
+    /// clip's file, or a clip whose flights say its time base is wrong); they are named on
+    /// stderr. A pair given with `edit jump --pair` is always kept.
+    #[arg(long = "keep-left-out")]
+    pub keep_left_out: bool,
     /// Limit form and μ (§7.5).
     #[command(flatten)]
     pub lim: LimitArgs,

@@ -79,6 +79,9 @@ pub enum Outcome {
     SomeFailed,
     /// Every input failed: nothing could be done (exit code 2; the tables still say why).
     AllFailed,
+    /// Written, but the result breaks a constraint (exit code 3: an edit with
+    /// `--allow-infeasible`).
+    Infeasible,
 }
 
 /// Run a parsed command line.

@@ -3,17 +3,20 @@
 //!
 //! # Model
 //! ```text
-//! run cycle S1, S2 at k = v / v_orig (the run-at-speed policy: (vs, ve, x)·k, vp kept),
-//! made exactly periodic so N cycles chain: S1 is the policy's own request, and S2 carries
+//! run cycle S1, S2 under the gait law (`query::run::law_request`, §6.8b): S1's heading
+//! speeds u + κ(vs₁ − v₀), u + κ(ve₁ − v₀), its distance from the law's period (the
+//! caller's); under the paper's policy at k = v / v_orig: (vs, ve, x)·k, vp kept. Made
+//! exactly periodic so N cycles chain: S1 is the law's (policy's) own request, and S2 carries
 //! the recorded S2 → S1 speed mismatch (it runs from S1's end apex back to S1's start
 //! apex); the recorded cycle's height change is split between its start and its end (the
 //! whole cycle sits δ higher, half of what the recording gains over it):
 //!   δ = (ze2 − (z_c1 − z_c2) − zs1) / 2
-//!   S1: zs = zs1 + δ, vs = k·vs1, ze = ze1 + δ, ve = k·ve1, vp1, vps = 0, x = k·x1
-//!   S2: zs = ze1 + δ + z_c1 − z_c2, vs = |(k·ve1, vp1)|, ze = zs1 + δ + z_c1 − z_c2,
-//!       ve = √((k·vs1)² − vp2²), vp2, vps = 0, x = k·x2
-//!   each solved leaned (`lean`): β_h = k, β_p = 1, the speed change S2's recorded impulse
-//!   does not carry added as a constant friction-ratio offset
+//!   S1: zs = zs1 + δ, vs = vs_S1, ze = ze1 + δ, ve = ve_S1, vp1, vps = 0
+//!   S2: zs = ze1 + δ + z_c1 − z_c2, vs = |(ve_S1, vp1)|, ze = zs1 + δ + z_c1 − z_c2,
+//!       ve = √(vs_S1² − vp2²), vp2, vps = 0
+//!   (paper: vs_S1 = k·vs1, ve_S1 = k·ve1, x = k·x1, k·x2)
+//!   each solved leaned (`lean`): β_h = κ/σ_c (paper: k), β_p = 1, the speed change S2's
+//!   recorded impulse does not carry added as a constant friction-ratio offset
 //! jump: the requests of `query::jump` (they chain by construction: ve1 = vs2 = u_apex)
 //! placement: the first stance keeps its recorded heading, and its COM at touchdown is the
 //!   recorded one; every later stance is chained at the apex (`path`): a run's along the
@@ -33,9 +36,9 @@ use super::pose::{Reference, StanceSource};
 use super::LEAD_IN_S;
 use crate::query::feasibility::Limits;
 use crate::query::pool::{PoolStance, Prepared};
-use crate::query::run::{scale_and_check, ScaledStance};
+use crate::query::run::{law_request, scale_and_check, ScaledStance};
 use crate::query::solve::{Refs, Request};
-use crate::query::tables::violation_name;
+use crate::query::tables::{tightest_detail, violation_detail, violation_name};
 
 use crate::math::v3::V3;
 
@@ -57,6 +60,8 @@ pub struct EditStance {
     /// The gait law's contact-time scale `σ_c` the stance plays at (`prepared` is the
     /// recorded stance stretched by it; 1 for jumps and the paper's runs).
     pub time_scale: f64,
+    /// The limits the stance was checked against (§7.5).
+    pub limits: Limits,
 }
 
 impl EditStance {
@@ -67,9 +72,25 @@ impl EditStance {
             .violated
             .map(|v| format!("{}: {}", self.source.stance_id, violation_name(v)))
     }
+
+    /// `<stance_id>: <constraint> <value> > <limit> (by <margin>)` when the exact check
+    /// fails ([`violation_detail`]).
+    pub fn violation_detail(&self) -> Option<String> {
+        violation_detail(&self.scaled.verdict, &self.limits)
+            .map(|d| format!("{}: {d}", self.source.stance_id))
+    }
+
+    /// `<stance_id>: <constraint> <value> ≤ <limit> (margin <m>)`: the constraint a feasible
+    /// stance is nearest to breaking, with its margin as a fraction of the limit
+    /// ([`tightest_detail`]).
+    pub fn tightest_detail(&self) -> Option<(f64, String)> {
+        tightest_detail(&self.scaled.verdict, &self.limits)
+            .map(|(m, d)| (m, format!("{}: {d}", self.source.stance_id)))
+    }
 }
 
-/// The periodic requests of a run cycle at `k` (see the module docs).
+/// The periodic requests of a run cycle at `k` under the paper's policy (see the module
+/// docs): the first stance's speeds and distance × `k`.
 ///
 /// The height shift `δ`: `cmu_09_01_run_mb`'s first cycle ends 1.2 cm higher than it
 /// starts; with the whole mismatch at the end (δ = 0) the recorded-speed edit's COM ran
@@ -77,6 +98,56 @@ impl EditStance {
 /// detail (`edit::detail`) it is within 1.28 cm of the recording over the first cycle;
 /// `δ` alone takes the largest distance from 2.81 to 2.63 cm (`docs/edited-motion.md`).
 pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
+    let p1 = &s[0].params;
+    let first = Request {
+        vs: k * p1.vs,
+        ve: k * p1.ve,
+        x: k * p1.x,
+        ..p1_request(s[0])
+    };
+    periodic(s, first, k * s[1].params.x)
+}
+
+/// The periodic requests of a run cycle under a gait law (`query::run::law_request`, docs
+/// stance-model §6.8b): the first stance's heading speeds keep their recorded fluctuation
+/// about the cycle's mean `v₀`, scaled by `κ`, about the new mean `u`; the second closes
+/// the cycle as in [`run_requests`]:
+///
+/// ```text
+/// S1: vs = u + κ (vs₁ − v₀),  ve = u + κ (ve₁ − v₀)
+/// S2: vs = |(ve_S1, vp₁)|,    ve = √(vs_S1² − vp₂²)
+/// ```
+///
+/// `s`: the cycle's stances (time-scaled by `σ_c`, character-scaled); `x` of both are the
+/// recorded ones, for the caller to set from the law's period
+/// (`query::run::distance_for_period`). With `κ = u/v₀` this is [`run_requests`] at
+/// `k = u/v₀`.
+pub fn law_run_requests(s: [&PoolStance; 2], v_orig: f64, kappa: f64, u: f64) -> [Request; 2] {
+    let first = Request {
+        vps: 0.0,
+        ..law_request(s[0], v_orig, kappa, u)
+    };
+    periodic(s, first, s[1].params.x)
+}
+
+/// The first stance's recorded request (heights, speeds, `vp`, distance; `vps = 0`).
+fn p1_request(s: &PoolStance) -> Request {
+    let p = &s.params;
+    Request {
+        zs: p.zs,
+        vs: p.vs,
+        ze: p.ze,
+        ve: p.ve,
+        vp: p.vp,
+        vps: 0.0,
+        x: p.x,
+    }
+}
+
+/// The cycle made periodic from its first stance's request `first` (recorded heights):
+/// the recorded height change split between start and end (`δ`, module docs), the second
+/// stance from `first`'s end apex back to its start apex, at distance `x2`.
+fn periodic(s: [&PoolStance; 2], first: Request, x2: f64) -> [Request; 2] {
     let (p1, p2) = (&s[0].params, &s[1].params);
     let dz0 = s[0].z_c - s[1].z_c;
     let shift = 0.5 * (p2.ze - dz0 - p1.zs);
@@ -84,21 +155,18 @@ pub fn run_requests(s: [&PoolStance; 2], k: f64) -> [Request; 2] {
     [
         Request {
             zs: p1.zs + shift,
-            vs: k * p1.vs,
             ze: p1.ze + shift,
-            ve: k * p1.ve,
-            vp: p1.vp,
             vps: 0.0,
-            x: k * p1.x,
+            ..first
         },
         Request {
             zs: p1.ze + dz,
-            vs: (k * p1.ve).hypot(p1.vp),
+            vs: first.ve.hypot(first.vp),
             ze: p1.zs + dz,
-            ve: ((k * p1.vs).powi(2) - p2.vp * p2.vp).max(0.0).sqrt(),
+            ve: (first.vs.powi(2) - p2.vp * p2.vp).max(0.0).sqrt(),
             vp: p2.vp,
             vps: 0.0,
-            x: k * p2.x,
+            x: x2,
         },
     ]
 }
@@ -167,6 +235,7 @@ pub fn solve_stance(
         request,
         scaled,
         time_scale: 1.0,
+        limits: *limits,
     })
 }
 
@@ -435,5 +504,40 @@ mod tests {
                 assert_eq!(r1.vs, k * p1.vs);
             }
         }
+    }
+
+    #[test]
+    fn law_requests_at_kappa_equal_to_the_speed_ratio_are_the_policys() {
+        let s = cycle(0.01, 0.0);
+        let v0 = 3.4;
+        for k in [0.6, 1.0, 1.4] {
+            let law = law_run_requests([&s[0], &s[1]], v0, k, k * v0);
+            let mut policy = run_requests([&s[0], &s[1]], k);
+            // The law leaves the distances for the period to set.
+            policy[0].x = s[0].params.x;
+            policy[1].x = s[1].params.x;
+            for (a, b) in law.iter().zip(&policy) {
+                for (x, y) in [
+                    (a.zs, b.zs),
+                    (a.vs, b.vs),
+                    (a.ze, b.ze),
+                    (a.ve, b.ve),
+                    (a.vp, b.vp),
+                    (a.vps, b.vps),
+                    (a.x, b.x),
+                ] {
+                    // u + k (v − v₀) = k v up to one rounding of each term.
+                    assert!((x - y).abs() < 1e-12, "k {k}: {a:?} vs {b:?}");
+                }
+            }
+        }
+        // Another κ keeps the mean u and scales each fluctuation about v₀ by κ.
+        let (p1, u, kappa) = (s[0].params, 4.0, 0.5);
+        let [r1, r2] = law_run_requests([&s[0], &s[1]], v0, kappa, u);
+        assert!((r1.vs - (u + kappa * (p1.vs - v0))).abs() < 1e-12);
+        assert!((r1.ve - (u + kappa * (p1.ve - v0))).abs() < 1e-12);
+        // The cycle closes: S2 starts at S1's end speed and ends at S1's start speed.
+        assert!((r2.vs - r1.ve.hypot(r1.vp)).abs() < 1e-12);
+        assert!((r2.ve.hypot(r2.vp) - r1.vs).abs() < 1e-12);
     }
 }

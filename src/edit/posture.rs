@@ -113,7 +113,10 @@ impl PostureFrame {
         let b = self.bound;
         let rp = rot::mul(
             rot::axis_angle(up, x[2] * b),
-            rot::mul(rot::axis_angle(fwd, x[1] * b), rot::axis_angle(lat, x[0] * b)),
+            rot::mul(
+                rot::axis_angle(fwd, x[1] * b),
+                rot::axis_angle(lat, x[0] * b),
+            ),
         );
         q[self.root] = rot::normalize(rot::mul(rp, q[self.root]));
         if let Some((j, w_parent, w_own)) = self.trunk {
@@ -300,6 +303,10 @@ mod tests {
         // The root turned; the trunk's world rotation is the free pose's.
         assert!(rot::angle_deg(q[0], q_root) > 5.0);
         let w = rot::mul(q[0], q[1]);
-        assert!(rot::angle_deg(w, w_trunk) < 1e-9, "{}", rot::angle_deg(w, w_trunk));
+        assert!(
+            rot::angle_deg(w, w_trunk) < 1e-9,
+            "{}",
+            rot::angle_deg(w, w_trunk)
+        );
     }
 }

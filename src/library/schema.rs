@@ -750,6 +750,9 @@ pub mod edit_plan {
     pub const STANCE_LO: &str = "stance_lo_clip_s";
     /// `converged`: COM and foot within tolerance.
     pub const CONVERGED: &str = "converged";
+    /// `foot_error_m`: Largest distance of a support ankle from its goal in the written
+    /// pose, m (0 in flight): what `converged` judges against 1 mm.
+    pub const FOOT_ERROR: &str = "foot_error_m";
     /// `iterations`: Root-correction and IK iterations used.
     pub const ITERATIONS: &str = "iterations";
     /// `violated`: `<stance_id>: <constraint>` when the frame's stance breaks one.

@@ -10,13 +10,13 @@ use anyhow::Context;
 use super::edit_outputs::{plan_table, plot_of, sidecars, EditOutputs};
 use super::queries::{load_pool, query_kv, write_table, LimitOptions};
 use crate::bvh::{parse_file, write_file, Bvh};
-use crate::edit::fidelity::{check, FidelityOptions};
+use crate::edit::fidelity::{check, recorded_knee_range, FidelityOptions};
 use crate::edit::plan::{place, EditStance, PlanKind, StanceTiming};
 use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
-    choose_jump, choose_run, jump_stances, EditLimits, JumpTarget, RunTarget,
+    choose_jump, choose_run, jump_stances, ChosenRun, EditLimits, JumpTarget, RunTarget,
 };
-use crate::edit::{EditOptions, MAX_CYCLES, MAX_FPS, MIN_FPS};
+use crate::edit::{EditOptions, MAX_CYCLES, MAX_FPS, MIN_FPS, RUN_KNEE_SLACK_DEG};
 use crate::ingest::body::BodyModel;
 use crate::library::provenance::library_body;
 use crate::library::read::{read_clip_sources, read_stance_timing};
@@ -25,6 +25,8 @@ use crate::pipeline::batch::file_sha256;
 use crate::plot::edit::edit_png;
 use crate::plot::write_png;
 use crate::query::feasibility::LimitForm;
+use crate::query::jump::recorded_jump;
+use crate::query::limits::{left_out_line, LeftOut};
 use crate::query::run::{check_scale, check_speed};
 use crate::skeleton::units::UpAxis;
 
@@ -78,10 +80,23 @@ pub struct EditReport {
     pub plan: PathBuf,
     /// The plot.
     pub png: PathBuf,
-    /// `<stance_id>: <constraint>` of every stance that breaks one (written anyway).
-    pub violated: Vec<String>,
+    /// The recorded cycle (`A + B`) or jump pair (`A → B`) the edit plays.
+    pub used: String,
+    /// What the plan achieves: a run's mean speed with its gait law, contact times and
+    /// step periods; a jump's apex height and distance.
+    pub achieved: String,
+    /// Every stance passes the exact check (§7.4).
+    pub feasible: bool,
+    /// Infeasible: each failing stance's deciding constraint, value, limit and margin
+    /// (`query::tables::violation_detail`, written anyway with `--allow-infeasible`);
+    /// feasible: the constraint nearest to breaking (`tightest_detail`).
+    pub deciding: Vec<String>,
     /// Frames whose COM or foot stayed off by more than the tolerance.
     pub unconverged: usize,
+    /// The support foot farthest from its planned place: (frame, distance m), when one is
+    /// off by more than the tolerance (out of reach: knee straight, heel up to its bound,
+    /// pelvis turned to its bound).
+    pub foot_off: Option<(usize, f64)>,
     /// The posture and smoothness figures against the source ([`crate::edit::fidelity`]).
     pub fidelity: String,
     /// One line per posture or smoothness check that fails.
@@ -137,23 +152,61 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
     let times = timing(&t.lib)?;
     let chosen = choose_run(&lib, &pool, &times, &e.run, limits)
         .with_context(|| format!("library {}", t.lib.display()))?;
+    report_left_out("edit run", "cycle(s)", &chosen.left_out);
     let first = chosen.stances[0].source.stance_id.clone();
+    let used = format!("{first} + {}", chosen.stances[1].source.stance_id);
+    let achieved = run_achieved(&chosen, e.run.speed_mps);
     let order: Vec<usize> = (0..e.cycles).flat_map(|_| [0, 1]).collect();
     let edit = compute(t, e.run.length_scale, chosen.stances, order, PlanKind::Run)?;
+    let tm = &chosen.timing;
     let kv = query_kv(
         &t.lib,
         serde_json::json!({
             "edit": "run", "lib": t.lib, "speed_mps": e.run.speed_mps, "cycles": e.cycles,
             "stance": first, "k": chosen.k, "length_scale": e.run.length_scale,
             "mass_scale": e.run.mass_scale, "limits": limits.form.name(), "mu": limits.mu,
-            "active_set": limits.active,
+            "active_set": limits.active, "gait_law": tm.law.source.name(),
+            "sigma_contact": tm.sigma_c, "sigma_step": tm.sigma_t, "kappa": tm.kappa,
+            "speed_achieved_mps": chosen.speed_mps, "keep_left_out": e.run.keep_left_out,
         }),
     )?;
     let title = format!(
         "edit run: {:.2} m/s, cycle {first}, {} cycles",
         e.run.speed_mps, e.cycles
     );
-    finish(t, edit, kv, title)
+    finish(t, edit, kv, title, (used, achieved))
+}
+
+/// A run's plan in one phrase: its mean speed, the gait law and each stance's contact time
+/// and step period (the query's, `query run`'s `contact_time_s`, `step_period_s`).
+fn run_achieved(c: &ChosenRun, asked: f64) -> String {
+    let each = |f: &dyn Fn(&crate::query::solve::Solution) -> f64| {
+        let v: Vec<String> = c
+            .stances
+            .iter()
+            .map(|e| format!("{:.3}", f(&e.scaled.solution)))
+            .collect();
+        v.join(" / ")
+    };
+    format!(
+        "speed {:.3} m/s (asked {asked}, recorded {:.3}), gait law {}: contact {} s, \
+         step period {} s",
+        c.speed_mps,
+        c.v_orig,
+        c.timing.law.source.name(),
+        each(&|s| s.t_lo - s.t_td),
+        each(&|s| s.t_e),
+    )
+}
+
+/// Prints (stderr) the clips an edit left out ([`left_out_line`]).
+fn report_left_out(command: &str, what: &str, left: &[(String, LeftOut)]) {
+    let clips: std::collections::BTreeMap<&String, &LeftOut> =
+        left.iter().map(|(c, w)| (c, w)).collect();
+    let named: Vec<(&String, &LeftOut)> = clips.into_iter().collect();
+    if let Some(line) = left_out_line(command, left.len(), what, &named) {
+        eprintln!("{line}");
+    }
 }
 
 /// Runs `edit jump`.
@@ -178,6 +231,7 @@ pub fn edit_jump(e: &JumpEdit) -> anyhow::Result<EditReport> {
     let times = timing(&t.lib)?;
     let chosen = choose_jump(&lib, &pool, &e.jump, limits)
         .with_context(|| format!("library {}", t.lib.display()))?;
+    report_left_out("edit jump", "pair(s)", &chosen.left_out);
     let [i, j] = chosen.pair;
     let ids = format!(
         "{} → {}",
@@ -200,7 +254,12 @@ pub fn edit_jump(e: &JumpEdit) -> anyhow::Result<EditReport> {
         }),
     )?;
     let title = format!("edit jump: apex {h:.2} m, distance {d:.2} m, {ids}");
-    finish(t, edit, kv, title)
+    let (h0, d0) = recorded_jump(&lib.stances[i], &lib.stances[j]);
+    let achieved = format!(
+        "apex {h:.3} m, distance {d:.3} m (recorded {h0:.3} m, {d0:.3} m: × {:.3} in height)",
+        h / h0
+    );
+    finish(t, edit, kv, title, (ids, achieved))
 }
 
 fn timing(lib: &Path) -> anyhow::Result<Vec<StanceTiming>> {
@@ -268,15 +327,28 @@ fn compute(
         .with_context(|| format!("clip {clip}"))?
         .with_length_scale(length);
     let (path, sources) = place(&stances, &order, &reference, kind);
-    let edited = pose_motion(
-        &reference,
-        &path,
-        &sources,
-        &EditOptions::default(),
-        frame_time_s,
-    );
+    let mut opts = EditOptions::default();
+    if kind == PlanKind::Run {
+        // The knee stays within the source's range over the cycle (`RUN_KNEE_SLACK_DEG`).
+        let t0 = sources
+            .iter()
+            .map(|s| s.td_clip_s - s.before_s)
+            .fold(f64::INFINITY, f64::min);
+        let t1 = sources
+            .iter()
+            .map(|s| s.lo_clip_s + s.after_s)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let [least, _] = recorded_knee_range(&reference.body, &reference.motion, t0, t1);
+        if least.is_finite() {
+            opts.min_knee_flexion_deg = (least - RUN_KNEE_SLACK_DEG).max(0.0);
+        }
+    }
+    let edited = pose_motion(&reference, &path, &sources, &opts, frame_time_s);
     let footprints = path.stances.iter().map(|s| s.contact_point()).collect();
-    let violated = stances.iter().filter_map(EditStance::violated).collect();
+    let violated = stances
+        .iter()
+        .filter_map(EditStance::violation_detail)
+        .collect();
     let fidelity = check(
         &reference.body,
         &reference.motion,
@@ -300,23 +372,45 @@ fn compute(
 }
 
 /// Refuses an infeasible edit (unless allowed), then writes the BVH and its sidecars.
+/// `(used, achieved)`: the cycle or pair played and what its plan achieves (for the report).
 fn finish(
     t: &EditTarget,
     e: EditOutputs,
     kv: Vec<(String, String)>,
     title: String,
+    (used, achieved): (String, String),
 ) -> anyhow::Result<EditReport> {
     if !e.violated.is_empty() && !t.allow_infeasible {
         anyhow::bail!(
-            "infeasible request: {} (nothing written; --allow-infeasible writes it anyway)",
+            "infeasible request ({used}; {achieved}): {} (nothing written; --allow-infeasible \
+             writes it anyway, exit 3)",
             e.violated.join("; ")
         );
     }
+    let feasible = e.violated.is_empty();
+    let deciding = if feasible {
+        e.stances
+            .iter()
+            .filter_map(EditStance::tightest_detail)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, d)| d)
+            .into_iter()
+            .collect()
+    } else {
+        e.violated.clone()
+    };
     if let Some(dir) = t.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let mut df = plan_table(&e)?;
-    let plot = plot_of(&e, title);
+    let unconverged = e.edited.frames.iter().filter(|f| !f.converged).count();
+    let verdict = match (feasible, unconverged) {
+        (true, 0) => "feasible".to_string(),
+        (true, n) => format!("feasible, {n} frame(s) not converged"),
+        (false, 0) => "INFEASIBLE".to_string(),
+        (false, n) => format!("INFEASIBLE, {n} frame(s) not converged"),
+    };
+    let plot = plot_of(&e, format!("{title} ({verdict})"));
     let out = Bvh {
         hierarchy: e.bvh.hierarchy.clone(),
         motion: e.edited.motion.clone(),
@@ -332,8 +426,19 @@ fn finish(
         bvh: t.out.clone(),
         plan,
         png,
-        violated: e.violated,
-        unconverged: e.edited.frames.iter().filter(|f| !f.converged).count(),
+        used,
+        achieved,
+        feasible,
+        deciding,
+        unconverged,
+        foot_off: e
+            .edited
+            .frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (i, f.foot_error_m))
+            .filter(|&(_, d)| d > EditOptions::default().com_tol_m)
+            .max_by(|a, b| a.1.total_cmp(&b.1)),
         fidelity: e.fidelity.summary(),
         unfaithful: e.fidelity.failures(),
     })

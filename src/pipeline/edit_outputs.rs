@@ -33,7 +33,8 @@ pub struct EditOutputs {
     pub order: Vec<usize>,
     /// Planned contact point of every placed stance, m.
     pub footprints: Vec<[f64; 3]>,
-    /// `<stance_id>: <constraint>` of every stance that breaks one.
+    /// `<stance_id>: <constraint> <value> > <limit> (by <margin>)` of every stance that
+    /// breaks one (`query::tables::violation_detail`).
     pub violated: Vec<String>,
     /// Posture and smoothness against the source ([`crate::edit::fidelity`]).
     pub fidelity: Fidelity,
@@ -103,6 +104,10 @@ pub fn plan_table(e: &EditOutputs) -> PolarsResult<DataFrame> {
     cols.push(Column::new(
         col::CONVERGED.into(),
         f.iter().map(|x| x.converged).collect::<Vec<_>>(),
+    ));
+    cols.push(Column::new(
+        col::FOOT_ERROR.into(),
+        f.iter().map(|x| x.foot_error_m).collect::<Vec<_>>(),
     ));
     cols.push(Column::new(
         col::ITERATIONS.into(),

@@ -27,24 +27,86 @@ pub fn violation_name(v: Violation) -> &'static str {
     }
 }
 
+/// The four measured constraints of a scaled stance as the exact check applies them
+/// ([`Limits::effective`]): `(constraint, value, limit, the comparison that fails, unit,
+/// decimals)`.
+fn measured(
+    verdict: &Verdict,
+    lim: &Limits,
+) -> [(Violation, f64, f64, char, &'static str, usize); 4] {
+    let l = lim.effective();
+    [
+        (Violation::Force, verdict.f_peak, l.f_max, '>', " N", 0),
+        (Violation::Friction, verdict.mu_req, l.mu, '>', "", 3),
+        (
+            Violation::ExtensionMin,
+            verdict.ext_min,
+            l.chi_min,
+            '<',
+            " m",
+            3,
+        ),
+        (
+            Violation::ExtensionMax,
+            verdict.ext_max,
+            l.chi_max,
+            '>',
+            " m",
+            3,
+        ),
+    ]
+}
+
 /// The deciding constraint of an infeasible scaled stance, with its value, its limit (as
 /// the exact check applies it, [`Limits::effective`]) and the margin in units:
 /// `force 1812 N > 1750 N (by 62 N)`. `None` when feasible.
 pub fn violation_detail(verdict: &Verdict, lim: &Limits) -> Option<String> {
-    let l = lim.effective();
     let v = verdict.violated?;
-    let name = violation_name(v);
-    // (value, limit, sign of the comparison it fails, unit, decimals)
-    let (value, limit, op, unit, digits) = match v {
-        Violation::Force => (verdict.f_peak, l.f_max, '>', " N", 0),
-        Violation::Friction => (verdict.mu_req, l.mu, '>', "", 3),
-        Violation::ExtensionMin => (verdict.ext_min, l.chi_min, '<', " m", 3),
-        Violation::ExtensionMax => (verdict.ext_max, l.chi_max, '>', " m", 3),
-        Violation::Beta | Violation::Unilateral => return Some(name.to_string()),
+    let Some(&(_, value, limit, op, unit, digits)) =
+        measured(verdict, lim).iter().find(|m| m.0 == v)
+    else {
+        return Some(violation_name(v).to_string());
     };
     let by = (value - limit).abs();
     Some(format!(
-        "{name} {value:.digits$}{unit} {op} {limit:.digits$}{unit} (by {by:.digits$}{unit})"
+        "{} {value:.digits$}{unit} {op} {limit:.digits$}{unit} (by {by:.digits$}{unit})",
+        violation_name(v)
+    ))
+}
+
+/// The constraint a feasible scaled stance is nearest to breaking (least margin as a
+/// fraction of its limit), with its value, limit and margin in units:
+/// `extension_max 1.012 m ≤ 1.050 m (margin 0.038 m)`, and that fraction (0.036 there).
+/// `None` when infeasible or no value is finite.
+pub fn tightest_detail(verdict: &Verdict, lim: &Limits) -> Option<(f64, String)> {
+    if !verdict.feasible {
+        return None;
+    }
+    let relative = |&(_, value, limit, op, ..): &(Violation, f64, f64, char, &str, usize)| {
+        let margin = if op == '>' {
+            limit - value
+        } else {
+            value - limit
+        };
+        margin / limit.abs().max(f64::MIN_POSITIVE)
+    };
+    let m = measured(verdict, lim);
+    let tight = m
+        .iter()
+        .filter(|m| m.1.is_finite() && m.2.is_finite())
+        .min_by(|a, b| relative(a).total_cmp(&relative(b)))?;
+    let &(v, value, limit, op, unit, digits) = tight;
+    let (ok, by) = if op == '>' {
+        ('≤', limit - value)
+    } else {
+        ('≥', value - limit)
+    };
+    Some((
+        relative(tight),
+        format!(
+            "{} {value:.digits$}{unit} {ok} {limit:.digits$}{unit} (margin {by:.digits$}{unit})",
+            violation_name(v)
+        ),
     ))
 }
 
