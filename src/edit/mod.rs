@@ -53,13 +53,19 @@
 //! - A support foot still beyond reach on its upright toe (a CMU run at 1.1 × its speed
 //!   plans the COM 1.127 m from the contact at liftoff, 3 % beyond the recorded 1.094 m) is
 //!   reached by posture, not by the leg alone ([`posture`]): the pelvis (pitch, roll, yaw,
-//!   at most [`DEFAULT_MAX_PELVIS_TURN_DEG`]) and the trunk (pitch, at most
-//!   [`DEFAULT_MAX_TRUNK_LEAN_DEG`]) turn by the smallest damped least-squares change that
-//!   brings the stance hip within reach of the foot once the root has put the COM back on
-//!   the plan (Jacobian of the leg's shortfall by finite differences of FK, foot IK and
-//!   COM), and the solved changes are ramped in and out over [`DEFAULT_POSTURE_RAMP_S`].
-//!   Without it the left push-off ended 2.0 frames early and 10 frames were reported; with
-//!   it 0.91 frames and none.
+//!   at most [`DEFAULT_MAX_PELVIS_TURN_DEG`]) turns under a trunk that keeps its recorded
+//!   orientation, by the smallest damped least-squares change that brings the stance hip
+//!   within reach of the foot once the root has put the COM back on the plan (Jacobian of
+//!   the leg's shortfall by finite differences of FK, foot IK and COM), and the solved
+//!   changes are ramped in and out over [`DEFAULT_POSTURE_RAMP_S`]. Without it the left
+//!   push-off ended 2.0 frames early and 10 frames were reported; with it 0.91 frames and
+//!   none.
+//! - The edit keeps its source's posture (issue 37 item 5, [`fidelity`]): a run's knee
+//!   straightens no further than the source's least flexion less [`RUN_KNEE_SLACK_DEG`]
+//!   (the heel rises instead), a jump's knee shares the end of its push with the heel
+//!   ([`DEFAULT_SOFT_REACH`]), and swinging feet rise with a body that flies higher than
+//!   recorded ([`DEFAULT_SWING_HOLD_S`]). Every written motion is checked against its
+//!   source: trunk lean, knee flexion, knees locked through a flight, root spikes.
 //! - The root carries the COM exactly: the COM is affine in the root translation, so one
 //!   root shift corrects it, and root shift and leg IK alternate until the COM error is
 //!   below [`DEFAULT_COM_TOL_M`]; frames that do not get there are reported.
