@@ -598,6 +598,10 @@ pub struct BodyArgs {
     /// Body mass in kg (default: body file, else 70).
     #[arg(long)]
     pub mass: Option<f64>,
+    /// Per-clip body masses: a CSV table `clip,mass_kg[,sex]` (clip name or glob; the first
+    /// matching row wins, over --mass). A clip without a mass gets 70 kg and a warning.
+    #[arg(long)]
+    pub masses: Option<PathBuf>,
     /// File unit: m, cm, mm, in, cmu, or metres per file unit (default: detected).
     #[arg(long)]
     pub unit: Option<String>,
@@ -639,12 +643,11 @@ impl BodyArgs {
     /// [`max_threads`](crate::pipeline::batch::max_threads).
     pub fn overrides(&self) -> anyhow::Result<Overrides> {
         crate::pipeline::batch::check_threads("--threads", self.threads)?;
-        let mass_kg = match self.mass {
-            Some(m) if !(m.is_finite() && m > 0.0) => {
-                anyhow::bail!("--mass must be a positive number of kg, found {m}")
-            }
-            m => m,
-        };
+        if let Some(m) = self.mass {
+            crate::ingest::masses::check_body_mass(m)
+                .map_err(|e| anyhow::anyhow!("--mass: {e}"))?;
+        }
+        let mass_kg = self.mass;
         let unit_m = match &self.unit {
             Some(u) => Some(parse_unit(u).ok_or_else(|| {
                 anyhow::anyhow!("--unit: '{u}' is not m, cm, mm, in, cmu or a positive number")
@@ -659,6 +662,7 @@ impl BodyArgs {
             static_contacts: self.static_contacts,
             no_hands: self.no_hands,
             joints: self.joints,
+            masses: self.masses.clone(),
         })
     }
 }

@@ -11,7 +11,7 @@ use crate::pipeline::build::{build_library, BuildOptions, BuildPlan, BuildSummar
 use crate::pipeline::inputs::read_body;
 use crate::pipeline::merge::merge_into;
 use crate::pipeline::output::OutputRules;
-use crate::pipeline::spec::{resolve, resolve_fit};
+use crate::pipeline::spec::{resolve, resolve_fit, with_masses};
 
 /// Run `build`.
 ///
@@ -21,7 +21,7 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
     let cli = a.body.overrides()?;
     let body = a.body.body.as_deref().map(read_body).transpose()?;
     let opts = BuildOptions {
-        ingest: resolve(body.as_ref(), None, &cli),
+        ingest: with_masses(resolve(body.as_ref(), None, &cli), cli.masses.as_deref())?,
         stances: resolve_fit(None, a.fit.force_model),
     };
     let rules = OutputRules {
