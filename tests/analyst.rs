@@ -1,11 +1,13 @@
-//! Issue 17: the analyst's first hour. The README's demo commands run, its column tables
-//! are the written schemas, the library's provenance (manifest date, command line, tool
-//! version; `stancelib.*` Parquet metadata; query outputs naming their library), `info`,
-//! and the options a newcomer tries first.
+//! Issue 17: the analyst's first hour. The README's demo commands run and answer with
+//! numbers (issue 38 item 6: not all zero or null, queries with feasible rows), the README
+//! stays a manual of at most 300 lines, `docs/tables.md` is the written schemas, the library's provenance (manifest date,
+//! command line, tool version; `stancelib.*` Parquet metadata; query outputs naming their
+//! library), `info`, and the options a newcomer tries first.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::SystemTime;
 
 use crate::util::{root, Demo};
 
@@ -13,20 +15,35 @@ fn readme() -> String {
     std::fs::read_to_string(root().join("README.md")).unwrap()
 }
 
-/// The fenced code blocks of `text` with info string `lang`, each as its lines.
-fn fenced_blocks(text: &str, lang: &str) -> Vec<Vec<String>> {
+/// A page of `docs/`.
+fn docs_page(name: &str) -> String {
+    let path = root().join("docs").join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The fenced code blocks of `text` in order: each block's info string and its lines.
+fn blocks(text: &str) -> Vec<(String, Vec<String>)> {
     let mut blocks = Vec::new();
-    let mut cur: Option<Vec<String>> = None;
+    let mut cur: Option<(String, Vec<String>)> = None;
     for line in text.lines() {
         let t = line.trim_start();
         match &mut cur {
-            None if t.starts_with("```") && t[3..].trim() == lang => cur = Some(Vec::new()),
+            None if t.starts_with("```") => cur = Some((t[3..].trim().to_string(), Vec::new())),
             Some(_) if t.starts_with("```") => blocks.extend(cur.take()),
-            Some(b) => b.push(line.to_string()),
+            Some((_, b)) => b.push(line.to_string()),
             None => {}
         }
     }
     blocks
+}
+
+/// The fenced code blocks of `text` with info string `lang`, each as its lines.
+fn fenced_blocks(text: &str, lang: &str) -> Vec<Vec<String>> {
+    blocks(text)
+        .into_iter()
+        .filter(|(l, _)| l == lang)
+        .map(|(_, b)| b)
+        .collect()
 }
 
 /// A shell line without its comment (a `#` at the start or after a space).
@@ -61,8 +78,137 @@ fn demo_commands_are_found_outside_comments_only() {
     );
 }
 
+/// Every file under `dir` (symbolic links not followed) with its modification time and size.
+fn stamps(dir: &Path) -> BTreeMap<PathBuf, (SystemTime, u64)> {
+    let mut out = BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let m = std::fs::symlink_metadata(&p).unwrap();
+            if m.is_dir() {
+                todo.push(p);
+            } else if m.is_file() {
+                out.insert(p, (m.modified().unwrap(), m.len()));
+            }
+        }
+    }
+    out
+}
+
+/// The files of `after` that are new or changed since `before`.
+fn written_since(
+    before: &BTreeMap<PathBuf, (SystemTime, u64)>,
+    after: &BTreeMap<PathBuf, (SystemTime, u64)>,
+) -> Vec<PathBuf> {
+    after
+        .iter()
+        .filter(|(p, s)| before.get(*p) != Some(s))
+        .map(|(p, _)| p.clone())
+        .collect()
+}
+
+/// The finite values of a Parquet table's numeric columns and numeric lists (nulls and
+/// NaN left out).
+fn table_numbers(path: &Path) -> Vec<f64> {
+    use polars::prelude::DataType;
+    let t = stancelib::library::read::Table::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut out = Vec::new();
+    for c in t.df.columns() {
+        let values = match c.dtype() {
+            d if d.is_primitive_numeric() => c.as_materialized_series().clone(),
+            DataType::List(inner) if inner.is_primitive_numeric() => c.list().unwrap().get_inner(),
+            _ => continue,
+        };
+        let values = values.cast(&DataType::Float64).unwrap();
+        out.extend(values.f64().unwrap().iter().flatten());
+    }
+    out.retain(|v| v.is_finite());
+    out
+}
+
+/// The numbers a command printed: whitespace-separated words that parse as finite numbers
+/// once brackets and separators around them are dropped (`(17`, `0.70,`, `1.5:` …).
+fn printed_numbers(text: &str) -> Vec<f64> {
+    text.split(|c: char| c.is_whitespace() || "()[]{},;=".contains(c))
+        .filter_map(|w| w.trim_end_matches([':', '.']).parse::<f64>().ok())
+        .filter(|v| v.is_finite())
+        .collect()
+}
+
+#[test]
+fn printed_numbers_are_the_numeric_words_of_the_output() {
+    let line = "  sk-1: mu 0.70, F_max 2403 N (17 stances; tool 0.1.0) -0.000 run_120hz:R:51";
+    assert_eq!(printed_numbers(line), [0.70, 2403.0, 17.0, -0.0]);
+    assert!(printed_numbers("plot stance: run_120hz_m_yup:L:95 → a.png").is_empty());
+}
+
+/// Whether a written table answers: the rows of its verdict column (`feasible`, or a jump
+/// map's `feasible_exact`), any of them true; `None` when it has no verdict column.
+fn any_feasible(path: &Path) -> Option<bool> {
+    let t = stancelib::library::read::Table::open(path).unwrap();
+    ["feasible", "feasible_exact"]
+        .iter()
+        .find(|c| t.df.column(c).is_ok())
+        .map(|c| t.bools(c).unwrap().into_iter().any(|f| f))
+}
+
+/// Checks what a documented command gave: every Parquet table it wrote (but a library's
+/// `errors.parquet`) holds a finite non-zero number (and, with `answers`, a feasible row when it has a verdict column); a
+/// command that wrote no table printed a finite non-zero number, or drew a picture.
+fn check_numbers(cmd: &str, written: &[PathBuf], stdout: &str, answers: bool) {
+    // A library's `errors.parquet` lists failed inputs: empty is the good answer.
+    let tables: Vec<&PathBuf> = written
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "parquet"))
+        .filter(|p| !p.ends_with("errors.parquet"))
+        .collect();
+    for t in &tables {
+        let n = table_numbers(t);
+        assert!(
+            n.iter().any(|v| *v != 0.0),
+            "`{cmd}` wrote {} whose numbers are all zero or null ({} finite values)",
+            t.display(),
+            n.len()
+        );
+        if answers {
+            assert_ne!(
+                any_feasible(t),
+                Some(false),
+                "`{cmd}`: no feasible row in {}; a README example must answer",
+                t.display()
+            );
+        }
+    }
+    if !tables.is_empty() {
+        return;
+    }
+    let printed = printed_numbers(stdout);
+    if !printed.is_empty() {
+        assert!(
+            printed.iter().any(|v| *v != 0.0),
+            "`{cmd}` printed only zeros:\n{stdout}"
+        );
+        return;
+    }
+    let pictures: Vec<&PathBuf> = written
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    assert!(
+        !pictures.is_empty(),
+        "`{cmd}` wrote no table, printed no number and drew no picture:\n{stdout}"
+    );
+    for p in pictures {
+        assert!(png_size(p).0 > 0, "{}", p.display());
+    }
+}
+
 // See: issue 17 item 1 — the README's query examples pointed to paths `make demo` does not
-// write, and called built commands "not built yet".
+// write, and called built commands "not built yet". Issue 38 item 6 — an example that runs
+// must also answer: its tables and printed numbers are not all zero or null, and a query's
+// table has a feasible row.
 #[test]
 fn readme_sh_blocks_that_use_the_demo_outputs_run() {
     let commands = demo_commands(&readme());
@@ -72,8 +218,34 @@ fn readme_sh_blocks_that_use_the_demo_outputs_run() {
     );
     let demo = Demo::build();
     for c in &commands {
+        let before = stamps(demo.dir.path());
         let (code, out, err) = demo.sh(c);
         assert_eq!(code, 0, "README command `{c}` failed:\n{out}\n{err}");
+        let written = written_since(&before, &stamps(demo.dir.path()));
+        check_numbers(c, &written, &out, true);
+    }
+}
+
+// See: issue 38 item 6 — the README is a user's manual; column tables, method and
+// measurement history live in docs/.
+#[test]
+fn readme_is_a_manual_of_at_most_300_lines() {
+    let text = readme();
+    let lines = text.lines().count();
+    assert!(lines <= 300, "README.md has {lines} lines (at most 300)");
+    // It points to the pages that took its reference material, and they exist.
+    for page in [
+        "tables.md",
+        "library.md",
+        "queries.md",
+        "editing.md",
+        "decisions.md",
+    ] {
+        assert!(
+            text.contains(&format!("(docs/{page})")),
+            "the README does not link docs/{page}"
+        );
+        assert!(root().join("docs").join(page).is_file(), "no docs/{page}");
     }
 }
 
@@ -141,10 +313,10 @@ fn cell_columns(cell: &str) -> Vec<String> {
         .collect()
 }
 
-/// The columns the README documents per file: rows of a table whose first cell is a
+/// The columns a page documents per file: rows of a table whose first cell is a
 /// backticked `*.parquet` name (columns in its last cell), and tables after a
 /// `<!-- columns: FILE -->` marker (columns in the first cell of each row).
-fn readme_columns(text: &str) -> BTreeMap<String, BTreeSet<String>> {
+fn documented_columns(text: &str) -> BTreeMap<String, BTreeSet<String>> {
     let mut out: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     let mut marker: Option<String> = None;
     for line in text.lines() {
@@ -195,37 +367,76 @@ fn parquet_columns(path: &Path) -> BTreeSet<String> {
 
 // See: issue 17 item 1 — columns were missing from the README's tables
 // (`clips.frame_time_s`, `handedness_ok`, `character_id`, `flight_az_median`,
-// `contacts.normal_x/y/z`).
+// `contacts.normal_x/y/z`). Issue 38 item 6 — the tables moved to docs/tables.md, which
+// also documents the query, forces and edit-plan outputs.
 #[test]
-fn readme_column_tables_are_the_written_schemas() {
-    let documented = readme_columns(&readme());
+fn docs_tables_are_the_written_schemas() {
+    let documented = documented_columns(&docs_page("tables.md"));
     let demo = Demo::build();
-    // `joints.parquet` needs `--joints`: write it beside the demo library.
-    let (code, out, err) =
-        demo.sh("stancelib frames fixtures/bvh/run_120hz_m_yup.bvh --joints --out joints");
-    assert_eq!(code, 0, "{out}{err}");
+    // Outputs the demo job does not write: `joints.parquet` (needs `--joints`), a jump
+    // query, the forces and an edit's plan, written beside the demo library.
+    for c in [
+        "stancelib frames fixtures/bvh/run_120hz_m_yup.bvh --joints --out joints",
+        "stancelib query jump --lib out/demo --height 1.2 --distance 0 --out q/jump.parquet",
+        "stancelib forces --lib out/demo --out q/forces.parquet",
+        "stancelib edit jump --lib out/demo --out q/edit.bvh",
+    ] {
+        let (code, out, err) = demo.sh(c);
+        assert_eq!(code, 0, "`{c}`: {out}{err}");
+    }
+    let lib = demo.lib();
+    let q = demo.dir.path().join("q");
     let files = [
-        ("frames.parquet", demo.lib()),
-        ("clips.parquet", demo.lib()),
-        ("contacts.parquet", demo.lib()),
-        ("stances.parquet", demo.lib()),
-        ("errors.parquet", demo.lib()),
-        ("kinematics.parquet", demo.lib()),
-        ("joints.parquet", demo.dir.path().join("joints")),
+        ("frames.parquet", lib.join("frames.parquet")),
+        ("clips.parquet", lib.join("clips.parquet")),
+        ("contacts.parquet", lib.join("contacts.parquet")),
+        ("stances.parquet", lib.join("stances.parquet")),
+        ("errors.parquet", lib.join("errors.parquet")),
+        ("kinematics.parquet", lib.join("kinematics.parquet")),
+        (
+            "kinematics_points.parquet",
+            lib.join("kinematics_points.parquet"),
+        ),
+        (
+            "joints.parquet",
+            demo.dir.path().join("joints/joints.parquet"),
+        ),
+        ("runs.parquet", lib.join("queries/runs.parquet")),
+        (
+            "jump_map.parquet",
+            lib.join("queries/jump_map/jump_map.parquet"),
+        ),
+        (
+            "jump_map_pairs.parquet",
+            lib.join("queries/jump_map/jump_map_pairs.parquet"),
+        ),
+        ("jump.parquet", q.join("jump.parquet")),
+        ("forces.parquet", q.join("forces.parquet")),
+        ("plan.parquet", q.join("edit.plan.parquet")),
     ];
-    for (file, dir) in files {
-        let written = parquet_columns(&dir.join(file));
+    for (file, path) in &files {
+        let written = parquet_columns(path);
         let doc = documented
-            .get(file)
-            .unwrap_or_else(|| panic!("the README has no column table for {file}"));
+            .get(*file)
+            .unwrap_or_else(|| panic!("docs/tables.md has no column table for {file}"));
         let missing: Vec<_> = written.difference(doc).collect();
         let extra: Vec<_> = doc.difference(&written).collect();
         assert!(
             missing.is_empty() && extra.is_empty(),
-            "{file}: written but not in the README: {missing:?}; in the README but not \
-             written: {extra:?}"
+            "{file}: written but not in docs/tables.md: {missing:?}; in docs/tables.md but \
+             not written: {extra:?}"
         );
     }
+    // And nothing documented goes unchecked.
+    let checked: BTreeSet<&str> = files.iter().map(|(f, _)| *f).collect();
+    let unchecked: Vec<_> = documented
+        .keys()
+        .filter(|f| !checked.contains(f.as_str()))
+        .collect();
+    assert!(
+        unchecked.is_empty(),
+        "docs/tables.md documents tables this test does not compare: {unchecked:?}"
+    );
 }
 
 fn manifest(lib: &Path) -> serde_json::Value {
