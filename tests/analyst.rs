@@ -1,6 +1,7 @@
 //! Issue 17: the analyst's first hour. The README's demo commands run and answer with
 //! numbers (issue 38 item 6: not all zero or null, queries with feasible rows), the README
-//! stays a manual of at most 300 lines, `docs/tables.md` is the written schemas, the library's provenance (manifest date,
+//! stays a manual of at most 300 lines, `docs/first-hour.md` runs as written,
+//! `docs/tables.md` is the written schemas, the library's provenance (manifest date,
 //! command line, tool version; `stancelib.*` Parquet metadata; query outputs naming their
 //! library), `info`, and the options a newcomer tries first.
 
@@ -235,6 +236,7 @@ fn readme_is_a_manual_of_at_most_300_lines() {
     assert!(lines <= 300, "README.md has {lines} lines (at most 300)");
     // It points to the pages that took its reference material, and they exist.
     for page in [
+        "first-hour.md",
         "tables.md",
         "library.md",
         "queries.md",
@@ -247,6 +249,161 @@ fn readme_is_a_manual_of_at_most_300_lines() {
         );
         assert!(root().join("docs").join(page).is_file(), "no docs/{page}");
     }
+}
+
+/// The value after `flag` in a command line.
+fn arg<'a>(cmd: &'a str, flag: &str) -> Option<&'a str> {
+    let words: Vec<&str> = cmd.split_whitespace().collect();
+    words.windows(2).find(|w| w[0] == flag).map(|w| w[1])
+}
+
+/// The stance ids and clip names a command takes (`--stance`, `--clip`, and the two ids of
+/// `--pair LIFTOFF:LANDING`, each `clip:label:frame`).
+fn ids_taken(cmd: &str) -> Vec<String> {
+    let mut ids: Vec<String> = ["--stance", "--clip"]
+        .iter()
+        .filter_map(|f| arg(cmd, f))
+        .map(str::to_string)
+        .collect();
+    if let Some(pair) = arg(cmd, "--pair") {
+        let cut = pair
+            .match_indices(':')
+            .nth(2)
+            .map_or(pair.len(), |(i, _)| i);
+        ids.push(pair[..cut].to_string());
+        ids.push(pair[(cut + 1).min(pair.len())..].to_string());
+    }
+    ids
+}
+
+#[test]
+fn ids_taken_splits_a_pair_into_its_two_stance_ids() {
+    assert_eq!(
+        ids_taken("stancelib edit jump --lib l --pair a_1:LR:35:b:LR:125 --out x.bvh"),
+        ["a_1:LR:35", "b:LR:125"]
+    );
+    assert_eq!(
+        ids_taken("stancelib plot clip --lib l --clip jump_1.3m --out p.png"),
+        ["jump_1.3m"]
+    );
+}
+
+/// Whitespace runs as one space, the ends trimmed.
+fn squeeze(line: &str) -> String {
+    line.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+// See: issue 38 item 6 — "a written walkthrough docs/first-hour.md follows a new user from
+// `make demo` to a feasible scaled run, a feasible higher jump and an edited BVH, using
+// only what the terminal prints". Every `sh` command of the page runs (its `make demo`
+// block is the demo library), its numbers are not all zero, the ids it takes were printed
+// by an earlier command, the output the page quotes is what the tool prints, and the
+// three answers are reached.
+#[test]
+fn first_hour_walkthrough_commands_run() {
+    let page = docs_page("first-hour.md");
+    let demo = Demo::build();
+    // The recorded jumps' heights, as `list` reports them.
+    let (code, json, err) = demo.sh("stancelib list out/demo --json");
+    assert_eq!(code, 0, "{err}");
+    let list: serde_json::Value = serde_json::from_str(json.trim()).unwrap();
+    let recorded = list["jumps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j["height_m"].as_f64().unwrap())
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        recorded.is_finite(),
+        "the demo library lists no jump: {list}"
+    );
+    let (mut run, mut jump, mut edit) = (false, false, false);
+    let mut seen = String::new();
+    let mut last: Option<String> = None;
+    let mut n = 0;
+    for (lang, lines) in blocks(&page) {
+        match lang.as_str() {
+            "sh" => {
+                let commands: Vec<String> = lines
+                    .iter()
+                    .map(|l| without_comment(l).to_string())
+                    .filter(|l| !l.is_empty())
+                    .collect();
+                if commands == ["make demo"] {
+                    last = None;
+                    continue;
+                }
+                let mut output = String::new();
+                for c in &commands {
+                    assert!(
+                        c.starts_with("stancelib "),
+                        "not a stancelib command: `{c}`"
+                    );
+                    for id in ids_taken(c) {
+                        assert!(
+                            seen.contains(&id),
+                            "`{c}` takes `{id}`, which no earlier command printed"
+                        );
+                    }
+                    let before = stamps(demo.dir.path());
+                    let (code, out, err) = demo.sh(c);
+                    assert_eq!(code, 0, "docs/first-hour.md: `{c}` failed:\n{out}\n{err}");
+                    let written = written_since(&before, &stamps(demo.dir.path()));
+                    check_numbers(c, &written, &out, false);
+                    let out_file = arg(c, "--out").map(|o| demo.dir.path().join(o));
+                    let out_file = out_file.as_deref();
+                    if c.starts_with("stancelib query run") {
+                        run |= any_feasible(out_file.unwrap()) == Some(true);
+                    }
+                    if c.starts_with("stancelib query jump") {
+                        let t = stancelib::library::read::Table::open(out_file.unwrap()).unwrap();
+                        let feasible = t.bools("feasible").unwrap();
+                        let heights = t.f64s("height_m").unwrap();
+                        jump |= feasible
+                            .iter()
+                            .zip(&heights)
+                            .any(|(f, h)| *f && *h > recorded + 0.05);
+                    }
+                    if c.starts_with("stancelib edit") {
+                        let bvh = out_file.unwrap();
+                        edit |= std::fs::metadata(bvh).is_ok_and(|m| m.len() > 0);
+                    }
+                    output.push_str(&out);
+                    output.push_str(&err);
+                    n += 1;
+                }
+                seen.push_str(&output);
+                last = Some(output);
+            }
+            "text" => {
+                // The terminal output quoted after a command block, trimmed with `…`.
+                let Some(output) = last.take() else { continue };
+                let printed: Vec<String> = output.lines().map(squeeze).collect();
+                for want in lines.iter().map(|l| squeeze(l)) {
+                    if want.is_empty() || want == "…" {
+                        continue;
+                    }
+                    assert!(
+                        printed.iter().any(|p| p.contains(&want)),
+                        "docs/first-hour.md quotes a line the tool does not print:\n{want}\n\
+                         it printed:\n{output}"
+                    );
+                }
+            }
+            _ => last = None,
+        }
+    }
+    assert!(n >= 6, "docs/first-hour.md shows only {n} commands");
+    assert!(
+        run,
+        "no `query run` of docs/first-hour.md answers with a feasible run"
+    );
+    assert!(
+        jump,
+        "no `query jump` of docs/first-hour.md answers a feasible jump higher than the \
+         recorded {recorded:.3} m"
+    );
+    assert!(edit, "no `edit` of docs/first-hour.md wrote a BVH file");
 }
 
 /// Expands a README column token: `a_{x,y,z}`, `<e>` (the four effectors) and

@@ -61,9 +61,10 @@
 //! # Command line and documentation
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
 //! - `analyst`: issue 17 — the README's demo commands run and answer with numbers (issue 38
-//!   item 6), the README has at most 300 lines, `docs/tables.md` is the written schemas;
-//!   manifest date and command line, query outputs naming their library, `info`, negative
-//!   numbers, `--help` limits, `--quiet` and `--json`.
+//!   item 6), the README has at most 300 lines, `docs/first-hour.md` runs as written and
+//!   reaches its answers, `docs/tables.md` is the written schemas; manifest date and
+//!   command line, query outputs naming their library, `info`, negative numbers, `--help`
+//!   limits, `--quiet` and `--json`.
 //! - `catalogue`: issue 38 item 2 — `list`: characters, run cycles (against `query run`), jumps.
 //!
 //! # Safety (issue 11)
