@@ -60,9 +60,11 @@
 //!
 //! # Command line and documentation
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
-//! - `analyst`: issue 17 — the README's demo commands run and its column tables are the
-//!   written schemas; manifest date and command line, query outputs naming their library,
-//!   `info`, negative numbers, `--help` limits, `--quiet` and `--json`.
+//! - `analyst`: issue 17 — the README's demo commands run and answer with numbers (issue 38
+//!   item 6), the README has at most 300 lines, `docs/first-hour.md` runs as written and
+//!   reaches its answers, `docs/tables.md` is the written schemas; manifest date and
+//!   command line, query outputs naming their library, `info`, negative numbers, `--help`
+//!   limits, `--quiet` and `--json`.
 //! - `catalogue`: issue 38 item 2 — `list`: characters, run cycles (against `query run`), jumps.
 //! - `duplicates`: issue 38 item 3 — copied clips reported by `info` and answering once;
 //!   clips a query leaves out named, `--keep-left-out`.
