@@ -136,6 +136,7 @@ mod catalogue;
 mod cli;
 mod duplicates;
 mod masses;
+mod verdicts;
 // Safety
 mod safety_inputs;
 mod safety_limits;

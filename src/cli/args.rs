@@ -498,6 +498,11 @@ pub struct RunQueryArgs {
     /// a clip whose flights say its time base is wrong); they are named on stderr.
     #[arg(long = "keep-left-out")]
     pub keep_left_out: bool,
+    /// Print one answer in full: the cycle whose first stance is this id (at each speed),
+    /// with its gait-law times and, per stance, its scaling and every limit with value,
+    /// limit and margin.
+    #[arg(long, value_name = "STANCE_ID")]
+    pub explain: Option<String>,
 }
 
 impl RunQueryArgs {
@@ -520,13 +525,30 @@ pub struct JumpArgs {
     /// Library folder.
     #[arg(long)]
     pub lib: PathBuf,
-    /// Flight apex height above the liftoff contact, m.
-    #[arg(long, allow_hyphen_values = true)]
-    pub height: f64,
+    /// Flight apex height above the liftoff contact, m (the same for every pair).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        required_unless_present = "height_scale"
+    )]
+    pub height: Option<f64>,
+    /// Each pair's own recorded apex height times this (e.g. 1.1: 10 % higher than
+    /// recorded), instead of `--height`.
+    #[arg(long = "height-scale", conflicts_with = "height")]
+    pub height_scale: Option<f64>,
     /// Jump distance (liftoff start apex to landing end apex, along the heading), m;
-    /// negative is backwards.
+    /// negative is backwards. Needed with `--height`.
     #[arg(long, allow_hyphen_values = true)]
-    pub distance: f64,
+    pub distance: Option<f64>,
+    /// Each pair's own recorded distance times this, instead of `--distance` (default 1
+    /// with `--height-scale`: the recorded distance).
+    #[arg(long = "distance-scale", conflicts_with = "distance")]
+    pub distance_scale: Option<f64>,
+    /// Print one answer in full: a rank of the printed table, or a stance id (the
+    /// best-ranked pair with that liftoff or landing), with the flight and, per side, its
+    /// scaling and every limit with value, limit and margin.
+    #[arg(long, value_name = "RANK|STANCE_ID")]
+    pub explain: Option<String>,
     /// Rows printed (the file has every pair).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
