@@ -232,3 +232,53 @@ fn an_unknown_stance_id_suggests_the_nearest_ones() {
     let got: i64 = near.rsplit(':').next().unwrap().parse().unwrap();
     assert_eq!((got - (frame + 1)).abs(), nearest_frame, "{err}");
 }
+
+// See: issue 38 item 1 — `map jumps` printed counts only; each pair now says how much of the
+// grid it can jump and whether its recorded jump, and one 10 % higher, are feasible, or which
+// limit stops them.
+#[test]
+fn map_jumps_says_per_pair_what_it_can_jump_and_why_not() {
+    let lib = fixture_library();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("map");
+    let text = ok(&[
+        "map",
+        "jumps",
+        "--lib",
+        &s(lib),
+        "--heights",
+        "0.8:1.6:0.05",
+        "--speeds",
+        "0:4:0.25",
+        "--out",
+        &s(&out),
+    ]);
+    eprintln!("{text}");
+    let t = Table::open(&out.join("jump_map_pairs.parquet")).unwrap();
+    let (up, down) = (
+        t.strings("liftoff_stance_id").unwrap(),
+        t.strings("landing_stance_id").unwrap(),
+    );
+    let n_exact = t.i64s("n_exact").unwrap();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| l.contains(" cells; as recorded "))
+        .collect();
+    assert_eq!(lines.len(), up.len().min(10), "{text}");
+    for l in &lines {
+        let (pair, rest) = l.trim().split_once(": ").unwrap();
+        let (a, b) = pair.split_once(" → ").unwrap();
+        let i = (0..up.len()).find(|&i| up[i] == a && down[i] == b).unwrap();
+        let n: i64 = rest.split(' ').next().unwrap().parse().unwrap();
+        assert_eq!(n, n_exact[i], "{l}");
+        // A "no" names its reason: a limit with its margin, or the solver's reason.
+        for part in rest.split("; ").skip(1) {
+            assert!(part.ends_with("feasible") || part.contains(" no ("), "{l}");
+        }
+    }
+    // The recorded jumps of the jump clips are feasible as recorded.
+    assert!(
+        lines.iter().any(|l| l.contains("as recorded feasible")),
+        "{text}"
+    );
+}

@@ -474,7 +474,30 @@ pub struct MapReport {
     pub iou: f64,
     /// Time spent computing the map, s.
     pub elapsed_s: f64,
+    /// Per pair, most feasible cells first ([`PairAnswer`]).
+    pub pair_answers: Vec<PairAnswer>,
 }
+
+/// One pair of `map jumps` in words: how much of the grid it can jump, and whether it can
+/// jump its own recorded jump and one [`HIGHER_BY`] higher, each with its deciding limit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairAnswer {
+    /// Liftoff stance id.
+    pub liftoff: String,
+    /// Landing stance id.
+    pub landing: String,
+    /// Cells feasible by the exact check, of `cells`.
+    pub feasible_cells: usize,
+    /// Cells of the grid.
+    pub cells: usize,
+    /// The recorded jump: `None` feasible, else why not ([`JumpRow::explain`]).
+    pub recorded: Option<String>,
+    /// The recorded jump with its apex [`HIGHER_BY`] times as high, same distance.
+    pub higher: Option<String>,
+}
+
+/// The factor on the recorded apex height `map jumps` reports per pair ("10 % higher").
+pub const HIGHER_BY: f64 = 1.1;
 
 /// Runs `map jumps` and writes `jump_map.parquet`, `jump_map_pairs.parquet`,
 /// `jump_map.json` and the figures into its folder.
@@ -528,6 +551,7 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         &(serde_json::to_string_pretty(&summary)? + "\n"),
     )?;
     map_figures(&q.out, &map, &pool)?;
+    let pair_answers = pair_answers(&map, &pool, &limits);
     Ok(MapReport {
         liftoffs: map.liftoffs.len(),
         landings: map.landings.len(),
@@ -540,7 +564,58 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         ),
         iou,
         elapsed_s: elapsed,
+        pair_answers,
     })
+}
+
+/// [`PairAnswer`] of every pair of the map, most feasible cells first (ties: ids).
+fn pair_answers(
+    map: &JumpMap,
+    pool: &[Prepared],
+    limits: &dyn Fn(&Prepared) -> Limits,
+) -> Vec<PairAnswer> {
+    let verdicts = |height: f64| -> BTreeMap<(String, String), Option<String>> {
+        let target = JumpTarget::Scaled {
+            height,
+            distance: 1.0,
+        };
+        ranked_jump_pairs(pool, |a, b| target.of(a, b), limits)
+            .iter()
+            .map(|r| {
+                let ids = (
+                    r.liftoff.stance.stance_id.clone(),
+                    r.landing.stance.stance_id.clone(),
+                );
+                (ids, r.explain())
+            })
+            .collect()
+    };
+    let (own, higher) = (verdicts(1.0), verdicts(HIGHER_BY));
+    let cells = map.heights.len() * map.speeds.len();
+    let mut out: Vec<PairAnswer> = map
+        .pairs
+        .iter()
+        .map(|p| {
+            let ids = (
+                pool[p.liftoff].stance.stance_id.clone(),
+                pool[p.landing].stance.stance_id.clone(),
+            );
+            PairAnswer {
+                feasible_cells: p.exact.iter().filter(|&&e| e).count(),
+                cells,
+                recorded: own.get(&ids).cloned().flatten(),
+                higher: higher.get(&ids).cloned().flatten(),
+                liftoff: ids.0,
+                landing: ids.1,
+            }
+        })
+        .collect();
+    out.sort_by(|a, b| {
+        b.feasible_cells
+            .cmp(&a.feasible_cells)
+            .then_with(|| (&a.liftoff, &a.landing).cmp(&(&b.liftoff, &b.landing)))
+    });
+    out
 }
 
 /// `jump_map.png`, and one `jump_map_<character>.png` each when the pool has several.
