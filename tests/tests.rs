@@ -77,6 +77,8 @@
 //!   option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `safety_outputs`: `--out` never destroys what the tool did not write; input links,
 //!   cycles and special files; per-input errors; stale temporaries; the build lock.
+//! - `safety_reuse`: issue 40 items 1, 4, 7: incremental builds and merges check what they
+//!   reuse against the manifest's content hashes and rows per clip; `frames` never writes into a library.
 //! - `safety_side_inputs`: issue 40 items 2, 3, 8, 10: side inputs as BVH inputs, clip budget, closed stdout, atomic `synth`.
 //!
 //! # Structure (issue 13)
@@ -137,6 +139,7 @@ mod safety_limits;
 mod safety_messages;
 mod safety_options;
 mod safety_outputs;
+mod safety_reuse;
 mod safety_side_inputs;
 // Structure (issue 13)
 mod structure_edges;
