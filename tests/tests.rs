@@ -73,6 +73,8 @@
 //! - `safety_messages`: escaped short error messages, the line bound, CR-only and empty files.
 //! - `safety_limits`: item 6: every documented work limit refused before work (exit 2,
 //!   field and limit named).
+//! - `safety_numbers`: issue 40 item 5: implausible segments, non-finite stance rows and
+//!   out-of-bound 2PAC inputs are errors, never inf or NaN written with status ok.
 //! - `safety_options`: items 10–12: pipelines validated before the library is touched, no
 //!   option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `safety_outputs`: `--out` never destroys what the tool did not write; input links,
@@ -137,6 +139,7 @@ mod duplicates;
 mod safety_inputs;
 mod safety_limits;
 mod safety_messages;
+mod safety_numbers;
 mod safety_options;
 mod safety_outputs;
 mod safety_reuse;

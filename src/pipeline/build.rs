@@ -54,7 +54,7 @@ use crate::library::schema::{
     SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::scratch::{scratch_name, Scratch};
-use crate::library::stances::{errors_table, stances_table, ErrorRow};
+use crate::library::stances::{errors_table, first_non_finite, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, joints_table};
 use crate::library::{ClipRecord, ClipStatus, Status};
 use crate::stances::build::StanceNote;
@@ -206,7 +206,29 @@ fn build_one(
         _ => (Vec::new(), Vec::new()),
     };
     bar.done(1, r.frames.as_ref().map_or(0, |f| f.frame.len() as u64));
-    (r, out)
+    refuse_non_finite(r, out)
+}
+
+/// A clip whose stances hold a non-finite number (inf or NaN in any column) becomes a
+/// per-clip error of stage `stances`, with no rows: the last guard before the tables.
+fn refuse_non_finite(mut r: ClipRecord, out: ClipStances) -> (ClipRecord, ClipStances) {
+    let found = match first_non_finite(&out.0) {
+        Ok(None) => return (r, out),
+        Ok(Some(cell)) => format!(
+            "stance {}: {} is {} (not finite): the clip's offsets, angles or body values \
+             overflow; no row of it is written",
+            crate::error::echo(&cell.stance_id),
+            cell.column,
+            cell.value
+        ),
+        Err(e) => format!("its stance rows cannot be checked: {e}"),
+    };
+    r.status = Status::Error;
+    r.error_stage = Some("stances");
+    r.message = Some(format!("{}: {found}", r.path));
+    r.frames = None;
+    r.contacts = Vec::new();
+    (r, (Vec::new(), Vec::new()))
 }
 
 /// The report of a batch of built clips: records in clip order, their error rows (failed
