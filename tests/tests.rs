@@ -77,10 +77,14 @@
 //! - `safety_messages`: escaped short error messages, the line bound, CR-only and empty files.
 //! - `safety_limits`: item 6: every documented work limit refused before work (exit 2,
 //!   field and limit named).
+//! - `safety_numbers`: issue 40 item 5: implausible segments, non-finite stance rows and
+//!   out-of-bound 2PAC inputs are errors, never inf or NaN written with status ok.
 //! - `safety_options`: items 10–12: pipelines validated before the library is touched, no
 //!   option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `safety_outputs`: `--out` never destroys what the tool did not write; input links,
 //!   cycles and special files; per-input errors; stale temporaries; the build lock.
+//! - `safety_reuse`: issue 40 items 1, 4, 7: incremental builds and merges check what they
+//!   reuse against the manifest's content hashes and rows per clip; `frames` never writes into a library.
 //! - `safety_side_inputs`: issue 40 items 2, 3, 8, 10: side inputs as BVH inputs, clip budget, closed stdout, atomic `synth`.
 //!
 //! # Structure (issue 13)
@@ -141,8 +145,10 @@ mod verdicts;
 mod safety_inputs;
 mod safety_limits;
 mod safety_messages;
+mod safety_numbers;
 mod safety_options;
 mod safety_outputs;
+mod safety_reuse;
 mod safety_side_inputs;
 // Structure (issue 13)
 mod structure_edges;

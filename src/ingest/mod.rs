@@ -233,8 +233,9 @@ pub fn check_point_samples(n_points: usize, n_frames: usize) -> Result<()> {
 ///
 /// # Errors
 /// More point samples than [`MAX_POINT_SAMPLES`] (`ErrorKind::Limit`, checked before the
-/// skeleton is used);
-/// A partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that
+/// skeleton is used); a segment far longer than the skeleton's others
+/// (`ErrorKind::Skeleton`, [`crate::skeleton::plausibility`]: before forward kinematics);
+/// a partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that
 /// names no joint (`ErrorKind::Skeleton`); a frame time so short that the smoothing window
 /// exceeds `MAX_SAVGOL_WINDOW` (`ErrorKind::Smoothing`, checked before any per-frame
 /// work); offsets and angles so large that a leg length, a position, the COM or its
@@ -250,6 +251,7 @@ pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
     };
     let skel = Skeleton::from_bvh(bvh);
     check_point_samples(skel.n_points(), m.n_frames())?;
+    crate::skeleton::plausibility::check_segments(&skel)?;
     let rest = fk::rest_pose(&skel);
     let lm = match landmarks::map(&skel, &rest, &opts.landmarks)? {
         Mapping::NotABody => {

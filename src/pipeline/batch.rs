@@ -269,7 +269,8 @@ pub fn worker_pool(files: &[PathBuf], threads: usize) -> anyhow::Result<rayon::T
 /// included.
 ///
 /// # Errors
-/// No readable input, a pool that cannot start, an unwritable output folder.
+/// No readable input, a pool that cannot start, an unwritable output folder, or an output
+/// folder that holds a library ([`super::output::refuse_library`]).
 pub fn frames_into(
     files: &[PathBuf],
     out: &Path,
@@ -277,6 +278,7 @@ pub fn frames_into(
     threads: usize,
 ) -> anyhow::Result<Vec<ClipStatus>> {
     use anyhow::Context;
+    super::output::refuse_library(out)?;
     let pool = worker_pool(files, threads)?;
     pool.install(|| stream_frames(files, out, opts))
         .with_context(|| format!("writing tables to {}", out.display()))

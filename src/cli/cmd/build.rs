@@ -70,11 +70,15 @@ pub fn run_merge(a: MergeArgs) -> anyhow::Result<Outcome> {
 /// `SomeFailed`: the merge decides).
 pub fn report_build(report: &BuildSummary, out: &Path, plan: &BuildPlan) -> Outcome {
     let reused = report.reused;
+    for line in &report.not_reused {
+        eprintln!("incremental: {line}");
+    }
     let outcome = super::frames::report(&report.records, out);
     crate::say!("{} stances rebuilt, {reused} clips reused", report.stances);
     let mut summary = super::frames::summary(&report.records, out, "build");
     summary["stances_rebuilt"] = report.stances.into();
     summary["clips_reused"] = reused.into();
+    summary["reuse_refused"] = report.not_reused.clone().into();
     // A library that cannot be read back here has said why already (the build's own
     // errors); the duplicates are then not reported.
     let duplicates = crate::library::info::duplicate_clips(out).unwrap_or_default();
