@@ -55,6 +55,82 @@ pub fn write_png(
     crate::library::atomic::write_file_atomic(path, |tmp| draw(tmp).map_err(anyhow::Error::from))
 }
 
+/// A picture's answer to its question, drawn as the line under its title: dark green when
+/// the answer is good news (feasible, valid, ballistic), dark red when it is not.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Verdict {
+    /// The answer in words, with numbers and units.
+    pub text: String,
+    /// Good news.
+    pub ok: bool,
+}
+
+impl Verdict {
+    /// A verdict `text`, good news when `ok`.
+    pub fn new(text: impl Into<String>, ok: bool) -> Verdict {
+        Verdict {
+            text: text.into(),
+            ok,
+        }
+    }
+}
+
+/// Font size of a picture's title line, px (the largest; shrunk to fit the width).
+pub const TITLE_FONT_PX: u32 = 22;
+/// Font size of a picture's verdict line, px (the largest; shrunk to fit the width).
+pub const VERDICT_FONT_PX: u32 = 18;
+/// Smallest font a title or verdict line is shrunk to, px.
+const MIN_FONT_PX: u32 = 11;
+const GOOD: RGBColor = RGBColor(0, 110, 50);
+const BAD: RGBColor = RGBColor(190, 0, 0);
+
+/// The largest font size from `size` down to [`MIN_FONT_PX`] at which `text` fits the
+/// width of `area` with 10 px either side.
+fn fitted_font(area: &DrawingArea<BitMapBackend<'_>, Shift>, text: &str, size: u32) -> u32 {
+    let width = area.dim_in_pixel().0;
+    (MIN_FONT_PX..=size)
+        .rev()
+        .find(|&s| {
+            let style: TextStyle = ("sans-serif", s).into();
+            area.estimate_text_size(text, &style)
+                .is_ok_and(|(w, _)| w + 20 <= width)
+        })
+        .unwrap_or(MIN_FONT_PX)
+}
+
+/// Draws `title` and, under it, the `verdict` (coloured) across the top of `area`, each
+/// shrunk to fit the width; returns the area below them.
+///
+/// # Errors
+/// The font cannot be used.
+fn titled<'a>(
+    area: &DrawingArea<BitMapBackend<'a>, Shift>,
+    path: &Path,
+    title: &str,
+    verdict: &Verdict,
+) -> Result<DrawingArea<BitMapBackend<'a>, Shift>, PlotError> {
+    let size = fitted_font(area, title, TITLE_FONT_PX);
+    let rest = area
+        .titled(title, ("sans-serif", size))
+        .map_err(|e| err(path, e))?;
+    let size = fitted_font(&rest, &verdict.text, VERDICT_FONT_PX);
+    let colour = if verdict.ok { GOOD } else { BAD };
+    rest.titled(
+        &verdict.text,
+        ("sans-serif", size).into_font().color(&colour),
+    )
+    .map_err(|e| err(path, e))
+}
+
+/// The unit horizontal direction of travel of a path of points (world x, y): from its
+/// first point to its last when they are at least `min_travel_m` apart, else `None`.
+pub fn travel_direction(path: &[[f64; 3]], min_travel_m: f64) -> Option<[f64; 2]> {
+    let (a, b) = (path.first()?, path.last()?);
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let n = d[0].hypot(d[1]);
+    (n >= min_travel_m && n.is_finite()).then(|| [d[0] / n, d[1] / n])
+}
+
 fn err(path: &Path, e: impl std::fmt::Display) -> PlotError {
     PlotError {
         path: path.display().to_string(),
