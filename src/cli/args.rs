@@ -485,8 +485,9 @@ pub struct RunQueryArgs {
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
-    /// Also draw Table 1 as a figure (PNG): β_h, mu_min and the leg extension against
-    /// speed, with the limits dashed and infeasible speeds marked.
+    /// Also draw Table 1 as a figure (PNG): contact time and step period, peak force,
+    /// mu_min and the leg extension against speed, one colour per cycle, the limits dashed
+    /// and each infeasible speed marked on the panel of the limit it violates.
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// How contact time and step period change with speed: `auto` (the character's own

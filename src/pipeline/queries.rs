@@ -346,6 +346,7 @@ fn run_points(rows: &[RunRow], n_cycles: usize) -> Vec<crate::plot::runs::RunPoi
             };
             crate::plot::runs::RunPoint {
                 cycle: i % n_cycles.max(1),
+                cycle_name: r.stances[0].stance.stance_id.clone(),
                 speed_mps: r.candidate.speed,
                 contact_s: solved
                     .iter()
