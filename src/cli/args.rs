@@ -553,6 +553,10 @@ pub struct MapJumpsArgs {
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also draw `jump_map_agreement.png`: where the fast filters (paper eq 10, 12) and the
+    /// exact check agree (a developer diagnostic; the IoU is in `jump_map.json` anyway).
+    #[arg(long)]
+    pub diagnostics: bool,
 }
 
 impl MapJumpsArgs {

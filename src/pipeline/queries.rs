@@ -379,6 +379,9 @@ pub struct MapQuery {
     pub limits: LimitOptions,
     /// Output folder.
     pub out: PathBuf,
+    /// Also draw `jump_map_agreement.png`, the fast filters against the exact check (a
+    /// developer diagnostic).
+    pub diagnostics: bool,
 }
 
 /// What `map jumps` found.
@@ -451,6 +454,11 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         &(serde_json::to_string_pretty(&summary)? + "\n"),
     )?;
     map_figures(&q.out, &map, &pool)?;
+    if q.diagnostics {
+        write_png(&q.out.join(JUMP_MAP_AGREEMENT_PNG), |p| {
+            crate::plot::jump_map_agreement_png(p, &map, "all characters")
+        })?;
+    }
     Ok(MapReport {
         liftoffs: map.liftoffs.len(),
         landings: map.landings.len(),
@@ -465,6 +473,9 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         elapsed_s: elapsed,
     })
 }
+
+/// The `--diagnostics` picture of `map jumps` in its output folder.
+pub const JUMP_MAP_AGREEMENT_PNG: &str = "jump_map_agreement.png";
 
 /// `jump_map.png`, and one `jump_map_<character>.png` each when the pool has several.
 fn map_figures(out: &Path, map: &JumpMap, pool: &[Prepared]) -> anyhow::Result<()> {
@@ -579,6 +590,7 @@ pub fn query_stages(
             speeds: axis_or("--speeds", q.map_speeds.as_deref(), DEFAULT_SPEEDS)?,
             limits,
             out: dir.join("jump_map"),
+            diagnostics: false,
         }),
         _ => None,
     };
