@@ -839,8 +839,9 @@ pub struct PlotStanceArgs {
     /// `f{x,y,z}_n`; N, the BVH file's axes).
     #[arg(long)]
     pub plates: Option<PathBuf>,
-    /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1].
-    #[arg(long = "active-set", default_value_t = crate::constraints::ACTIVE_FRACTION)]
+    /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1]
+    /// (default: the queries' friction check, whose `mu_req_robust` the plot shows).
+    #[arg(long = "active-set", default_value_t = crate::query::feasibility::DEFAULT_QUERY_ACTIVE_FRACTION)]
     pub active_set: f64,
     /// Output PNG file.
     #[arg(long)]
