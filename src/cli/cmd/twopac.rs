@@ -12,6 +12,7 @@ use super::super::Outcome;
 use crate::math::constants::STATIC_TOL;
 use crate::pipeline::twopac_outputs::{run_twopac, TwopacJob, TwopacReport};
 use crate::twopac::transition::QpForm;
+use crate::twopac::validate::Validation;
 
 /// Run `twopac`.
 ///
@@ -30,6 +31,22 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
     let report = run_twopac(&job)?;
     print_summary(&report, &job);
     Ok(Outcome::Clean)
+}
+
+/// A validation's verdict in words: `2pac: dynamically valid (321 of 321 samples)` or
+/// `NOT dynamically valid`, with the valid fraction and the largest slack.
+pub fn validation_line(name: &str, v: &Validation) -> String {
+    let n = v.samples.len();
+    let n_valid = v.samples.iter().filter(|s| s.valid).count();
+    let verdict = if v.trajectory_valid {
+        "dynamically valid"
+    } else {
+        "NOT dynamically valid"
+    };
+    format!(
+        "{name}: {verdict}: {n_valid} of {n} samples valid (point_valid_rate {:.3}), max s* {:.3} N at {:.2} s",
+        v.point_valid_rate, v.max_slack_n, v.worst_t_s
+    )
 }
 
 /// The summary lines on stdout.
@@ -56,18 +73,14 @@ fn print_summary(r: &TwopacReport, job: &TwopacJob) {
         p.windows.len(),
         r.planned.plan_s * 1e3
     );
-    for (name, v) in [
-        ("2pac", &r.planned.v_curve),
-        ("quasi-static", &r.planned.v_qs),
+    for (name, v, why) in [
+        ("2pac", &r.planned.v_curve, r.planned.why_curve()),
+        ("quasi-static baseline", &r.planned.v_qs, r.planned.why_qs()),
     ] {
-        crate::say!(
-            "  {name}: {} samples, point_valid_rate {:.3}, trajectory_valid {}, max s* {:.3} N at {:.2} s",
-            v.samples.len(),
-            v.point_valid_rate,
-            v.trajectory_valid,
-            v.max_slack_n,
-            v.worst_t_s
-        );
+        crate::say!("  {}", validation_line(name, v));
+        if let Some(why) = why {
+            crate::say!("    why: {why}");
+        }
     }
     crate::say!("  → {}", job.out.display());
 }
