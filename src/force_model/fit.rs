@@ -226,6 +226,8 @@ pub struct StanceForce<'a> {
     pub r_s: [[f64; 3]; 3],
     /// Body mass `m` (kg).
     pub mass_kg: f64,
+    /// The stance foot's leg line (a single-foot running stance), else `None`.
+    pub leg: Option<super::LegLine<'a>>,
 }
 
 impl StanceForce<'_> {
@@ -304,6 +306,7 @@ pub fn fit_stage_a(
         dt,
         r_s,
         mass_kg,
+        leg: None,
     };
     stance.check("stage a")?;
     ws.ensure(opts.samples);

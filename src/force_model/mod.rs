@@ -44,12 +44,14 @@
 pub mod basis;
 pub mod export;
 pub mod fit;
+pub mod leg_line;
 pub mod model;
 pub mod ratio;
 
 pub use fit::{fit_axis, fit_stage_a, j_cap, k_max, FitWorkspace, StanceForce};
+pub use leg_line::LegLine;
 pub use model::{AxisModel, ForceModel};
-pub use ratio::{fit_ratio, EdgeTargets, RatioFit, RatioOptions};
+pub use ratio::{fit_ratio, fit_ratio_with, EdgeTargets, RatioFit, RatioOptions};
 
 pub use crate::math::constants::GRAVITY;
 /// Default number of samples `N` per stance (spec §4.1 step 3).
@@ -177,12 +179,26 @@ pub fn fit_stance(
                     force.t_td
                 )));
             }
-            let fit = fit_ratio(
+            let tau = ratio::sample_grid(n);
+            let leg = force
+                .leg
+                .as_ref()
+                .filter(|_| opts.ratio.leg_line_weight > 0.0);
+            let slopes = leg.and_then(|l| {
+                l.slopes(
+                    (force.t_td, force.dt),
+                    &force.r_s,
+                    &tau,
+                    opts.ratio.roll_fraction,
+                )
+            });
+            let fit = fit_ratio_with(
                 &samples,
                 n_st,
                 force.mass_kg,
                 force.dt,
                 targets,
+                slopes.as_ref(),
                 &opts.ratio,
             )?;
             Ok(StanceFit {

@@ -159,6 +159,12 @@ pub struct RatioOptions {
     pub ratio_degree_h: usize,
     /// Degree of `q_p`; default [`DEFAULT_RATIO_DEGREE_P`].
     pub ratio_degree_p: usize,
+    /// Weight `λ ∈ [0, 1]` of the leg line in the ratio data ([`super::leg_line`]); default
+    /// [`super::leg_line::DEFAULT_LEG_LINE_WEIGHT`].
+    pub leg_line_weight: f64,
+    /// Roll fraction `φ ∈ [0, 1]` of the leg line's support point; default
+    /// [`super::leg_line::DEFAULT_ROLL_FRACTION`].
+    pub roll_fraction: f64,
 }
 
 impl Default for RatioOptions {
@@ -167,6 +173,8 @@ impl Default for RatioOptions {
             vertical_degree: DEFAULT_VERTICAL_DEGREE,
             ratio_degree_h: DEFAULT_RATIO_DEGREE_H,
             ratio_degree_p: DEFAULT_RATIO_DEGREE_P,
+            leg_line_weight: super::leg_line::DEFAULT_LEG_LINE_WEIGHT,
+            roll_fraction: super::leg_line::DEFAULT_ROLL_FRACTION,
         }
     }
 }
@@ -198,6 +206,18 @@ impl RatioOptions {
         ] {
             if d > MAX_RATIO_DEGREE {
                 return bad(name, d, 0, MAX_RATIO_DEGREE);
+            }
+        }
+        for (name, v) in [
+            ("leg_line_weight", self.leg_line_weight),
+            ("roll_fraction", self.roll_fraction),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(Error::config(
+                    None,
+                    None,
+                    format!("fit.{name} = {v} is not in [0, 1]"),
+                ));
             }
         }
         Ok(())
@@ -443,20 +463,59 @@ fn rms(axis: &AxisModel, tau: &[f64], samples: &[f64]) -> f64 {
     (ss / tau.len().max(1) as f64).sqrt()
 }
 
-/// Fits the ratio model to stance-axis force samples on `τ_j = j/(N−1)`.
-///
-/// # Arguments
-/// * `samples`: `s_aj` per stance axis (h, p, v), N, all of length `N ≥ 2`;
-/// * `n_st`: stance frames (sets the degree of `f_v`); `mass_kg`, `dt_s`: for the model.
+/// Fits the ratio model to stance-axis force samples on `τ_j = j/(N−1)` (no leg line:
+/// [`fit_ratio_with`]).
 ///
 /// # Errors
-/// A config error for bad options or sample lengths; a numeric error when the QP fails.
+/// See [`fit_ratio_with`].
 pub fn fit_ratio(
     samples: &[Vec<f64>; 3],
     n_st: usize,
     mass_kg: f64,
     dt_s: f64,
     targets: Option<&EdgeTargets>,
+    opts: &RatioOptions,
+) -> Result<RatioFit> {
+    fit_ratio_with(samples, n_st, mass_kg, dt_s, targets, None, opts)
+}
+
+/// The ratio data `s'_a = (1 − λ) s_a + λ f_v g_a` of the leg line ([`super::leg_line`]),
+/// a = h, p; the kinematic samples where there is no leg line or `λ = 0`.
+fn ratio_data(
+    samples: &[Vec<f64>; 3],
+    fv: &[f64],
+    leg: Option<&[Vec<f64>; 2]>,
+    lambda: f64,
+) -> [Vec<f64>; 2] {
+    std::array::from_fn(
+        |a| match leg.filter(|g| lambda > 0.0 && g[a].len() == fv.len()) {
+            Some(g) => samples[a]
+                .iter()
+                .zip(fv.iter().zip(&g[a]))
+                .map(|(s, (f, g))| (1.0 - lambda) * s + lambda * f * g)
+                .collect(),
+            None => samples[a].clone(),
+        },
+    )
+}
+
+/// Fits the ratio model to stance-axis force samples on `τ_j = j/(N−1)`.
+///
+/// # Arguments
+/// * `samples`: `s_aj` per stance axis (h, p, v), N, all of length `N ≥ 2`;
+/// * `n_st`: stance frames (sets the degree of `f_v`); `mass_kg`, `dt_s`: for the model;
+/// * `leg`: the leg line's slopes `g_h`, `g_p` on the same grid ([`super::leg_line`]),
+///   mixed into the ratio data with weight `opts.leg_line_weight`.
+///
+/// # Errors
+/// A config error for bad options or sample lengths; a numeric error when the QP fails.
+pub fn fit_ratio_with(
+    samples: &[Vec<f64>; 3],
+    n_st: usize,
+    mass_kg: f64,
+    dt_s: f64,
+    targets: Option<&EdgeTargets>,
+    leg: Option<&[Vec<f64>; 2]>,
     opts: &RatioOptions,
 ) -> Result<RatioFit> {
     opts.check()?;
@@ -495,22 +554,9 @@ pub fn fit_ratio(
     let sigma = mass_kg * TRAVEL_TOLERANCE_M / (dt_s * dt_s);
     let imp = |a: usize| targets.map(|t| (moments.as_slice(), t.impulse[a]));
     let travel = |a: usize| targets.map(|t| (double.as_slice(), t.travel_double[a], sigma));
-    let q_h = ratio_fit(
-        &fv,
-        &tau,
-        &samples[0],
-        opts.ratio_degree_h,
-        imp(0),
-        travel(0),
-    );
-    let q_p = ratio_fit(
-        &fv,
-        &tau,
-        &samples[1],
-        opts.ratio_degree_p,
-        imp(1),
-        travel(1),
-    );
+    let data = ratio_data(samples, &fv, leg, opts.leg_line_weight);
+    let q_h = ratio_fit(&fv, &tau, &data[0], opts.ratio_degree_h, imp(0), travel(0));
+    let q_p = ratio_fit(&fv, &tau, &data[1], opts.ratio_degree_p, imp(1), travel(1));
     let axis = |poly: Vec<f64>, s: &[f64]| {
         let mut a = AxisModel {
             poly,

@@ -85,6 +85,8 @@ pub struct FitTable {
     pub vertical_degree: Option<u32>,
     pub ratio_degree_h: Option<u32>,
     pub ratio_degree_p: Option<u32>,
+    pub leg_line_weight: Option<f64>,
+    pub roll_fraction: Option<f64>,
     pub stage_b: Option<bool>,
     pub stage_b_time_refinement: Option<bool>,
     pub max_harmonics: Option<u32>,
@@ -122,6 +124,9 @@ pub struct QueriesTable {
     pub map_heights: Option<String>,
     /// Map columns, `start:stop:step` in m/s (default 0:5:0.05).
     pub map_speeds: Option<String>,
+    /// Keep the clips the queries leave out (copies of another clip's file, clips whose
+    /// time base is wrong); default false.
+    pub keep_left_out: Option<bool>,
 }
 
 /// A pipeline file.
@@ -533,6 +538,8 @@ pub fn resolve_fit(
         o.fit.ratio.ratio_degree_p = deg(f.ratio_degree_p, o.fit.ratio.ratio_degree_p);
         o.fit.max_harmonics = f.max_harmonics.map_or(o.fit.max_harmonics, |v| v as usize);
         o.fit.energy = f.energy.unwrap_or(o.fit.energy);
+        o.fit.ratio.leg_line_weight = f.leg_line_weight.unwrap_or(o.fit.ratio.leg_line_weight);
+        o.fit.ratio.roll_fraction = f.roll_fraction.unwrap_or(o.fit.ratio.roll_fraction);
         o.fit.samples = f.samples.map_or(o.fit.samples, |v| v as usize);
     }
     if let Some(m) = cli_model {

@@ -240,6 +240,25 @@ pub fn policy_request(p: &PoolStance, k: f64) -> Request {
     }
 }
 
+/// The request of a stance under a gait law (docs stance-model §6.8b): the heading speeds
+/// keep their fluctuation about the cycle's mean, scaled by `κ`, about a new mean `u`:
+///
+/// ```text
+/// vs = u + κ (vs₀ − v₀),   ve = u + κ (ve₀ − v₀),   zs, ze, vp, vps as recorded
+/// ```
+///
+/// (`v₀`: the recorded cycle's mean speed, m/s). `x` is the recorded one until the caller
+/// sets it from the period ([`distance_for_period`]). With `κ = u/v₀` this is
+/// [`policy_request`] at `k = u/v₀`.
+pub fn law_request(p: &PoolStance, v_orig: f64, kappa: f64, u: f64) -> Request {
+    let q = &p.params;
+    Request {
+        vs: u + kappa * (q.vs - v_orig),
+        ve: u + kappa * (q.ve - v_orig),
+        ..policy_request(p, 1.0)
+    }
+}
+
 /// One scaled stance of a cycle: the solution and its verdicts.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScaledStance {
@@ -344,6 +363,9 @@ pub struct Timing {
     pub sigma_c: f64,
     /// Step-period scale `σ_T` (each stance's apex-to-apex period is `σ_T T₀`).
     pub sigma_t: f64,
+    /// Speed-fluctuation scale `κ = (v/v₀) σ_c σ_T`: each stance's change of heading speed
+    /// about the cycle's mean scales by it ([`law_request`]); `v/v₀` under the paper's law.
+    pub kappa: f64,
 }
 
 /// Speed ratios `v/v₀` below this are timed as at this ratio: a jog in place keeps a
@@ -360,6 +382,7 @@ impl Timing {
             law: *law,
             sigma_c,
             sigma_t,
+            kappa: v / v_orig * sigma_c * sigma_t,
         }
     }
 }
@@ -423,27 +446,44 @@ pub fn distance_for_period(
     req.ve * t - d * t_td - beta_h * shape.k[0]
 }
 
-/// The distance factor `x̂` of one time-scaled stance for the end-apex time `T`
-/// ([`distance_for_period`] of the `k = 1` request): the request's distance is `k·x̂` when
-/// `vs`, `ve` scale by `k`, so `T` is a root of the master quadratic of
-/// `(k vs₀, k ve₀, k x̂)` for every `k` (A4 is linear in `k`; A3 and A5 do not involve the
-/// heading axis).
-pub fn distance_factor(p: &Prepared, t: f64) -> f64 {
-    distance_for_period(
-        &p.shape,
-        &policy_request(&p.stance, 1.0),
-        &Refs::run(1.0),
-        t,
-    )
+/// A cycle's requests under a gait law ([`law_request`]): each stance's end apex at its
+/// period `T_i`, its distance from the period ([`distance_for_period`]), and the mean level
+/// `u` that makes the cycle's speed `v` exactly:
+///
+/// ```text
+/// x_i(u) = x_i(0) + u T_i      (A4 is affine in u: d = κ (ve₀ − vs₀) and t_TD do not involve it)
+/// u = v − (x_1(0) + x_2(0)) / (T_1 + T_2)      ⇒  Σ x_i / Σ T_i = v
+/// β_h,ref = κ/σ_c              (the heading force's scale, J̃_h = σ_c J_h)
+/// ```
+///
+/// Returns the requests, the references and `u` (m/s).
+pub fn law_requests(
+    timed: [&Prepared; 2],
+    v_orig: f64,
+    speed: f64,
+    timing: &Timing,
+    t_target: [f64; 2],
+) -> ([Request; 2], Refs, f64) {
+    let refs = Refs::run(timing.kappa / timing.sigma_c);
+    let at = |u: f64| {
+        [0, 1].map(|i| {
+            let mut r = law_request(&timed[i].stance, v_orig, timing.kappa, u);
+            r.x = distance_for_period(&timed[i].shape, &r, &refs, t_target[i]);
+            r
+        })
+    };
+    let zero = at(0.0);
+    let u = speed - (zero[0].x + zero[1].x) / (t_target[0] + t_target[1]);
+    (at(u), refs, u)
 }
 
 /// The run policy with time as a degree of freedom, for one cycle of (already
 /// character-scaled) prepared stances.
 ///
 /// ```text
-/// (σ_c, σ_T) from the gait law;  each stance: Δt̃ = σ_c Δt₀, target T_i = σ_T T_i0
-/// k = v Σ T_i / Σ x̂_i(T_i)       (so Σx/ΣT = v exactly)
-/// request_i = (zs, k vs, ze, k ve, vp, vps, k x̂_i)  → solve (root nearest T_i) → check
+/// (σ_c, σ_T, κ) from the gait law;  each stance: Δt̃ = σ_c Δt₀, target T_i = σ_T T_i0
+/// request_i = law_requests (speeds u + κ(v₀ᵢ − v₀), distance from T_i, Σx/ΣT = v exactly)
+///   → solve (root nearest T_i) → check;   k = u / v_orig
 /// ```
 ///
 /// Under [`GaitLaw::PAPER`] this is the paper's policy (`σ = 1`, `k = v/v_orig`, §6.5 rule 3
@@ -473,22 +513,21 @@ pub fn run_at_speed(
         std::borrow::Cow::Owned(t)
     });
     let t_target = cycle.map(|p| timing.sigma_t * p.stance.params.t_e);
-    let x_hat = [0, 1].map(|i| distance_factor(&timed[i], t_target[i]));
-    let k = if paper {
-        speed / v_orig
+    let (requests, refs, k) = if paper {
+        let k = speed / v_orig;
+        (cycle.map(|p| policy_request(&p.stance, k)), Refs::run(k), k)
     } else {
-        speed * (t_target[0] + t_target[1]) / (x_hat[0] + x_hat[1])
+        let (requests, refs, u) =
+            law_requests([&timed[0], &timed[1]], v_orig, speed, &timing, t_target);
+        (requests, refs, u / v_orig)
     };
     let check = |i: usize| {
         let p: &Prepared = &timed[i];
-        let mut req = policy_request(&p.stance, k);
-        if !paper {
-            req.x = k * x_hat[i];
-        }
+        let req = requests[i];
         if !(k.is_finite() && k >= 0.0) {
             return Err(super::solve::Infeasible::InvalidInput);
         }
-        let sol = solve(&p.shape, &req, &Refs::run(k), Some(t_target[i]))?;
+        let sol = solve(&p.shape, &req, &refs, Some(t_target[i]))?;
         Ok(check_solution(p, &req, &sol, lims[i]))
     };
     let mut stances = [check(0), check(1)];

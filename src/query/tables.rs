@@ -182,6 +182,7 @@ pub fn run_table(rows: &[RunRow]) -> PolarsResult<DataFrame> {
         ),
         col("sigma_contact", f(&|r| r.candidate.timing.sigma_c)),
         col("sigma_step", f(&|r| r.candidate.timing.sigma_t)),
+        col("kappa", f(&|r| r.candidate.timing.kappa)),
         col("k", f(&|r| r.candidate.k)),
         lists("contact_time_s", &|s| s.solution.t_lo - s.solution.t_td)?,
         lists("step_period_s", &|s| s.solution.t_e)?,

@@ -9,8 +9,8 @@ use crate::contacts::flight::FlightFit;
 use crate::contacts::timing::EVENT_MAX_SHIFT_S;
 use crate::contacts::EFFECTORS;
 use crate::force_model::{
-    fit_stance, EdgeTargets, FitOptions, FitWorkspace, ForceModelKind, StanceFit, StanceForce,
-    GRAVITY,
+    fit_stance, EdgeTargets, FitOptions, FitWorkspace, ForceModelKind, LegLine, StanceFit,
+    StanceForce, GRAVITY,
 };
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};
 use crate::math::polyfit::{fit as poly_fit, fit_fixed_curvature};
@@ -496,6 +496,31 @@ impl<'a> ClipData<'a> {
         heading(v_heading, facing_td, previous)
     }
 
+    /// The leg line of a running stance on one foot ([`LegLine`]): none for a walking
+    /// stance (its double support shares the force), several effectors, or a foot without
+    /// an ankle.
+    fn leg_line(&self, seg: &Segment) -> Option<LegLine<'_>> {
+        if seg.walking_foot.is_some() {
+            return None;
+        }
+        let support = supporting(seg, &self.fr.contact);
+        let mut used = support
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| **s)
+            .map(|(e, _)| e);
+        let (Some(foot), None) = (used.next(), used.next()) else {
+            return None;
+        };
+        let ankle = self.fr.effector_pos.get(foot)?.as_ref()?;
+        Some(LegLine {
+            time_s: &self.fr.time_s,
+            ankle,
+            toe: self.fr.toe.get(foot)?,
+            com: &self.pos.0,
+        })
+    }
+
     /// The force fit of a stance (§4), with the adjacent flights' edge targets when it has
     /// a ballistic neighbour; a failed note when the fit fails.
     fn fit_force(
@@ -517,6 +542,7 @@ impl<'a> ClipData<'a> {
             dt: dt_s,
             r_s: h.rotation(),
             mass_kg: self.mass_kg,
+            leg: self.leg_line(seg),
         };
         match fit_stance(ws, &force, seg.i1 - seg.i0 + 1, targets.as_ref(), &opts.fit) {
             Ok(fit) => Ok((fit, targets)),

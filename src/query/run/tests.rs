@@ -189,8 +189,11 @@ fn time_scaled_stances_solve_exactly() {
             1e-9
         ));
         // Independent: RK4 with the time-scaled force reaches the requested end apex.
-        let mut req = policy_request(&timed, c.k);
-        req.x = c.k * distance_factor(&Prepared::new(timed.clone()), s.solution.t_e);
+        let both = [&p, &other].map(|x| Prepared::new(x.stance.time_scaled(c.timing.sigma_c)));
+        let t_e = [c.timing.sigma_t * q.t_e; 2];
+        let (req, _, u) = law_requests([&both[0], &both[1]], q.x / q.t_e, v, &c.timing, t_e);
+        assert!(close(u / (q.x / q.t_e), c.k, 1e-12), "k = u/v₀");
+        let req = req[0];
         let end = simulate(&timed.model, &req, &s.solution);
         assert_reaches_end_apex(&end, &req, 1e-6, "time-scaled stance");
     }
@@ -223,17 +226,22 @@ fn the_gait_law_hits_the_speed_and_moves_times_the_way_people_do() {
             continue;
         };
         checked += 1;
-        // Mean speed of each answer: x = k·x̂ per stance over the solved periods.
+        // Mean speed of each answer: the requests' distances over the solved periods (each
+        // request's end apex is the solution's: RK4-checked in
+        // `time_scaled_stances_solve_exactly`).
         for (c, a, b) in [(&slow, s0, s1), (&fast, f0, f1)] {
-            let x: f64 = [0, 1]
-                .iter()
-                .map(|&i| {
-                    let t = Prepared::new(pair[i].stance.time_scaled(c.timing.sigma_c));
-                    c.k * distance_factor(&t, [a, b][i].solution.t_e)
-                })
-                .sum();
-            let v = x / (a.solution.t_e + b.solution.t_e);
+            let t = pair
+                .each_ref()
+                .map(|p| Prepared::new(p.stance.time_scaled(c.timing.sigma_c)));
+            let periods = [a.solution.t_e, b.solution.t_e];
+            let (req, _, _) = law_requests([&t[0], &t[1]], v_orig, c.speed, &c.timing, periods);
+            let v = (req[0].x + req[1].x) / (periods[0] + periods[1]);
             assert!(close(v, c.speed, 1e-9), "mean speed {v} vs {}", c.speed);
+            // The speed change of each stance scales by κ = (v/v₀) σ_c σ_T.
+            for i in 0..2 {
+                let d0 = q[i].ve - q[i].vs;
+                assert!(close(req[i].ve - req[i].vs, c.timing.kappa * d0, 1e-9));
+            }
         }
         assert!(f0.solution.t_lo - f0.solution.t_td < s0.solution.t_lo - s0.solution.t_td);
         assert!(f0.solution.t_e < s0.solution.t_e);
