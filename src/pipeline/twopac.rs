@@ -300,10 +300,9 @@ pub fn plot_data(
         .collect();
     TrajectoryPlot {
         title: format!(
-            "Is the 2PAC COM trajectory dynamically valid? ({} phases, {} transitions, {} windows)",
+            "Is the 2PAC COM trajectory dynamically valid? ({} contact phases, {} transitions)",
             phases.len(),
             p.transitions.len(),
-            p.windows.len()
         ),
         verdict: None,
         contacts,

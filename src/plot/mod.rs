@@ -57,7 +57,7 @@ pub fn write_png(
 
 /// A picture's answer to its question, drawn as the line under its title: dark green when
 /// the answer is good news (feasible, valid, ballistic), dark red when it is not.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Verdict {
     /// The answer in words, with numbers and units.
     pub text: String,
@@ -151,6 +151,15 @@ fn draw_legend<'a, 'b: 'a>(
         .position(SeriesLabelPosition::UpperRight)
         .draw()
         .map_err(|e| err(path, e))
+}
+
+/// A tick label in metres (or any decimal axis): at most three decimals, trailing zeros
+/// dropped, and never `-0` (plotters prints `-0.0` for a tick at a rounded zero).
+fn metre_tick(v: &f64) -> String {
+    let v = if v.abs() < 5e-4 { 0.0 } else { *v };
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
 }
 
 /// The mesh of a value panel: `x_desc` against `y_desc`, no light grid lines, 13 px labels.

@@ -13,6 +13,10 @@
 //!   too fast     c is held at rest, but not with its acceleration; detail: |c̈|, m/s²
 //! ```
 //!
+//! `s*` (N) reads as a pull: the contacts make the wrench only if a friction-cone edge
+//! may carry a force down to `−s*`, i.e. a contact pulls on the ground (or wall) with up
+//! to `s*` newtons.
+//!
 //! # Frames and units
 //!
 //! World frame, Z up; s, m, m/s², N.
@@ -175,8 +179,8 @@ pub fn explain(v: &Validation, failures: &[Failure], phase_names: &[String]) -> 
     let worst = worst.map_or(String::new(), |s| {
         let name = phase_names.get(s.phase).map_or("", String::as_str);
         format!(
-            "; worst s* = {:.1} N at {:.2} s (phase {} [{name}])",
-            s.slack_n, s.t_s, s.phase
+            "; worst at {:.2} s (phase {} [{name}]): a contact would have to pull with s* = {:.1} N",
+            s.t_s, s.phase, s.slack_n
         )
     });
     Some(format!(

@@ -41,7 +41,7 @@
 //!     .unwrap();
 //! let form = EqualityForm::new(&[c], 54.0).unwrap();
 //! let v = form.verdict([0.0, 0.0, 1.0], [0.0; 3]);
-//! assert_eq!(v.status, Status::Ok);
+//! assert_eq!(v.status, Status::Solved);
 //! assert!((v.margin_n.unwrap() - 38.05).abs() < 0.01);
 //! ```
 

@@ -12,7 +12,7 @@ use super::super::Outcome;
 use crate::math::constants::STATIC_TOL;
 use crate::pipeline::twopac_outputs::{run_twopac, TwopacJob, TwopacReport};
 use crate::twopac::transition::QpForm;
-use crate::twopac::validate::Validation;
+use crate::twopac::validate::{Validation, DEFAULT_STEP_S};
 
 /// Run `twopac`.
 ///
@@ -33,20 +33,23 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
     Ok(Outcome::Clean)
 }
 
-/// A validation's verdict in words: `2pac: dynamically valid (321 of 321 samples)` or
-/// `NOT dynamically valid`, with the valid fraction and the largest slack.
+/// A validation's verdict in words: `2PAC curve: dynamically valid at all 591 samples …`
+/// or `NOT dynamically valid (256 of 591 samples valid)`; the reasons follow on a `why:`
+/// line ([`crate::twopac::diagnose::explain`]).
 pub fn validation_line(name: &str, v: &Validation) -> String {
     let n = v.samples.len();
     let n_valid = v.samples.iter().filter(|s| s.valid).count();
-    let verdict = if v.trajectory_valid {
-        "dynamically valid"
+    if v.trajectory_valid {
+        format!(
+            "{name}: dynamically valid at all {n} samples (every {} s, the contacts can make the force and moment its COM needs)",
+            DEFAULT_STEP_S
+        )
     } else {
-        "NOT dynamically valid"
-    };
-    format!(
-        "{name}: {verdict}: {n_valid} of {n} samples valid (point_valid_rate {:.3}), max s* {:.3} N at {:.2} s",
-        v.point_valid_rate, v.max_slack_n, v.worst_t_s
-    )
+        format!(
+            "{name}: NOT dynamically valid ({n_valid} of {n} samples valid, point_valid_rate {:.3})",
+            v.point_valid_rate
+        )
+    }
 }
 
 /// The summary lines on stdout.
@@ -74,8 +77,12 @@ fn print_summary(r: &TwopacReport, job: &TwopacJob) {
         r.planned.plan_s * 1e3
     );
     for (name, v, why) in [
-        ("2pac", &r.planned.v_curve, r.planned.why_curve()),
-        ("quasi-static baseline", &r.planned.v_qs, r.planned.why_qs()),
+        ("2PAC curve", &r.planned.v_curve, r.planned.why_curve()),
+        (
+            "quasi-static baseline (for comparison: it stops at every phase state and transition point)",
+            &r.planned.v_qs,
+            r.planned.why_qs(),
+        ),
     ] {
         crate::say!("  {}", validation_line(name, v));
         if let Some(why) = why {
