@@ -10,7 +10,8 @@
 //! The views are along the path's own direction, not world x (a walk along y would
 //! collapse): `s` is the horizontal direction from the curve's start to its end (or, for
 //! a path that returns to its start, the principal horizontal direction of all points),
-//! `l` the horizontal direction to its left, and `z` up.
+//! `l` the horizontal direction to its left, and `z` up; a direction within 10° of a world
+//! axis is snapped to it ([`SNAP_TO_AXIS_RAD`]).
 
 use std::path::Path;
 
@@ -19,7 +20,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::{err, register_font, titled, PlotError, Verdict};
+use super::{err, metre_tick, register_font, titled, PlotError, Verdict};
 use crate::twopac::diagnose::Cause;
 
 /// One validated sample of the 2PAC curve.
@@ -89,9 +90,28 @@ fn cause_label(c: Cause) -> &'static str {
     }
 }
 
+/// A path direction within this angle of a world axis (±x, ±y) is drawn along that axis,
+/// rad (10°): a walk that ends on one foot, beside its start line, would otherwise show
+/// its square-set feet turned by a few degrees.
+pub const SNAP_TO_AXIS_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
+
+/// `e` turned onto the nearest world axis when it is within [`SNAP_TO_AXIS_RAD`] of it.
+fn snapped(e: [f64; 2]) -> [f64; 2] {
+    let axes = [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]];
+    axes.into_iter()
+        .find(|a| (e[0] * a[0] + e[1] * a[1]).clamp(-1.0, 1.0).acos() <= SNAP_TO_AXIS_RAD)
+        .unwrap_or(e)
+}
+
 /// The unit horizontal direction `e_s` of the path: start to end of the curve, else the
-/// principal horizontal axis of every point, else world x.
+/// principal horizontal axis of every point, else world x; snapped to a world axis within
+/// [`SNAP_TO_AXIS_RAD`].
 pub fn path_direction(d: &TrajectoryPlot) -> [f64; 2] {
+    snapped(raw_path_direction(d))
+}
+
+/// [`path_direction`] before snapping.
+fn raw_path_direction(d: &TrajectoryPlot) -> [f64; 2] {
     let unit = |v: [f64; 2]| {
         let n = v[0].hypot(v[1]);
         (n > 1e-6).then(|| [v[0] / n, v[1] / n])
@@ -215,6 +235,8 @@ fn view(
         .configure_mesh()
         .x_desc("s, along the path (m)")
         .y_desc(y_desc)
+        .x_label_formatter(&metre_tick)
+        .y_label_formatter(&metre_tick)
         .light_line_style(WHITE.mix(0.0))
         .label_style(("sans-serif", 14))
         .draw()
