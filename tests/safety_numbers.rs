@@ -130,7 +130,7 @@ fn twopac_refuses_a_com_of_1e308() {
 #[test]
 fn twopac_refuses_a_duration_of_5e_324() {
     let d = tempfile::tempdir().unwrap();
-    let p = walk_with(d.path(), "\"duration_s\": 0.4", "\"duration_s\": 5e-324");
+    let p = walk_with(d.path(), "\"duration_s\": 0.8", "\"duration_s\": 5e-324");
     let out = d.path().join("tw");
     refused(
         &["twopac", "--phases", &p, "--out", &s(&out)],

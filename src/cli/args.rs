@@ -485,8 +485,9 @@ pub struct RunQueryArgs {
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
-    /// Also draw Table 1 as a figure (PNG): β_h, mu_min and the leg extension against
-    /// speed, with the limits dashed and infeasible speeds marked.
+    /// Also draw Table 1 as a figure (PNG): contact time and step period, peak force,
+    /// mu_min and the leg extension against speed, one colour per cycle, the limits dashed
+    /// and each infeasible speed marked on the panel of the limit it violates.
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// How contact time and step period change with speed: `auto` (the character's own
@@ -586,6 +587,10 @@ pub struct MapJumpsArgs {
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also draw `jump_map_agreement.png`: where the fast filters (paper eq 10, 12) and the
+    /// exact check agree (a developer diagnostic; the IoU is in `jump_map.json` anyway).
+    #[arg(long)]
+    pub diagnostics: bool,
 }
 
 impl MapJumpsArgs {
@@ -872,8 +877,9 @@ pub struct PlotStanceArgs {
     /// `f{x,y,z}_n`; N, the BVH file's axes).
     #[arg(long)]
     pub plates: Option<PathBuf>,
-    /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1].
-    #[arg(long = "active-set", default_value_t = crate::constraints::ACTIVE_FRACTION)]
+    /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1]
+    /// (default: the queries' friction check, whose `mu_req_robust` the plot shows).
+    #[arg(long = "active-set", default_value_t = crate::query::feasibility::DEFAULT_QUERY_ACTIVE_FRACTION)]
     pub active_set: f64,
     /// Output PNG file.
     #[arg(long)]

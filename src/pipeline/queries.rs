@@ -421,6 +421,7 @@ fn run_points(rows: &[RunRow], n_cycles: usize) -> Vec<crate::plot::runs::RunPoi
             };
             crate::plot::runs::RunPoint {
                 cycle: i % n_cycles.max(1),
+                cycle_name: r.stances[0].stance.stance_id.clone(),
                 speed_mps: r.candidate.speed,
                 contact_s: solved
                     .iter()
@@ -455,6 +456,9 @@ pub struct MapQuery {
     pub keep_left_out: bool,
     /// Output folder.
     pub out: PathBuf,
+    /// Also draw `jump_map_agreement.png`, the fast filters against the exact check (a
+    /// developer diagnostic).
+    pub diagnostics: bool,
 }
 
 /// What `map jumps` found.
@@ -552,6 +556,11 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
     )?;
     map_figures(&q.out, &map, &pool)?;
     let pair_answers = pair_answers(&map, &pool, &limits);
+    if q.diagnostics {
+        write_png(&q.out.join(JUMP_MAP_AGREEMENT_PNG), |p| {
+            crate::plot::jump_map_agreement_png(p, &map, "all characters")
+        })?;
+    }
     Ok(MapReport {
         liftoffs: map.liftoffs.len(),
         landings: map.landings.len(),
@@ -617,6 +626,9 @@ fn pair_answers(
     });
     out
 }
+
+/// The `--diagnostics` picture of `map jumps` in its output folder.
+pub const JUMP_MAP_AGREEMENT_PNG: &str = "jump_map_agreement.png";
 
 /// `jump_map.png`, and one `jump_map_<character>.png` each when the pool has several.
 fn map_figures(out: &Path, map: &JumpMap, pool: &[Prepared]) -> anyhow::Result<()> {
@@ -734,6 +746,7 @@ pub fn query_stages(
             limits,
             keep_left_out: q.keep_left_out.unwrap_or(false),
             out: dir.join("jump_map"),
+            diagnostics: false,
         }),
         _ => None,
     };

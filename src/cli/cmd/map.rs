@@ -1,5 +1,6 @@
 //! `stancelib map jumps`: the jump feasibility map of a library (spec stance-model §6.10)
-//! as `jump_map.parquet`, `jump_map_pairs.parquet`, `jump_map.json` and `jump_map.png`.
+//! as `jump_map.parquet`, `jump_map_pairs.parquet`, `jump_map.json` and `jump_map.png`
+//! (with `--diagnostics`, also `jump_map_agreement.png`).
 
 use super::super::args::MapJumpsArgs;
 use super::super::Outcome;
@@ -17,6 +18,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         limits: a.lim.options(),
         keep_left_out: a.keep_left_out,
         out: a.out.clone(),
+        diagnostics: a.diagnostics,
     };
     print_map(&map_jumps(&q)?, &q.out);
     Ok(Outcome::Clean)

@@ -12,6 +12,7 @@ use super::super::Outcome;
 use crate::math::constants::STATIC_TOL;
 use crate::pipeline::twopac_outputs::{run_twopac, TwopacJob, TwopacReport};
 use crate::twopac::transition::QpForm;
+use crate::twopac::validate::{Validation, DEFAULT_STEP_S};
 
 /// Run `twopac`.
 ///
@@ -30,6 +31,25 @@ pub fn run(a: TwopacArgs) -> anyhow::Result<Outcome> {
     let report = run_twopac(&job)?;
     print_summary(&report, &job);
     Ok(Outcome::Clean)
+}
+
+/// A validation's verdict in words: `2PAC curve: dynamically valid at all 591 samples …`
+/// or `NOT dynamically valid (256 of 591 samples valid)`; the reasons follow on a `why:`
+/// line ([`crate::twopac::diagnose::explain`]).
+pub fn validation_line(name: &str, v: &Validation) -> String {
+    let n = v.samples.len();
+    let n_valid = v.samples.iter().filter(|s| s.valid).count();
+    if v.trajectory_valid {
+        format!(
+            "{name}: dynamically valid at all {n} samples (every {} s, the contacts can make the force and moment its COM needs)",
+            DEFAULT_STEP_S
+        )
+    } else {
+        format!(
+            "{name}: NOT dynamically valid ({n_valid} of {n} samples valid, point_valid_rate {:.3})",
+            v.point_valid_rate
+        )
+    }
 }
 
 /// The summary lines on stdout.
@@ -56,18 +76,18 @@ fn print_summary(r: &TwopacReport, job: &TwopacJob) {
         p.windows.len(),
         r.planned.plan_s * 1e3
     );
-    for (name, v) in [
-        ("2pac", &r.planned.v_curve),
-        ("quasi-static", &r.planned.v_qs),
+    for (name, v, why) in [
+        ("2PAC curve", &r.planned.v_curve, r.planned.why_curve()),
+        (
+            "quasi-static baseline (for comparison: it stops at every phase state and transition point)",
+            &r.planned.v_qs,
+            r.planned.why_qs(),
+        ),
     ] {
-        crate::say!(
-            "  {name}: {} samples, point_valid_rate {:.3}, trajectory_valid {}, max s* {:.3} N at {:.2} s",
-            v.samples.len(),
-            v.point_valid_rate,
-            v.trajectory_valid,
-            v.max_slack_n,
-            v.worst_t_s
-        );
+        crate::say!("  {}", validation_line(name, v));
+        if let Some(why) = why {
+            crate::say!("    why: {why}");
+        }
     }
     crate::say!("  → {}", job.out.display());
 }
