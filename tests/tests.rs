@@ -64,6 +64,8 @@
 //!   written schemas; manifest date and command line, query outputs naming their library,
 //!   `info`, negative numbers, `--help` limits, `--quiet` and `--json`.
 //! - `catalogue`: issue 38 item 2 — `list`: characters, run cycles (against `query run`), jumps.
+//! - `duplicates`: issue 38 item 3 — copied clips reported by `info` and answering once;
+//!   clips a query leaves out named, `--keep-left-out`.
 //!
 //! # Safety (issue 11)
 //! - `safety_inputs`: reader and numeric items: SG window bound, no silent NaN, 100k-joint
@@ -128,6 +130,7 @@ mod edit_motion;
 mod analyst;
 mod catalogue;
 mod cli;
+mod duplicates;
 // Safety
 mod safety_inputs;
 mod safety_limits;

@@ -265,7 +265,7 @@ pub enum Command {
     ///
     /// With `--json`, one object: `library`; `characters[]` {`character_id`, `n_clips`,
     /// `clips`, `leg_length_m`, `mass_kg`, `n_stances`}; `run_cycles[]` {`clip`,
-    /// `character_id`, `stance_ids`, `v_orig_mps`, `time_scaled`, `feasible_at_own_speed`
+    /// `character_id`, `stance_ids`, `v_orig_mps`, `time_scaled`, `left_out`, `feasible_at_own_speed`
     /// (null when left out)}; `jumps[]` {`clip`, `character_id`, `liftoff`, `landing`,
     /// `height_m`, `distance_m`}.
     List(ListArgs),
@@ -494,6 +494,10 @@ pub struct RunQueryArgs {
     /// v^-0.42, step period ∝ v^-0.19) or `paper` (every time kept, β_v = 1).
     #[arg(long = "gait-law", default_value = "auto", value_parser = ["auto", "population", "paper"])]
     pub gait_law: String,
+    /// Keep the stances of clips the queries leave out (a copy of another clip's file, or
+    /// a clip whose flights say its time base is wrong); they are named on stderr.
+    #[arg(long = "keep-left-out")]
+    pub keep_left_out: bool,
 }
 
 impl RunQueryArgs {
@@ -526,6 +530,10 @@ pub struct JumpArgs {
     /// Rows printed (the file has every pair).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
+    /// Keep the stances of clips the queries leave out (a copy of another clip's file, or
+    /// a clip whose flights say its time base is wrong); they are named on stderr.
+    #[arg(long = "keep-left-out")]
+    pub keep_left_out: bool,
     /// Limit form and μ (§7.5).
     #[command(flatten)]
     pub lim: LimitArgs,
@@ -546,6 +554,10 @@ pub struct MapJumpsArgs {
     /// Columns: horizontal apex speeds `start:stop:step`, m/s.
     #[arg(long, default_value = crate::query::map::DEFAULT_SPEEDS_ARG)]
     pub speeds: String,
+    /// Keep the stances of clips the queries leave out (a copy of another clip's file, or
+    /// a clip whose flights say its time base is wrong); they are named on stderr.
+    #[arg(long = "keep-left-out")]
+    pub keep_left_out: bool,
     /// Limit form and μ (§7.5).
     #[command(flatten)]
     pub lim: LimitArgs,

@@ -9,11 +9,11 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::provenance::manifest_sha256;
-use super::read::Table;
+use super::read::{same_content, Table};
 use super::schema::{
     clips, errors, stances as S, CLIPS_FILE, ERRORS_FILE, MANIFEST_FILE, STANCES_FILE,
 };
-use crate::error::{Error, Result};
+use crate::error::{echo, Error, Result};
 
 /// Stances beyond a person's bounds listed by the text summary (`--json` lists all).
 pub const BEYOND_BOUNDS_SHOWN: usize = 10;
@@ -60,6 +60,9 @@ pub struct LibraryInfo {
     /// Foot stances beyond what a person's legs do, `(stance_id, why)`
     /// ([`crate::stances::limits::beyond_bounds`]): their characters' limits are capped.
     pub beyond_bounds: Vec<(String, String)>,
+    /// Clips whose file repeats another clip's content (clip, the first clip by name with
+    /// that content): the queries answer with the first only.
+    pub duplicates: Vec<(String, String)>,
 }
 
 impl LibraryInfo {
@@ -106,6 +109,7 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
             clips::CHARACTER_ID,
             clips::CLIP,
             clips::LEG_LENGTH,
+            clips::CONTENT_SHA256,
         ],
     )?;
     let stances = Table::open_columns(
@@ -143,7 +147,34 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
         options: m.get("options").cloned().unwrap_or_default(),
         limits: m.get("limits").cloned().unwrap_or_default(),
         beyond_bounds: beyond_bounds(&clips, &stances)?,
+        duplicates: duplicates(&clips)?,
     })
+}
+
+/// The clips of the library `lib` whose file repeats an earlier clip's content (clip, the
+/// first clip by name with that content).
+///
+/// # Errors
+/// `clips.parquet` missing or unreadable.
+pub fn duplicate_clips(lib: &Path) -> Result<Vec<(String, String)>> {
+    let t = Table::open_columns(&lib.join(CLIPS_FILE), &[clips::CLIP, clips::CONTENT_SHA256])?;
+    duplicates(&t)
+}
+
+/// The clips of `clips_t` whose content repeats an earlier clip's ([`same_content`]).
+fn duplicates(clips_t: &Table) -> Result<Vec<(String, String)>> {
+    let (names, sha) = (
+        clips_t.strings(clips::CLIP)?,
+        clips_t.strings(clips::CONTENT_SHA256)?,
+    );
+    Ok(same_content(
+        names
+            .iter()
+            .map(String::as_str)
+            .zip(sha.iter().map(String::as_str)),
+    )
+    .into_iter()
+    .collect())
 }
 
 /// The foot stances of `stances` beyond a person's bounds (legs from `clips`).
@@ -243,6 +274,23 @@ impl fmt::Display for LibraryInfo {
                     f,
                     "  … {} more (`info --json` lists every one)",
                     self.beyond_bounds.len() - BEYOND_BOUNDS_SHOWN
+                )?;
+            }
+        }
+        if !self.duplicates.is_empty() {
+            writeln!(
+                f,
+                "duplicate clips ({}; same file content, the queries answer with the first):",
+                self.duplicates.len()
+            )?;
+            for (clip, of) in self.duplicates.iter().take(BEYOND_BOUNDS_SHOWN) {
+                writeln!(f, "  {} = {}", echo(clip), echo(of))?;
+            }
+            if self.duplicates.len() > BEYOND_BOUNDS_SHOWN {
+                writeln!(
+                    f,
+                    "  … {} more (`info --json` lists every one)",
+                    self.duplicates.len() - BEYOND_BOUNDS_SHOWN
                 )?;
             }
         }

@@ -275,6 +275,30 @@ pub struct ClipInfo {
     pub leg_m: Option<f64>,
     /// Body mass, kg.
     pub mass_kg: f64,
+    /// SHA-256 of the clip file's bytes, hex (empty when the file was not read).
+    pub content_sha256: String,
+}
+
+/// Clips whose file content (SHA-256) repeats an earlier clip's, each mapped to the first
+/// clip by name with that content; empty hashes (files never read) are not compared.
+pub fn same_content<'a>(
+    clips: impl IntoIterator<Item = (&'a str, &'a str)>,
+) -> BTreeMap<String, String> {
+    let mut sorted: Vec<(&str, &str)> = clips.into_iter().filter(|(_, h)| !h.is_empty()).collect();
+    sorted.sort();
+    let mut first: BTreeMap<&str, &str> = BTreeMap::new();
+    let mut out = BTreeMap::new();
+    for (name, hash) in sorted {
+        match first.get(hash) {
+            Some(of) => {
+                out.insert(name.to_string(), of.to_string());
+            }
+            None => {
+                first.insert(hash, name);
+            }
+        }
+    }
+    out
 }
 
 /// A library folder as the queries see it.
@@ -300,6 +324,7 @@ pub fn read_clip_info(path: &Path) -> Result<BTreeMap<String, ClipInfo>> {
         t.opt_f64(clips::LEG_LENGTH)?,
         t.opt_f64(clips::MASS)?,
     );
+    let sha = t.strings(clips::CONTENT_SHA256)?;
     Ok(names
         .into_iter()
         .enumerate()
@@ -308,6 +333,7 @@ pub fn read_clip_info(path: &Path) -> Result<BTreeMap<String, ClipInfo>> {
                 s_eff: s_eff[i],
                 leg_m: leg[i],
                 mass_kg: mass[i].unwrap_or(f64::NAN),
+                content_sha256: sha[i].clone(),
             };
             (n, info)
         })

@@ -39,7 +39,7 @@ use crate::math::stats::median;
 use crate::query::feasibility::{LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::gait::{GaitLaw, LawChoice};
 use crate::query::jump::{is_landing, is_liftoff, recorded_jump};
-use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
+use crate::query::limits::{absolute_limits, left_out_clips, stance_limits, time_scaled};
 use crate::query::pool::Prepared;
 use crate::query::run::{character_laws, run_at_speed, run_cycles, RunCycle};
 
@@ -75,6 +75,9 @@ pub struct CatalogueCycle {
     /// The clip's time base is wrong (`s_eff` outside the accepted range): `query run`
     /// leaves the cycle out.
     pub time_scaled: bool,
+    /// Why `query run` leaves the cycle out (its clip's time base, or a copy of another
+    /// clip's file), `None` when it answers.
+    pub left_out: Option<String>,
     /// Feasible at its own speed under the default `query run` (`None` when left out).
     pub feasible_at_own_speed: Option<bool>,
 }
@@ -192,15 +195,20 @@ fn characters(
 fn cycles(lib: &StanceLibrary) -> Vec<CatalogueCycle> {
     let active = DEFAULT_QUERY_ACTIVE_FRACTION;
     let all = run_cycles(&lib.stances);
-    let left_out = |c: &RunCycle| time_scaled(lib, &lib.stances[c.stances[0]].clip);
-    let kept: Vec<RunCycle> = all.iter().filter(|c| !left_out(c)).copied().collect();
+    let left = left_out_clips(lib);
+    let left_out = |c: &RunCycle| left.get(&lib.stances[c.stances[0]].clip);
+    let kept: Vec<RunCycle> = all
+        .iter()
+        .filter(|c| left_out(c).is_none())
+        .copied()
+        .collect();
     let limits: BTreeMap<String, Limits> = absolute_limits(lib);
     let laws = character_laws(&lib.stances, &kept, LawChoice::Auto);
     all.par_iter()
         .map(|c| {
             let [a, b] = c.stances.map(|i| &lib.stances[i]);
             let skip = left_out(c);
-            let feasible = (!skip).then(|| {
+            let feasible = skip.is_none().then(|| {
                 let prep = c
                     .stances
                     .map(|i| Prepared::with_active_fraction(lib.stances[i].clone(), active));
@@ -218,7 +226,8 @@ fn cycles(lib: &StanceLibrary) -> Vec<CatalogueCycle> {
                 character_id: a.character_id.clone(),
                 stance_ids: [a.stance_id.clone(), b.stance_id.clone()],
                 v_orig_mps: c.v_orig,
-                time_scaled: skip,
+                time_scaled: time_scaled(lib, &a.clip),
+                left_out: skip.map(ToString::to_string),
                 feasible_at_own_speed: feasible,
             }
         })

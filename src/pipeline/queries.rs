@@ -20,7 +20,9 @@ use crate::library::write::write_atomic;
 use crate::plot::{jump_map_png, write_png};
 use crate::query::feasibility::{check_mu, LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::gait::{GaitLaw, LawChoice};
-use crate::query::limits::{absolute_limits, stance_limits, time_scaled};
+use crate::query::limits::{
+    absolute_limits, left_out_clips, left_out_line, stance_limits, LeftOut,
+};
 use crate::query::map::{check_grid, jump_map, Axis, JumpMap, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};
 use crate::query::pairs::ranked_jump_pairs;
 use crate::query::pool::Prepared;
@@ -29,7 +31,6 @@ use crate::query::run::{
     run_cycles, scale_limits, RunCycle, ScaledStance,
 };
 use crate::query::tables::{jump_map_table, jump_pairs_table, jump_table, run_table, RunRow};
-use crate::stances::limits::S_EFF_RANGE;
 
 /// The limit options of a query (§7.5), as given: each `None` takes the query's default.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -98,6 +99,49 @@ pub fn load_pool(
     Ok((library, pool))
 }
 
+/// Prints (stderr) which clips a query left out and why ([`left_out_line`]): the clips of
+/// `dropped` (one per dropped item, repeats allowed), `count` items of kind `what`.
+fn report_left_out<'a>(
+    command: &str,
+    count: usize,
+    what: &str,
+    left: &BTreeMap<String, LeftOut>,
+    dropped: impl Iterator<Item = &'a String>,
+) {
+    let clips: std::collections::BTreeSet<&String> = dropped.collect();
+    let named: Vec<(&String, &LeftOut)> = clips
+        .into_iter()
+        .filter_map(|c| left.get_key_value(c))
+        .collect();
+    if let Some(line) = left_out_line(command, count, what, &named) {
+        eprintln!("{line}");
+    }
+}
+
+/// The pool without the stances of left-out clips (unless `keep`), with the report line.
+fn pool_without_left_out(
+    command: &str,
+    lib: &StanceLibrary,
+    pool: Vec<Prepared>,
+    keep: bool,
+) -> Vec<Prepared> {
+    if keep {
+        return pool;
+    }
+    let left = left_out_clips(lib);
+    let (kept, dropped): (Vec<Prepared>, Vec<Prepared>) = pool
+        .into_iter()
+        .partition(|p| !left.contains_key(&p.stance.clip));
+    report_left_out(
+        command,
+        dropped.len(),
+        "stance(s)",
+        &left,
+        dropped.iter().map(|p| &p.stance.clip),
+    );
+    kept
+}
+
 /// Writes `df` to the file `out` atomically (parent folder created).
 ///
 /// # Errors
@@ -151,6 +195,8 @@ pub struct RunQuery {
     pub png: Option<PathBuf>,
     /// How contact time and step period change with speed.
     pub gait_law: LawChoice,
+    /// Keep the clips the queries leave out ([`left_out_clips`]).
+    pub keep_left_out: bool,
 }
 
 /// One printed line of `query run`: a cycle at one speed (its first stance's values).
@@ -208,17 +254,22 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
     let active = q.limits.active_fraction()?;
     let (lib, pool) = load_pool(&q.lib, active)?;
     let all = run_cycles(&lib.stances);
+    let left = if q.keep_left_out {
+        BTreeMap::new()
+    } else {
+        left_out_clips(&lib)
+    };
+    let clip_of = |c: &RunCycle| &lib.stances[c.stances[0]].clip;
     let (cycles, skipped): (Vec<RunCycle>, Vec<RunCycle>) = all
         .into_iter()
-        .partition(|c| !time_scaled(&lib, &lib.stances[c.stances[0]].clip));
-    if !skipped.is_empty() {
-        eprintln!(
-            "query run: {} cycle(s) left out: their clip's s_eff lies outside [{}, {}]",
-            skipped.len(),
-            S_EFF_RANGE.0,
-            S_EFF_RANGE.1
-        );
-    }
+        .partition(|c| !left.contains_key(clip_of(c)));
+    report_left_out(
+        "query run",
+        skipped.len(),
+        "cycle(s)",
+        &left,
+        skipped.iter().map(clip_of),
+    );
     check_sweep("--speeds", cycles.len(), q.speeds.len())?;
     // Absolute limits of the target character: the source character's, scaled by §9.
     let limits: BTreeMap<String, Limits> = absolute_limits(&lib)
@@ -376,6 +427,8 @@ pub struct MapQuery {
     pub speeds: Vec<f64>,
     /// Limit options (default form: relative).
     pub limits: LimitOptions,
+    /// Keep the clips the queries leave out ([`left_out_clips`]).
+    pub keep_left_out: bool,
     /// Output folder.
     pub out: PathBuf,
 }
@@ -415,6 +468,7 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
     let (form, mu) = q.limits.form(LimitForm::Absolute)?;
     let active = q.limits.active_fraction()?;
     let (lib, pool) = load_pool(&q.lib, active)?;
+    let pool = pool_without_left_out("map jumps", &lib, pool, q.keep_left_out);
     let absolute = absolute_limits(&lib);
     let limits = |p: &Prepared| stance_limits(p, form, &absolute, mu);
     let t0 = Instant::now();
@@ -568,6 +622,7 @@ pub fn query_stages(
             out: dir.join("runs.parquet"),
             png: None,
             gait_law: gait_law_choice(q.gait_law.as_deref())?,
+            keep_left_out: q.keep_left_out.unwrap_or(false),
         }),
         None => None,
     };
@@ -577,6 +632,7 @@ pub fn query_stages(
             heights: axis_or("--heights", q.map_heights.as_deref(), DEFAULT_HEIGHTS)?,
             speeds: axis_or("--speeds", q.map_speeds.as_deref(), DEFAULT_SPEEDS)?,
             limits,
+            keep_left_out: q.keep_left_out.unwrap_or(false),
             out: dir.join("jump_map"),
         }),
         _ => None,
@@ -617,6 +673,8 @@ pub struct JumpQuery {
     pub distance_m: f64,
     /// Limit options (default form: relative).
     pub limits: LimitOptions,
+    /// Keep the clips the queries leave out ([`left_out_clips`]).
+    pub keep_left_out: bool,
     /// Output Parquet file.
     pub out: PathBuf,
 }
@@ -652,6 +710,7 @@ pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
     let (form, mu) = q.limits.form(LimitForm::Absolute)?;
     let active = q.limits.active_fraction()?;
     let (lib, pool) = load_pool(&q.lib, active)?;
+    let pool = pool_without_left_out("query jump", &lib, pool, q.keep_left_out);
     let absolute = absolute_limits(&lib);
     let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);
     let rows = ranked_jump_pairs(&pool, q.height_m, q.distance_m, lim);

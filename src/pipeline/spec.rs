@@ -124,6 +124,9 @@ pub struct QueriesTable {
     pub map_heights: Option<String>,
     /// Map columns, `start:stop:step` in m/s (default 0:5:0.05).
     pub map_speeds: Option<String>,
+    /// Keep the clips the queries leave out (copies of another clip's file, clips whose
+    /// time base is wrong); default false.
+    pub keep_left_out: Option<bool>,
 }
 
 /// A pipeline file.

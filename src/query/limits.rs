@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 
 use super::feasibility::{relative_limits, LimitForm, Limits};
 use super::pool::Prepared;
-use crate::library::read::StanceLibrary;
+use crate::library::read::{same_content, StanceLibrary};
 use crate::stances::limits::{limits, ClipFacts, StanceFacts, S_EFF_RANGE};
 use crate::stances::segment::Boundary;
 
@@ -101,4 +101,77 @@ pub fn time_scaled(lib: &StanceLibrary, clip: &str) -> bool {
         .get(clip)
         .and_then(|c| c.s_eff)
         .is_some_and(|s| !(S_EFF_RANGE.0..=S_EFF_RANGE.1).contains(&s))
+}
+
+/// Why a clip's stances are left out of the queries (`--keep-left-out` keeps them).
+#[derive(Debug, Clone, PartialEq)]
+pub enum LeftOut {
+    /// Its flights say its time base is wrong: `s_eff` outside [`S_EFF_RANGE`].
+    TimeBase(f64),
+    /// The same file content (SHA-256) as the named clip, first by name, which answers for
+    /// both: a copy would enter every answer twice.
+    Duplicate(String),
+}
+
+impl std::fmt::Display for LeftOut {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LeftOut::TimeBase(s) => write!(
+                f,
+                "time base wrong (s_eff {s:.3} outside [{}, {}])",
+                S_EFF_RANGE.0, S_EFF_RANGE.1
+            ),
+            LeftOut::Duplicate(of) => write!(f, "same content as {}", crate::error::echo(of)),
+        }
+    }
+}
+
+/// The clips whose stances the queries leave out, and why ([`LeftOut`]); a clip both
+/// copied and mistimed is named for its copy.
+pub fn left_out_clips(lib: &StanceLibrary) -> BTreeMap<String, LeftOut> {
+    let copies = same_content(
+        lib.clips
+            .iter()
+            .map(|(n, c)| (n.as_str(), c.content_sha256.as_str())),
+    );
+    let mut out: BTreeMap<String, LeftOut> = copies
+        .into_iter()
+        .map(|(c, of)| (c, LeftOut::Duplicate(of)))
+        .collect();
+    for name in lib.clips.keys() {
+        if !out.contains_key(name) && time_scaled(lib, name) {
+            let s = lib.clips[name].s_eff.unwrap_or(f64::NAN);
+            out.insert(name.clone(), LeftOut::TimeBase(s));
+        }
+    }
+    out
+}
+
+/// Most clips one "left out" line names; the rest are counted.
+pub const LEFT_OUT_NAMED: usize = 10;
+
+/// The line that names the left-out clips of a query (`what`: "cycle(s)", …, with their
+/// count), or `None` when nothing is left out.
+pub fn left_out_line(
+    command: &str,
+    count: usize,
+    what: &str,
+    clips: &[(&String, &LeftOut)],
+) -> Option<String> {
+    if clips.is_empty() {
+        return None;
+    }
+    let mut named: Vec<String> = clips
+        .iter()
+        .take(LEFT_OUT_NAMED)
+        .map(|(c, why)| format!("{} ({why})", crate::error::echo(c)))
+        .collect();
+    if clips.len() > LEFT_OUT_NAMED {
+        named.push(format!("and {} more", clips.len() - LEFT_OUT_NAMED));
+    }
+    Some(format!(
+        "{command}: {count} {what} of {} clip(s) left out: {}; --keep-left-out keeps them",
+        clips.len(),
+        named.join(", ")
+    ))
 }

@@ -75,6 +75,28 @@ pub fn report_build(report: &BuildSummary, out: &Path, plan: &BuildPlan) -> Outc
     let mut summary = super::frames::summary(&report.records, out, "build");
     summary["stances_rebuilt"] = report.stances.into();
     summary["clips_reused"] = reused.into();
+    // A library that cannot be read back here has said why already (the build's own
+    // errors); the duplicates are then not reported.
+    let duplicates = crate::library::info::duplicate_clips(out).unwrap_or_default();
+    if !duplicates.is_empty() {
+        let named: Vec<String> = duplicates
+            .iter()
+            .take(crate::query::limits::LEFT_OUT_NAMED)
+            .map(|(c, of)| format!("{} = {}", crate::error::echo(c), crate::error::echo(of)))
+            .collect();
+        eprintln!(
+            "warning: {} duplicate clip(s), the same file content as another (the queries \
+             answer with the first by name): {}{}",
+            duplicates.len(),
+            named.join(", "),
+            if duplicates.len() > named.len() {
+                ", … (`info` lists them)"
+            } else {
+                ""
+            }
+        );
+    }
+    summary["duplicates"] = duplicates.len().into();
     crate::cli::summary_json(&summary);
     if (reused > 0 || plan.shard.is_some()) && outcome == Outcome::AllFailed {
         return Outcome::SomeFailed;

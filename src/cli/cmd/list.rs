@@ -11,7 +11,6 @@ use anyhow::Context;
 use super::super::args::ListArgs;
 use super::super::Outcome;
 use crate::pipeline::catalogue::{read_catalogue, Catalogue};
-use crate::stances::limits::S_EFF_RANGE;
 
 /// Clip names shown per character in the text (`--json` lists all).
 pub const CLIPS_SHOWN: usize = 3;
@@ -88,8 +87,8 @@ pub fn print_catalogue(cat: &Catalogue) {
             Some(true) => "yes".to_string(),
             Some(false) => "no".to_string(),
             None => format!(
-                "left out: clip time base wrong (s_eff outside [{}, {}])",
-                S_EFF_RANGE.0, S_EFF_RANGE.1
+                "left out: {}",
+                c.left_out.as_deref().unwrap_or("by query run")
             ),
         };
         crate::say!(

@@ -15,6 +15,7 @@ pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
         heights: a.heights()?.values(),
         speeds: a.speeds()?.values(),
         limits: a.lim.options(),
+        keep_left_out: a.keep_left_out,
         out: a.out.clone(),
     };
     print_map(&map_jumps(&q)?, &q.out);

@@ -24,6 +24,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
         png: a.png.clone(),
         gait_law: crate::pipeline::queries::gait_law_choice(Some(&a.gait_law))
             .context("--gait-law")?,
+        keep_left_out: a.keep_left_out,
     };
     print_run(&run_query(&q)?, &q.out);
     Ok(Outcome::Clean)
@@ -88,6 +89,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         height_m: a.height,
         distance_m: a.distance,
         limits: a.lim.options(),
+        keep_left_out: a.keep_left_out,
         out: a.out,
     };
     let lines = jump_query(&q)?;
