@@ -1,41 +1,55 @@
-//! Landings of feet without a toe tip of their own: found from the foot's own motion, where
-//! the ground arrests the ankle's descent.
+//! Landings of feet without a toe tip of their own: which foot lands from the foot's own
+//! motion, when from the COM's deceleration (or, without it, the ankle's arrest).
 //!
 //! # Model
 //! ```text
-//! estimated toe ⇔ max_k Δ(k) − min_k Δ(k) ≤ 1 mm,   Δ(k) = z_toe(k) − z_ankle(k)
-//!                 (the ingest's fallback toe tip, spec com-from-bvh §4.3, is a fixed offset
-//!                 ahead of and below the ankle: it never pitches with the foot)
-//! a_A(k), v_A(k): SG vertical acceleration and velocity of the ankle (the COM's window, §6)
-//! landing of such a foot's contact run a..b (a ≥ 1; sub-frame touchdown t_TD):
-//!   the latest k in [a − 0.1 s, a], after the foot's previous run, with
-//!     a_A(k−1) ≤ 0.75 g < a_A(k)      (the descent is arrested)
-//!     v_A(k) < 0                        (still descending)
-//!     h_on < h_A(k) ≤ 0.15 m·L_leg/0.84 (the ankle above the height rule's enter height,
-//!                                        raised by a foot landing toe first)
-//!   t_L = t[k−1] + dt·(0.75 g − a_A(k−1))/(a_A(k) − a_A(k−1));  used when t_L < t_TD:
-//!   the run starts at frame k and its touchdown is t_L
+//! estimated toe tip: the ingest's fallback (spec com-from-bvh §4.3), a fixed offset ahead of
+//!                    and below the ankle that never pitches with the foot
+//! a_A(k), v_A(k): SG vertical acceleration (m/s²) and velocity (m/s) of that foot's ankle
+//! h_A(k):         the ankle's height above its own floor (§7.1), m
+//! L(k) = a_z(k) + g: the COM's lift (SG vertical COM acceleration), m/s²
+//! near(k) ⇔ v_A(k) < 0 ∧ h_on < h_A(k) ≤ 0.15 m·L_leg/0.84
+//!           (coming down, above the height rule's enter height, no higher than a pointed
+//!            foot lifts its ankle)
+//! landing of such a foot's contact run a..b (a ≥ 1, touchdown t_TD; height rule or
+//! speed-led), looking back no further than the foot's previous run:
+//!   COM cue:   the latest k ∈ [a − 0.2 s, a] with L(k−1) < g/2 ≤ L(k), a_A(k) > 0, near(k)
+//!              t_L = t[k−1] + dt·(g/2 − L(k−1))/(L(k) − L(k−1))
+//!   else ankle cue: the latest k ∈ [a − 0.1 s, a] with a_A(k−1) ≤ 0.75 g < a_A(k), near(k)
+//!              t_L = t[k−1] + dt·(0.75 g − a_A(k−1))/(a_A(k) − a_A(k−1))
+//!   used when t_L < t_TD: the run starts at frame k and its touchdown is t_L
 //! ```
 //! A foot that lands toe first leaves its ankle 6–15 cm above the floor until the heel comes
 //! down. With a real toe tip the height rule (spec §7.3) sees the toe arrive; with the
 //! fallback toe tip, which keeps a fixed height below the ankle, it sees only the heel, two
-//! to eight frames (up to 70 ms) after the COM has started to decelerate. The foot's own
-//! motion shows the landing: the ground stops its descent. Heel strikes are unchanged (their
-//! ankle is below the enter height when it is arrested, and the height rule is earlier).
+//! to ten frames late (CMU 131_03's hop: 84 ms), or never when the ankle stays up (a
+//! held-out standing jump: ankles 6–9 cm above the floor), and then the speed-led rule of
+//! [`super::support`] finds the landing only where the feet have slowed, 90–130 ms after
+//! the body started to land. The landing foot carries the body: when the COM's lift rises
+//! through half the weight while this foot comes down near its floor and slows, that is its
+//! touchdown. Where the COM shows no landing (the other foot is already down: a step, not
+//! a landing from a flight) the ground's arrest of the ankle times it. Heel strikes are
+//! unchanged: their ankle is below the enter height, and the height rule is earlier. This
+//! is the one place the COM moves a contact edge (com-from-bvh §7.6 rejects it for feet
+//! with their own toe tip), and only earlier.
 //!
 //! # Why these numbers
-//! 0.75 g: on the force-plate drop jump rewritten without End Sites and toe joints (100 Hz,
-//! both landings, both feet) the arrest time is within −5.6, +6.9, −1.6 and −0.2 ms of the
-//! plates' first 20 N (mean |error| 3.6 ms); g was up to 49 ms late (one foot's arrest
-//! ramps slowly through it), 0.5 g up to 8 ms early. 0.1 s: the lost part of a landing
-//! (the held-out jumps: up to 70 ms) with room, yet short of a jump's apex. 0.15 m: the
-//! height a pointed foot lifts the ankle (the detector's bound on a foot point's own floor,
-//! [`super::floor::FOOT_FLOOR_MAX_ABOVE_GROUND`]). 1 mm: a captured toe joint moves by
-//! centimetres relative to its ankle; the fallback by round-off.
+//! g/2: the SG acceleration is a symmetric weighted mean of the true one, so a force step
+//! crosses half its height at the step; on the force-plate drop jump rewritten without End
+//! Sites and toe joints (100 Hz) the COM cue is −7.2 / −6.8 ms (first landing, left /
+//! right) and +2.7 / −7.2 ms (second) from the plates' first 20 N; a lift of g − 3 m/s²
+//! (the flight tolerance) crossed 28 ms early. a_A > 0: the landing foot itself slows; one
+//! still swinging down is not the foot that lands. 0.75 g: the same clip's ankle arrest is
+//! within −5.6, +6.9, −1.6 and −0.2 ms of the plates (g: up to 49 ms late, 0.5 g up to 8 ms
+//! early). 0.1 s: the lost part of a landing (up to 70 ms) with room, yet short of a jump's
+//! apex. 0.2 s: a landing the speed-led rule found where the feet slowed (CMU 01_01 with
+//! its landings lost: 134 ms after the COM); the lift cannot cross g/2 upwards at an apex,
+//! where it is near zero. 0.15 m: the height a pointed foot lifts the ankle (the detector's
+//! bound on a foot point's own floor, [`super::floor::FOOT_FLOOR_MAX_ABOVE_GROUND`]).
 //!
 //! # References
 //! `docs/com-from-bvh.md` §7.10 (the rule and the held-out jumps); spec com-from-bvh §4.3,
-//! §6, §7.3.
+//! §6, §7.3; test `held_out_jumps`.
 
 use super::floor::FOOT_FLOOR_MAX_ABOVE_GROUND;
 use super::timeline::{ContactTimeline, ContactTracks};
@@ -43,36 +57,41 @@ use super::{runs, ClipMotion, ContactRun, EFFECTORS};
 use crate::math::constants::GRAVITY;
 use crate::math::savgol::{SavGol, DEFAULT_ORDER};
 
-/// A toe point whose height relative to its ankle varies by at most this over the clip is
-/// the ingest's estimate, not a point of the foot, m.
-pub const RIGID_TOE_TOL_M: f64 = 0.001;
 /// The ankle's upward SG acceleration at which its descent counts as arrested by the
 /// ground, m/s² (0.75 g).
 pub const LANDING_ARREST_MPS2: f64 = 0.75 * GRAVITY;
+/// The COM's lift `a_z + g` (SG) at which a landing body counts as held, m/s² (g/2: half
+/// its weight carried).
+pub const LANDING_COM_LIFT_MPS2: f64 = 0.5 * GRAVITY;
 /// Farthest before the height rule's touchdown frame a landing is looked for, s.
 pub const LANDING_MAX_LEAD_S: f64 = 0.1;
+/// Farthest before the first frame of a run (height rule or speed-led) a landing timed by
+/// the COM is looked for, s.
+pub const LANDING_MAX_LEAD_COM_S: f64 = 0.2;
 
 /// One landing found from the foot's own motion (indices into the clip's kept frames).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Landing {
     /// Effector index (into [`EFFECTORS`]): a foot.
     pub effector: usize,
-    /// First frame of the run as the height rule found it.
+    /// First frame of the run as found before (height rule or speed-led).
     pub detected_first: usize,
     /// First frame from the foot's motion (`≤ detected_first`).
     pub first: usize,
     /// Sub-frame touchdown, clip time, s.
     pub t_s: f64,
+    /// What timed it.
+    pub cue: LandingCue,
 }
 
-/// The toe point carries no information of its own: its height keeps a fixed offset from
-/// the ankle's (within [`RIGID_TOE_TOL_M`]).
-pub fn toe_is_estimated(ankle_z: &[f64], toe_z: &[f64]) -> bool {
-    let d = ankle_z.iter().zip(toe_z).map(|(a, t)| t - a);
-    let (lo, hi) = d.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-        (lo.min(x), hi.max(x))
-    });
-    hi.is_finite() && lo.is_finite() && hi - lo <= RIGID_TOE_TOL_M
+/// What timed a landing found from the foot's motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LandingCue {
+    /// The COM's lift reached [`LANDING_COM_LIFT_MPS2`] while this foot came down near
+    /// its floor and slowed.
+    Com,
+    /// The ankle's upward acceleration reached [`LANDING_ARREST_MPS2`].
+    Ankle,
 }
 
 /// Upward crossing time of `level` between frames `k − 1` and `k`, s.
@@ -81,7 +100,8 @@ fn crossing(t: &[f64], a: &[f64], k: usize, level: f64) -> f64 {
 }
 
 /// The landings of the feet whose toe tip is estimated (see the module docs); `runs_out`
-/// holds the runs as the height rule found them, `foot_h_on` is its enter height (m).
+/// holds the clip's contact runs as found so far, `foot_h_on` is the height rule's enter
+/// height (m).
 pub fn find(
     tracks: &ContactTracks,
     timeline: &ContactTimeline,
@@ -93,51 +113,82 @@ pub fn find(
         return Vec::new();
     };
     let t = motion.time_s;
-    let lead = (LANDING_MAX_LEAD_S / motion.dt + 1e-9).floor() as usize;
+    let lead = |s: f64| (s / motion.dt + 1e-9).floor() as usize;
     let h_max = FOOT_FLOOR_MAX_ABOVE_GROUND * tracks.leg_scale;
     let skip = motion.frame.first().copied().unwrap_or(0);
+    // The COM's lift a_z + g per kept frame (none when the lengths disagree).
+    let lift: Vec<f64> = match motion.com_az.len() == motion.time_s.len() {
+        true => motion.com_az.iter().map(|a| a + GRAVITY).collect(),
+        false => Vec::new(),
+    };
     let mut out = Vec::new();
-    for e in 0..2 {
+    for (e, foot) in EFFECTORS.iter().enumerate().take(2) {
         let (points, track) = (&tracks.points[e], &tracks.tracks[e]);
-        if points.len() < 2 || track.is_empty() {
+        if points.is_empty() || track.is_empty() {
             continue;
         }
-        let z = |p: usize| -> Vec<f64> { points[p].iter().map(|q| q[2]).collect() };
-        let ankle_z = z(0);
-        if !toe_is_estimated(&ankle_z, &z(1)) {
+        if !tracks.toe_estimated[e] {
             continue;
         }
-        let (v, a) = (sg.apply(&ankle_z, 1, motion.dt), sg.apply(&ankle_z, 2, motion.dt));
+        let ankle_z: Vec<f64> = points[0].iter().map(|q| q[2]).collect();
+        let (v, a) = (
+            sg.apply(&ankle_z, 1, motion.dt),
+            sg.apply(&ankle_z, 2, motion.dt),
+        );
         if a.len() != ankle_z.len() {
             continue; // shorter than the SG window
         }
         let h = &track[0].h;
         let mut prev_end = 0;
         for (first, last) in runs(&timeline.contact[e]) {
-            let lo = prev_end.max(first.saturating_sub(lead)).max(1);
-            prev_end = last + 1;
-            let td = runs_out
+            let run = runs_out
                 .iter()
-                .find(|r| r.effector == EFFECTORS[e] && r.first_frame == skip + first as i64)
-                .and_then(|r| r.td_time_s);
-            let (Some(td), true) = (td, first >= 1) else {
+                .find(|r| r.effector == *foot && r.first_frame == skip + first as i64);
+            let lo = |lead_s: f64| prev_end.max(first.saturating_sub(lead(lead_s))).max(1);
+            let (lo_com, lo) = (lo(LANDING_MAX_LEAD_COM_S), lo(LANDING_MAX_LEAD_S));
+            prev_end = last + 1;
+            let (Some(td), true) = (run.and_then(|r| r.td_time_s), first >= 1) else {
                 continue;
             };
-            let arrest = (lo..=first).rev().find(|&k| {
-                a[k - 1] <= LANDING_ARREST_MPS2
-                    && a[k] > LANDING_ARREST_MPS2
-                    && v[k] < 0.0
-                    && h[k] > foot_h_on
-                    && h[k] <= h_max
-            });
-            if let Some(k) = arrest {
-                let t_s = crossing(t, &a, k, LANDING_ARREST_MPS2);
+            let near_floor = |k: usize| v[k] < 0.0 && h[k] > foot_h_on && h[k] <= h_max;
+            // The body's landing, when this foot is the one coming down onto the floor.
+            let held = (lo_com..=first)
+                .rev()
+                .filter(|&k| k < lift.len())
+                .find(|&k| {
+                    lift[k - 1] < LANDING_COM_LIFT_MPS2
+                        && lift[k] >= LANDING_COM_LIFT_MPS2
+                        && a[k] > 0.0
+                        && near_floor(k)
+                });
+            // Else the foot's own arrest.
+            let arrest = || {
+                (lo..=first).rev().find(|&k| {
+                    a[k - 1] <= LANDING_ARREST_MPS2 && a[k] > LANDING_ARREST_MPS2 && near_floor(k)
+                })
+            };
+            let found = match held {
+                Some(k) => Some((
+                    k,
+                    crossing(t, &lift, k, LANDING_COM_LIFT_MPS2),
+                    LandingCue::Com,
+                )),
+                None => arrest().map(|k| {
+                    (
+                        k,
+                        crossing(t, &a, k, LANDING_ARREST_MPS2),
+                        LandingCue::Ankle,
+                    )
+                }),
+            };
+            if let Some((k, t_s, cue)) = found {
                 if t_s < td {
                     out.push(Landing {
                         effector: e,
                         detected_first: first,
                         first: k,
                         t_s,
+                        cue,
                     });
                 }
             }
@@ -162,29 +213,14 @@ mod tests {
     use super::*;
     use crate::contacts::detect::PointTrack;
 
-    #[test]
-    fn a_fixed_toe_offset_is_an_estimate_and_a_pitching_toe_is_not() {
-        let ankle: Vec<f64> = (0..50).map(|k| 0.08 + 0.1 * (k as f64 * 0.2).sin()).collect();
-        let rigid: Vec<f64> = ankle.iter().map(|a| a - 0.07).collect();
-        let pitching: Vec<f64> = ankle
-            .iter()
-            .enumerate()
-            .map(|(k, a)| a - 0.07 + 0.03 * (k as f64 * 0.3).cos())
-            .collect();
-        assert!(toe_is_estimated(&ankle, &rigid));
-        assert!(!toe_is_estimated(&ankle, &pitching));
-    }
-
     /// An ankle that falls at 2 m/s and is stopped by the ground from `t0` (constant
-    /// deceleration 40 m/s² for 50 ms), 12 cm above its floor: a toe-first landing.
-    #[test]
-    fn a_toe_first_landing_starts_where_the_ankle_is_arrested() {
-        let dt = 1.0 / 120.0;
-        let n = 120;
+    /// deceleration 40 m/s² for 50 ms), 12 cm above its floor: a toe-first landing that the
+    /// height rule sees 8 frames late. `com_az`: the COM's SG vertical acceleration.
+    fn toe_first_landing(com_az: Vec<f64>, toe_estimated: bool) -> Vec<Landing> {
+        let (dt, n) = (1.0 / 120.0, 120);
         let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
-        let t0 = 60.5 * dt;
         let z_of = |tt: f64| -> f64 {
-            let s = tt - t0;
+            let s = tt - T0;
             if s < 0.0 {
                 0.12 - 2.0 * s
             } else if s < 0.05 {
@@ -196,8 +232,8 @@ mod tests {
         let ankle: Vec<[f64; 3]> = t.iter().map(|&tt| [0.0, 0.0, z_of(tt)]).collect();
         let toe: Vec<[f64; 3]> = ankle.iter().map(|p| [0.19, 0.0, p[2] - 0.07]).collect();
         let h: Vec<f64> = ankle.iter().map(|p| p[2] - 0.07).collect();
-        let track = |h: &[f64]| PointTrack {
-            h: h.to_vec(),
+        let track = || PointTrack {
+            h: h.clone(),
             v: vec![0.0; n],
         };
         let mut tracks = ContactTracks {
@@ -206,10 +242,10 @@ mod tests {
             points: Default::default(),
             dt,
             leg_scale: 1.0,
+            toe_estimated: [toe_estimated, false],
         };
-        tracks.tracks[0] = vec![track(&h), track(&h)];
+        tracks.tracks[0] = vec![track(), track()];
         tracks.points[0] = vec![ankle, toe];
-        // The height rule sees the heel down 8 frames late.
         let mut contact: [Vec<bool>; 4] = std::array::from_fn(|_| vec![false; n]);
         contact[0][69..].iter_mut().for_each(|c| *c = true);
         let timeline = ContactTimeline {
@@ -220,8 +256,7 @@ mod tests {
             landing_s: std::array::from_fn(|_| vec![None; n]),
         };
         let frame: Vec<i64> = (0..n as i64).collect();
-        let zero = vec![0.0; n];
-        let com = vec![[0.0; 3]; n];
+        let (zero, com) = (vec![0.0; n], vec![[0.0; 3]; n]);
         let facing = vec![[1.0, 0.0, 0.0]; n];
         let motion = ClipMotion {
             frame: &frame,
@@ -229,7 +264,7 @@ mod tests {
             dt,
             com: &com,
             com_vz: &zero,
-            com_az: &zero,
+            com_az: &com_az,
             facing: &facing,
         };
         let run = ContactRun {
@@ -247,16 +282,43 @@ mod tests {
             yaw_rad: 0.0,
             normal: [0.0, 0.0, 1.0],
         };
-        let runs_out = [run];
-        let found = find(&tracks, &timeline, &motion, &runs_out, 0.04);
+        find(&tracks, &timeline, &motion, &[run], 0.04)
+    }
+
+    /// The ground's first touch, s (frame 60.5 at 120 Hz).
+    const T0: f64 = 60.5 / 120.0;
+
+    #[test]
+    fn a_toe_first_landing_starts_where_the_ankle_is_arrested() {
+        // No flight before it (the COM held all along): the ankle cue.
+        let found = toe_first_landing(vec![0.0; 120], true);
         assert_eq!(found.len(), 1, "{found:?}");
         // The SG acceleration ramps over its window (±0.05 s): a 40 m/s² step crosses
         // 0.75 g before the step, by less than the half-window (measured 2.4 frames).
         let l = found[0];
-        assert!(l.t_s <= t0 && l.t_s > t0 - 0.05, "{l:?} t0 {t0}");
+        assert_eq!(l.cue, LandingCue::Ankle);
+        assert!(l.t_s <= T0 && l.t_s > T0 - 0.05, "{l:?} t0 {T0}");
         assert!(l.first < 61 && l.detected_first == 69, "{l:?}");
-        // The same foot with a toe tip that pitches on its own is left to the height rule.
-        tracks.points[0][1][65][2] += 0.02;
-        assert!(find(&tracks, &timeline, &motion, &runs_out, 0.04).is_empty());
+        // A foot with a toe tip of its own is left to the height rule.
+        assert!(toe_first_landing(vec![0.0; 120], false).is_empty());
+    }
+
+    #[test]
+    fn a_landing_from_a_flight_starts_where_the_com_is_half_held() {
+        // The COM falls freely, then its lift ramps at 2 g per frame from frame 58 (the SG
+        // smoothing leads the touchdown by up to its half-window): it crosses g/2 a quarter
+        // of a frame after frame 58.
+        let com_az: Vec<f64> = (0..120)
+            .map(|k| -GRAVITY + (2.0 * GRAVITY * (k as f64 - 58.0)).clamp(0.0, 2.0 * GRAVITY))
+            .collect();
+        let found = toe_first_landing(com_az, true);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let l = found[0];
+        assert_eq!(
+            (l.cue, l.first, l.detected_first),
+            (LandingCue::Com, 59, 69)
+        );
+        // Exact for a linear ramp: t[58] + dt/4.
+        assert!((l.t_s - 58.25 / 120.0).abs() < 1e-12, "{l:?}");
     }
 }

@@ -80,12 +80,10 @@ pub fn runs_and_flights(
     let mut runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
     let mut warnings = Vec::new();
     if opts.support_check {
-        let landings = landing::find(tracks, timeline, motion, &runs_out, opts.foot.h_on);
-        if !landings.is_empty() {
-            landing::apply(timeline, &landings);
-            runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
-        }
+        find_landings(tracks, timeline, motion, opts, &mut runs_out);
         warnings = support::cross_check(tracks, timeline, motion, opts, &mut runs_out);
+        // Again for the speed-led runs: a landing the height rule lost entirely.
+        find_landings(tracks, timeline, motion, opts, &mut runs_out);
         open_hidden_flights(tracks, timeline, motion, opts, &mut runs_out);
     }
     let flights = flight::flights(&timeline.contact, &runs_out, motion);
@@ -101,6 +99,22 @@ pub fn runs_and_flights(
         runs: runs_out,
         flights,
         warnings,
+    }
+}
+
+/// The landings of feet with an estimated toe tip ([`landing`]): each found starts its run
+/// earlier, and `runs_out` is collected again.
+fn find_landings(
+    tracks: &ContactTracks,
+    timeline: &mut ContactTimeline,
+    motion: &ClipMotion,
+    opts: &ContactOptions,
+    runs_out: &mut Vec<ContactRun>,
+) {
+    let landings = landing::find(tracks, timeline, motion, runs_out, opts.foot.h_on);
+    if !landings.is_empty() {
+        landing::apply(timeline, &landings);
+        *runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
     }
 }
 

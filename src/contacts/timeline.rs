@@ -32,6 +32,9 @@ pub struct EffectorPoints {
     pub feet: [[Vec<V3>; 2]; 2],
     /// Wrist centre and MET3 of the left and right hand; `None` without that arm.
     pub hands: [Option<[Vec<V3>; 2]>; 2],
+    /// Per foot: its toe tip is the ingest's fallback estimate (spec com-from-bvh §4.3), a
+    /// fixed offset from the ankle that never pitches with the foot.
+    pub toe_estimated: [bool; 2],
 }
 
 /// What the detector sees of a clip: the local floor and, per effector
@@ -49,6 +52,8 @@ pub struct ContactTracks {
     pub dt: f64,
     /// `L_leg / NOMINAL_LEG_M`: the scale of the clearances and height bounds.
     pub leg_scale: f64,
+    /// Per foot: its toe tip is estimated ([`EffectorPoints::toe_estimated`]).
+    pub toe_estimated: [bool; 2],
 }
 
 impl ContactTracks {
@@ -93,6 +98,7 @@ pub fn tracks(pts: EffectorPoints, leg_m: f64, dt: f64, opts: &ContactOptions) -
     };
     let mut tracks: [Vec<PointTrack>; 4] = Default::default();
     let mut points: [Vec<Vec<V3>>; 4] = Default::default();
+    let toe_estimated = pts.toe_estimated;
     let [feet_l, feet_r] = pts.feet;
     for (k, [ankle, toe]) in [feet_l, feet_r].into_iter().enumerate() {
         let foot = |p: &[V3], clearance: f64| {
@@ -124,6 +130,7 @@ pub fn tracks(pts: EffectorPoints, leg_m: f64, dt: f64, opts: &ContactOptions) -
         points,
         dt,
         leg_scale: sc,
+        toe_estimated,
     }
 }
 
