@@ -15,6 +15,9 @@
 //! - `invariance`: translating and turning a real clip moves its COM alike, contacts unchanged.
 //! - `contacts_physics`: sub-frame contact events against the plates, no non-ballistic
 //!   no-contact interval on real clips, a stance on a platform, a skeleton without a head.
+//! - `held_out_jumps`: issue 39 item 4 — real jumps rewritten Z-up, in inches, without End
+//!   Sites or toe joints: landings within a frame of the COM's deceleration and the plates,
+//!   no contact at an apex, flights within 3 m/s² of −g.
 //! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 //!
@@ -110,6 +113,7 @@ mod props;
 mod contacts_physics;
 mod fixtures;
 mod forceplate;
+mod held_out_jumps;
 mod invariance;
 mod multicontact;
 mod real_data;

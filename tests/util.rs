@@ -235,6 +235,29 @@ pub struct ForcePlateClip {
     pub bvh: stancelib::bvh::Bvh,
 }
 
+/// Every `.bvh` under `dir` (recursively), sorted.
+pub fn bvh_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display())) {
+            let p = e.expect("dir entry").path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "bvh") {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The shared clips whose time base is wrong (`data/bvh/SOURCES.md`: the backflip plays
+/// about 2× too fast, the fast run 15–25 % too fast): their flights are not ballistic at
+/// the file's clock, whatever the contacts.
+pub const TIME_SCALED_CLIPS: [&str; 2] = ["mass_backflip.bvh", "mass_run_fast.bvh"];
+
 /// Load one force-plate clip (panics with the file name on a malformed input: test data).
 pub fn forceplate_clip(data: &Path, clip: &str) -> ForcePlateClip {
     let dir = data.join("forceplate").join(clip);
