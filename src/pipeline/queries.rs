@@ -494,7 +494,7 @@ pub struct PairAnswer {
     pub feasible_cells: usize,
     /// Cells of the grid.
     pub cells: usize,
-    /// The recorded jump: `None` feasible, else why not ([`JumpRow::explain`]).
+    /// The recorded jump: `None` feasible, else why not ([`crate::query::tables::JumpRow::explain`]).
     pub recorded: Option<String>,
     /// The recorded jump with its apex [`HIGHER_BY`] times as high, same distance.
     pub higher: Option<String>,
