@@ -66,6 +66,8 @@
 //! - `catalogue`: issue 38 item 2 — `list`: characters, run cycles (against `query run`), jumps.
 //! - `duplicates`: issue 38 item 3 — copied clips reported by `info` and answering once;
 //!   clips a query leaves out named, `--keep-left-out`.
+//! - `pictures`: issue 38 item 5 — every picture kind written by its command of
+//!   `docs/pictures.md`, its example there, small.
 //!
 //! # Safety (issue 11)
 //! - `safety_inputs`: reader and numeric items: SG window bound, no silent NaN, 100k-joint
@@ -131,6 +133,7 @@ mod analyst;
 mod catalogue;
 mod cli;
 mod duplicates;
+mod pictures;
 // Safety
 mod safety_inputs;
 mod safety_limits;

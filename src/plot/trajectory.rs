@@ -433,6 +433,7 @@ fn slack_strip(
         .configure_mesh()
         .x_desc("time (s)")
         .y_desc("s* (N)")
+        .y_label_formatter(&tick_label)
         .light_line_style(WHITE.mix(0.0))
         .label_style(("sans-serif", 13))
         .draw()
