@@ -161,3 +161,20 @@ fn issue38_item5_every_picture_kind_is_written_by_its_command() {
         );
     }
 }
+
+// See: issue 38 (brief item 3) — `query run --help` listed three quantities for a picture
+// of four panels; it now names the panels the picture draws.
+#[test]
+fn issue38_item5_query_run_help_names_the_panels_of_its_picture() {
+    let help = crate::util::ok(&["query", "run", "--help"]);
+    let n = stancelib::plot::runs::N_PANELS;
+    assert_eq!(n, 4);
+    assert!(help.contains("four panels"), "{help}");
+    for (k, letter) in ["(a)", "(b)", "(c)", "(d)"].iter().enumerate().take(n) {
+        assert!(
+            help.contains(letter),
+            "panel {k} {letter} not named:\n{help}"
+        );
+    }
+    assert!(!help.contains("(e)"), "{help}");
+}

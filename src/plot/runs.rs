@@ -66,8 +66,9 @@ const PALETTE: [RGBColor; 8] = [
 pub const RUNS_PLOT_PX: (u32, u32) = (1100, 1450);
 /// Height of the legend row under the title, px.
 const LEGEND_ROW_PX: u32 = 60;
-/// Panels of the figure, in order: (a) times, (b) peak force, (c) friction, (d) extension.
-const N_PANELS: usize = 4;
+/// Panels of the figure, in order: (a) times, (b) peak force, (c) friction, (d) extension
+/// (`query run --help` names them).
+pub const N_PANELS: usize = 4;
 
 /// The panel that shows the limit a violation names (`<stance_id>: friction`): (b) for
 /// `force`, (c) for `friction`, (d) for `extension_min`/`extension_max`, (a) for anything
