@@ -502,6 +502,11 @@ pub struct RunQueryArgs {
     /// a clip whose flights say its time base is wrong); they are named on stderr.
     #[arg(long = "keep-left-out")]
     pub keep_left_out: bool,
+    /// Print one answer in full: the cycle whose first stance is this id (at each speed),
+    /// with its gait-law times and, per stance, its scaling and every limit with value,
+    /// limit and margin.
+    #[arg(long, value_name = "STANCE_ID")]
+    pub explain: Option<String>,
 }
 
 impl RunQueryArgs {
@@ -524,13 +529,30 @@ pub struct JumpArgs {
     /// Library folder.
     #[arg(long)]
     pub lib: PathBuf,
-    /// Flight apex height above the liftoff contact, m.
-    #[arg(long, allow_hyphen_values = true)]
-    pub height: f64,
+    /// Flight apex height above the liftoff contact, m (the same for every pair).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        required_unless_present = "height_scale"
+    )]
+    pub height: Option<f64>,
+    /// Each pair's own recorded apex height times this (e.g. 1.1: 10 % higher than
+    /// recorded), instead of `--height`.
+    #[arg(long = "height-scale", conflicts_with = "height")]
+    pub height_scale: Option<f64>,
     /// Jump distance (liftoff start apex to landing end apex, along the heading), m;
-    /// negative is backwards.
+    /// negative is backwards. Needed with `--height`.
     #[arg(long, allow_hyphen_values = true)]
-    pub distance: f64,
+    pub distance: Option<f64>,
+    /// Each pair's own recorded distance times this, instead of `--distance` (default 1
+    /// with `--height-scale`: the recorded distance).
+    #[arg(long = "distance-scale", conflicts_with = "distance")]
+    pub distance_scale: Option<f64>,
+    /// Print one answer in full: a rank of the printed table, or a stance id (the
+    /// best-ranked pair with that liftoff or landing), with the flight and, per side, its
+    /// scaling and every limit with value, limit and margin.
+    #[arg(long, value_name = "RANK|STANCE_ID")]
+    pub explain: Option<String>,
     /// Rows printed (the file has every pair).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
@@ -606,6 +628,10 @@ pub struct BodyArgs {
     /// Body mass in kg (default: body file, else 70).
     #[arg(long)]
     pub mass: Option<f64>,
+    /// Per-clip body masses: a CSV table `clip,mass_kg[,sex]` (clip name or glob; the first
+    /// matching row wins, over --mass). A clip without a mass gets 70 kg and a warning.
+    #[arg(long)]
+    pub masses: Option<PathBuf>,
     /// File unit: m, cm, mm, in, cmu, or metres per file unit (default: detected).
     #[arg(long)]
     pub unit: Option<String>,
@@ -647,12 +673,11 @@ impl BodyArgs {
     /// [`max_threads`](crate::pipeline::batch::max_threads).
     pub fn overrides(&self) -> anyhow::Result<Overrides> {
         crate::pipeline::batch::check_threads("--threads", self.threads)?;
-        let mass_kg = match self.mass {
-            Some(m) if !(m.is_finite() && m > 0.0) => {
-                anyhow::bail!("--mass must be a positive number of kg, found {m}")
-            }
-            m => m,
-        };
+        if let Some(m) = self.mass {
+            crate::ingest::masses::check_body_mass(m)
+                .map_err(|e| anyhow::anyhow!("--mass: {e}"))?;
+        }
+        let mass_kg = self.mass;
         let unit_m = match &self.unit {
             Some(u) => Some(parse_unit(u).ok_or_else(|| {
                 anyhow::anyhow!("--unit: '{u}' is not m, cm, mm, in, cmu or a positive number")
@@ -667,6 +692,7 @@ impl BodyArgs {
             static_contacts: self.static_contacts,
             no_hands: self.no_hands,
             joints: self.joints,
+            masses: self.masses.clone(),
         })
     }
 }

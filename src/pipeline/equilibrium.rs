@@ -27,7 +27,7 @@ use crate::library::write::write_atomic;
 use crate::plot::write_png;
 use crate::twopac::contact::{contact_points, min_mu, ContactPoint};
 use crate::twopac::equilibrium::{EqualityForm, Status, Verdict, MAX_COM_STATES};
-use crate::twopac::phases::parse_contacts;
+use crate::twopac::phases::{parse_contacts, within, MAX_ACC_MPS2, MAX_COORDINATE_M};
 use crate::twopac::region::{static_region, RegionOptions, RegionStatus, StaticRegion};
 
 /// An `equilibrium` job.
@@ -114,14 +114,31 @@ fn read_points(path: &Path) -> anyhow::Result<ComStates> {
             .map(|i| [cols[0][i], cols[1][i], cols[2][i]])
             .collect())
     };
-    Ok((xyz(POSITION, false)?, xyz(ACCELERATION, true)?))
+    let (com, acc) = (xyz(POSITION, false)?, xyz(ACCELERATION, true)?);
+    for (rows, max, limit, unit) in [
+        (&com, MAX_COORDINATE_M, "MAX_COORDINATE_M", "m"),
+        (&acc, MAX_ACC_MPS2, "MAX_ACC_MPS2", "m/s²"),
+    ] {
+        if let Some((i, v)) = rows
+            .iter()
+            .enumerate()
+            .find_map(|(i, r)| r.iter().find(|c| !within(**c, max)).map(|c| (i, *c)))
+        {
+            anyhow::bail!(
+                "{}: row {i}: value {v} is beyond ±{max} {unit} ({limit})",
+                path.display()
+            );
+        }
+    }
+    Ok((com, acc))
 }
 
 /// Runs an `equilibrium` job.
 ///
 /// # Errors
 /// An unreadable or invalid contacts file, an unreadable points table or one without
-/// `x_m`, `y_m`, `z_m` (float64, no nulls), an unwritable output.
+/// `x_m`, `y_m`, `z_m` (float64, no nulls) or with a value beyond its bound
+/// (`MAX_COORDINATE_M`, `MAX_ACC_MPS2`), an unwritable output.
 pub fn run_equilibrium(job: &EquilibriumJob) -> anyhow::Result<EquilibriumReport> {
     let start = Instant::now();
     let text = read_side_text(&job.contacts, SideInput::Contacts)?;
