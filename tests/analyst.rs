@@ -897,9 +897,12 @@ fn query_run_png_draws_table_1_beside_the_table() {
         "stancelib query run --lib out/demo --speeds 0:6:1 --out q/runs.parquet --png q/runs.png",
     );
     assert_eq!(code, 0, "{out}{err}");
-    // Four panels since issue 37 (times, peak force, friction, extension) and a legend row
-    // naming each cycle's colour since issue 38.
-    assert_eq!(png_size(&demo.dir.path().join("q/runs.png")), (1100, 1450));
+    // Four panels since issue 37 (times, peak force, friction, extension), under the
+    // legend row of issue 38.
+    assert_eq!(
+        png_size(&demo.dir.path().join("q/runs.png")),
+        stancelib::plot::runs::RUNS_PLOT_PX
+    );
     assert!(demo.dir.path().join("q/runs.parquet").is_file());
 }
 

@@ -73,6 +73,8 @@
 //!   clips a query leaves out named, `--keep-left-out`.
 //! - `masses`: issue 38 item 4 — `--masses` (and the pipeline key): a mass per clip in
 //!   `clips.parquet` and `info`, the default mass a warning, bad tables refused.
+//! - `pictures`: issue 38 item 5 — every picture kind written by its command of
+//!   `docs/pictures.md`, its example there, small.
 //!
 //! # Safety (issue 11)
 //! - `safety_inputs`: reader and numeric items: SG window bound, no silent NaN, 100k-joint
@@ -144,6 +146,7 @@ mod catalogue;
 mod cli;
 mod duplicates;
 mod masses;
+mod pictures;
 mod verdicts;
 // Safety
 mod safety_inputs;

@@ -582,6 +582,8 @@ fn issue38_item7_bundled_twopac_examples_pass_their_own_validation() {
             "{}:\n{printed}",
             path.display()
         );
+        // A valid curve says how much room it leaves (the walk: none, on the feet's edge).
+        assert!(printed.contains("smallest robustness margin"), "{printed}");
         let v = Table::open(&out.join("validation.parquet")).unwrap();
         assert_eq!(v.strings("trajectory").unwrap()[0], "2pac");
         assert!(v.bools("trajectory_valid").unwrap()[0], "{printed}");

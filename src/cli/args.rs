@@ -485,9 +485,12 @@ pub struct RunQueryArgs {
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
-    /// Also draw Table 1 as a figure (PNG): contact time and step period, peak force,
-    /// mu_min and the leg extension against speed, one colour per cycle, the limits dashed
-    /// and each infeasible speed marked on the panel of the limit it violates.
+    /// Also draw Table 1 as a figure (PNG) of four panels against the target speed: (a)
+    /// each stance's contact time and step period, (b) the cycle's peak force against
+    /// F_max, (c) the friction it needs, mu_min, against μ, (d) the leg extension extremes
+    /// against χ_min and χ_max; one colour and marker per cycle, the limits dashed, each
+    /// infeasible speed marked on the panel of the limit it violates, and under the title
+    /// the speeds at which every cycle is feasible.
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// How contact time and step period change with speed: `auto` (the character's own

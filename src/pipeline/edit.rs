@@ -145,7 +145,7 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
         }),
     )?;
     let title = format!(
-        "edit run: {:.2} m/s, cycle {first}, {} cycles",
+        "Can cycle {first} run at {:.2} m/s? The edited run ({} cycles)",
         e.run.speed_mps, e.cycles
     );
     finish(t, edit, kv, title)
@@ -194,7 +194,9 @@ pub fn edit_jump(e: &JumpEdit) -> anyhow::Result<EditReport> {
             "limits": limits.form.name(), "mu": limits.mu, "active_set": limits.active,
         }),
     )?;
-    let title = format!("edit jump: apex {h:.2} m, distance {d:.2} m, {ids}");
+    // A jump in place printed "distance -0.00 m", which read as backwards.
+    let d_shown = if d.abs() < 0.005 { 0.0 } else { d };
+    let title = format!("Can {ids} jump {h:.2} m high, {d_shown:.2} m far? The edited jump");
     finish(t, edit, kv, title)
 }
 

@@ -343,7 +343,7 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
     if let Some(png) = &q.png {
         let points = run_points(&rows, scaled.len());
         let title = format!(
-            "query run: {} cycle(s), limits {}, gait law {}{}",
+            "At which speeds can the run cycles run? ({} cycle(s), limits {}, gait law {}{})",
             scaled.len(),
             form.name(),
             q.gait_law.name(),

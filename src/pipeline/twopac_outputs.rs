@@ -135,6 +135,8 @@ pub struct Planned {
     pub fail_qs: Vec<Failure>,
     /// The effectors of each phase (`left_foot+right_foot`), to name phases in words.
     pub phase_names: Vec<String>,
+    /// Body mass, kg.
+    pub mass_kg: f64,
     /// Samples of the 2PAC curve.
     pub curve_rows: Vec<TrajectoryRow>,
     /// Samples of the baseline.
@@ -194,6 +196,7 @@ pub fn plan_phases(
         fail_curve,
         fail_qs,
         phase_names: phase_names(phases),
+        mass_kg: file.mass_kg,
         curve_rows,
         qs_rows,
         timings,
@@ -235,6 +238,18 @@ impl Planned {
             )
         };
         Verdict::new(format!("{}; {qs}", v.text), v.ok)
+    }
+
+    /// The 2PAC curve's smallest robustness margin (N, §8.2, with each sample's own
+    /// acceleration), its time (s) and phase: how far the COM stays from the edge of
+    /// what the contacts can hold (≈ 0: it runs along the edge of the support). `None`
+    /// without a finite margin (force closure, infeasible samples).
+    pub fn smallest_margin(&self) -> Option<(f64, f64, usize)> {
+        self.curve_rows
+            .iter()
+            .filter_map(|r| r.verdict.margin_n.map(|m| (m, r.t_s, r.phase)))
+            .filter(|(m, _, _)| m.is_finite())
+            .min_by(|a, b| a.0.total_cmp(&b.0))
     }
 
     /// Why the quasi-static baseline fails its validation, in words (`None` when valid).

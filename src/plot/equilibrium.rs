@@ -22,7 +22,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{draw_legend, err, metre_tick, register_font, titled, PlotError, Verdict};
+use super::{draw_legend, err, register_font, tick_label, titled, PlotError, Verdict};
 
 /// Cells per axis of the slice.
 pub const DEFAULT_SLICE_CELLS: usize = 80;
@@ -129,8 +129,8 @@ pub fn equilibrium_png(path: &Path, d: &EquilibriumPlot) -> Result<(), PlotError
         .configure_mesh()
         .x_desc("x (m)")
         .y_desc("y (m)")
-        .x_label_formatter(&metre_tick)
-        .y_label_formatter(&metre_tick)
+        .x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
         .light_line_style(WHITE.mix(0.0))
         .label_style(("sans-serif", 13))
         .draw()

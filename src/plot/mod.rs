@@ -153,16 +153,17 @@ fn draw_legend<'a, 'b: 'a>(
         .map_err(|e| err(path, e))
 }
 
-/// A tick label in metres (or any decimal axis): at most three decimals, trailing zeros
-/// dropped, and never `-0` (plotters prints `-0.0` for a tick at a rounded zero).
-fn metre_tick(v: &f64) -> String {
+/// A tick label of a decimal axis: at most three decimals, trailing zeros dropped
+/// (`2400`, not `2400.0`), and never `-0` (plotters prints `-0.0` at a rounded zero).
+fn tick_label(v: &f64) -> String {
     let v = if v.abs() < 5e-4 { 0.0 } else { *v };
     let s = format!("{v:.3}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     s.to_string()
 }
 
-/// The mesh of a value panel: `x_desc` against `y_desc`, no light grid lines, 13 px labels.
+/// The mesh of a value panel: `x_desc` against `y_desc`, no light grid lines, 13 px labels
+/// ([`tick_label`]).
 fn value_mesh(
     chart: &mut Chart<'_, '_>,
     path: &Path,
@@ -173,54 +174,96 @@ fn value_mesh(
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
+        .x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
         .light_line_style(WHITE.mix(0.0))
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| err(path, e))
 }
 
-/// Per (distance bin, height row): pairs feasible by both, approx only, exact only.
+/// Per (distance bin, height row): the pairs with a cell there feasible by both, approx
+/// only, exact only; the pairs with any cell there; the pairs feasible there (exact).
 struct Binned {
     d0: f64,
     width: f64,
     n_d: usize,
-    cells: Vec<[u32; 3]>,
+    cells: Vec<[u32; 5]>,
     max_exact: u32,
 }
 
+/// The distance bins of a map, at least `width` wide, wider when the grid's speeds are
+/// farther apart than that: a cell's distance is `d = u · D + C` (per pair and height
+/// row), so consecutive speeds land `Δu · |D|` apart, and bins narrower than that left
+/// empty stripes inside the feasible area that read as "no pair makes this jump". The
+/// spacing is taken over the rows that have a feasible cell (other rows' `|D|` reach
+/// 66 s on the demo, where the stance times stretch with speed), rounded up to a
+/// multiple of `width`, and capped at [`MAX_BIN_WIDENING`] × `width`.
 fn bin(map: &JumpMap, width: f64) -> Option<Binned> {
     let n_u = map.speeds.len();
+    let du = map
+        .speeds
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
+    let mut spread = 0.0f64;
+    for p in &map.pairs {
+        for (r, row) in p.rows.iter().enumerate() {
+            let feasible = (0..n_u).any(|q| p.approx[r * n_u + q] || p.exact[r * n_u + q]);
+            if let (Some((d, _, _)), true) = (row, feasible) {
+                if (d.abs() * du).is_finite() {
+                    spread = spread.max(d.abs() * du);
+                }
+            }
+        }
+    }
+    let widening = (spread / width - 1e-9).ceil().clamp(1.0, MAX_BIN_WIDENING);
+    let width = width * widening;
     let mut range = (f64::INFINITY, f64::NEG_INFINITY);
-    let each = |f: &mut dyn FnMut(usize, f64, bool, bool)| {
-        for p in &map.pairs {
+    let each = |f: &mut dyn FnMut(usize, usize, f64, bool, bool)| {
+        for (i, p) in map.pairs.iter().enumerate() {
             for (r, row) in p.rows.iter().enumerate() {
                 let Some((d, c, _)) = row else { continue };
                 for (q, &u) in map.speeds.iter().enumerate() {
                     let (a, e) = (p.approx[r * n_u + q], p.exact[r * n_u + q]);
-                    if a || e {
-                        f(r, u * d + c, a, e);
-                    }
+                    f(i, r, u * d + c, a, e);
                 }
             }
         }
     };
-    each(&mut |_, d, _, _| range = (range.0.min(d), range.1.max(d)));
+    each(&mut |_, _, d, a, e| {
+        if a || e {
+            range = (range.0.min(d), range.1.max(d));
+        }
+    });
     if !range.0.is_finite() {
         return None;
     }
     let d0 = (range.0 / width).floor() * width;
     let n_d = ((range.1 - d0) / width).floor() as usize + 1;
-    let mut cells = vec![[0u32; 3]; n_d * map.heights.len()];
-    each(&mut |r, d, a, e| {
-        let k = (((d - d0) / width) as usize).min(n_d - 1);
-        let kind = match (a, e) {
-            (true, true) => 0,
-            (true, false) => 1,
-            _ => 2,
+    // Each pair counts once per bin and kind, however many of its speeds land there.
+    let mut cells = vec![[0u32; 5]; n_d * map.heights.len()];
+    let mut counted = vec![[usize::MAX; 5]; cells.len()];
+    each(&mut |i, r, d, a, e| {
+        let k = (d - d0) / width;
+        if !(k >= 0.0 && k < n_d as f64) {
+            return;
+        }
+        let at = r * n_d + k as usize;
+        let kinds: &[usize] = match (a, e) {
+            (true, true) => &[0, 3, 4],
+            (true, false) => &[1, 3],
+            (false, true) => &[2, 3, 4],
+            (false, false) => &[3],
         };
-        cells[r * n_d + k][kind] += 1;
+        for &kind in kinds {
+            if counted[at][kind] != i {
+                counted[at][kind] = i;
+                cells[at][kind] += 1;
+            }
+        }
     });
-    let max_exact = cells.iter().map(|c| c[0] + c[2]).max().unwrap_or(0);
+    let max_exact = cells.iter().map(|c| c[4]).max().unwrap_or(0);
     Some(Binned {
         d0,
         width,
@@ -235,8 +278,11 @@ type Chart<'a, 'b> =
 
 /// Pixel size of `jump_map.png` (and of the `--diagnostics` agreement picture).
 pub const JUMP_MAP_PX: (u32, u32) = (1100, 760);
-/// Width of a distance bin of the jump map, m.
+/// Narrowest distance bin of the jump map, m (wider when the speeds are coarser, see `bin`).
 pub const JUMP_MAP_BIN_M: f64 = 0.05;
+/// Most a distance bin is widened beyond [`JUMP_MAP_BIN_M`] to close the gaps between
+/// the distances of consecutive speeds (factor).
+pub const MAX_BIN_WIDENING: f64 = 4.0;
 /// Most shades the jump map's legend lists (more pair counts share shades).
 const MAX_LEGEND_SHADES: u32 = 6;
 
@@ -301,7 +347,7 @@ fn recorded_counts(
         });
         match cell {
             None => counts.1 += 1,
-            Some(c) if c[0] + c[2] == 0 => {
+            Some(c) if c[4] == 0 => {
                 counts.0 += 1;
                 counts.2 += 1;
             }
@@ -325,7 +371,7 @@ pub fn jump_map_verdict(map: &JumpMap, recorded: &[(f64, f64)]) -> Verdict {
     let feasible = b.as_ref().map(|b| {
         let mut top = (f64::NEG_INFINITY, f64::NEG_INFINITY);
         for (i, c) in b.cells.iter().enumerate() {
-            if c[0] + c[2] > 0 {
+            if c[4] > 0 {
                 let (row, k) = (i / b.n_d, i % b.n_d);
                 top.0 = top.0.max(h0 + row as f64 * dh);
                 top.1 = top.1.max(b.d0 + (k + 1) as f64 * b.width);
@@ -457,9 +503,22 @@ fn draw_exact_cells(
     b: &Binned,
     map: &JumpMap,
 ) -> Result<(), PlotError> {
+    let grey = RGBColor(215, 215, 215);
+    let checked = (0..b.cells.len()).filter_map(|i| {
+        let c = b.cells[i];
+        (c[3] > 0 && c[4] == 0).then(|| {
+            let r = cell_rect(b, map, i % b.n_d, i / b.n_d);
+            Rectangle::new(r, grey.filled())
+        })
+    });
+    chart
+        .draw_series(checked)
+        .map_err(|e| err(path, e))?
+        .label("checked: no pair makes the jump (white: not on the grid)")
+        .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 14, y + 6)], grey.filled()));
     let cells = (0..b.cells.len()).filter_map(|i| {
         let c = b.cells[i];
-        let n = c[0] + c[2];
+        let n = c[4];
         (n > 0).then(|| {
             let r = cell_rect(b, map, i % b.n_d, i / b.n_d);
             Rectangle::new(r, BLUE.mix(shade(n, b.max_exact)).filled())
@@ -505,7 +564,7 @@ fn draw_agreement_cells(
         let rects = (0..b.cells.len()).filter_map(|i| {
             let c = b.cells[i];
             let most = (0..3).max_by_key(|&j| (c[j], 3 - j)).unwrap_or(0);
-            (c.iter().any(|&n| n > 0) && most == kind).then(|| {
+            (c[..3].iter().any(|&n| n > 0) && most == kind).then(|| {
                 Rectangle::new(
                     cell_rect(b, map, i % b.n_d, i / b.n_d),
                     colours[kind].filled(),

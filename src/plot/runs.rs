@@ -3,7 +3,9 @@
 //! (a) each stance's contact time and step period, (b) the cycle's peak force against
 //! `F_max`, (c) the friction the cycle needs, `mu_min`, against the friction limit μ, and
 //! (d) the leg extension extremes `ext_min`, `ext_max` against `χ_min`, `χ_max`. One colour
-//! per cycle, named in the legend row; limits dashed in the cycle's colour. An infeasible
+//! per cycle, named in the legend row, each with its own marker; a later cycle is drawn
+//! thinner on top of an earlier one, so cycles whose lines coincide (two stances of one
+//! clip) both stay visible; limits dashed in the cycle's colour. An infeasible
 //! (cycle, speed) is marked with a red cross and the violated limit's name on the panel of
 //! that limit only; the verdict line says up to which speed every cycle is feasible.
 
@@ -64,8 +66,9 @@ const PALETTE: [RGBColor; 8] = [
 pub const RUNS_PLOT_PX: (u32, u32) = (1100, 1450);
 /// Height of the legend row under the title, px.
 const LEGEND_ROW_PX: u32 = 60;
-/// Panels of the figure, in order: (a) times, (b) peak force, (c) friction, (d) extension.
-const N_PANELS: usize = 4;
+/// Panels of the figure, in order: (a) times, (b) peak force, (c) friction, (d) extension
+/// (`query run --help` names them).
+pub const N_PANELS: usize = 4;
 
 /// The panel that shows the limit a violation names (`<stance_id>: friction`): (b) for
 /// `force`, (c) for `friction`, (d) for `extension_min`/`extension_max`, (a) for anything
@@ -175,17 +178,60 @@ type Chart<'a, 'b> =
 /// The values of a point one panel shows.
 type Get = dyn Fn(&RunPoint) -> Vec<f64>;
 
+/// The line width and marker size of cycle `c` of `n`, px: 4 and 5 for the first, one
+/// less for each later cycle down to 1 and 2, so coinciding lines stay visible.
+fn cycle_width(c: usize, n: usize) -> (u32, u32) {
+    let k = n.saturating_sub(1 + c).min(3) as u32;
+    (1 + k, 2 + k)
+}
+
+/// Draws cycle `c`'s markers at `pts` (pixel size `size`): circle, square, triangle, ring,
+/// in turn.
+fn draw_markers(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    (c, pts): (usize, &[(f64, f64)]),
+    size: u32,
+    colour: RGBColor,
+) -> Result<(), PlotError> {
+    let s = size as i32;
+    let r = match c % 4 {
+        0 => chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, size, colour.filled())))
+            .map(|_| ()),
+        1 => chart
+            .draw_series(pts.iter().map(|&p| {
+                EmptyElement::at(p) + Rectangle::new([(-s, -s), (s, s)], colour.filled())
+            }))
+            .map(|_| ()),
+        2 => chart
+            .draw_series(
+                pts.iter()
+                    .map(|&p| TriangleMarker::new(p, s + 1, colour.filled())),
+            )
+            .map(|_| ()),
+        _ => chart
+            .draw_series(
+                pts.iter()
+                    .map(|&p| Circle::new(p, size + 1, colour.stroke_width(2))),
+            )
+            .map(|_| ()),
+    };
+    r.map_err(|e| err(path, e))
+}
+
 /// Cycle `c`'s lines on one panel: one per value slot (stance 1, stance 2; ext_min,
-/// ext_max) with its points, and its limits dashed.
+/// ext_max) with its markers, and its limits dashed.
 fn draw_cycle(
     chart: &mut Chart<'_, '_>,
     path: &Path,
     points: &[RunPoint],
-    c: usize,
+    (c, n): (usize, usize),
     get: &Get,
     lim: &Get,
 ) -> Result<(), PlotError> {
     let colour = PALETTE[c % PALETTE.len()];
+    let (width, size) = cycle_width(c, n);
     let mine: Vec<&RunPoint> = points.iter().filter(|p| p.cycle == c).collect();
     let slots = mine.iter().map(|p| get(p).len()).max().unwrap_or(0);
     for k in 0..slots {
@@ -195,11 +241,9 @@ fn draw_cycle(
             .filter(|(_, y)| y.is_finite())
             .collect();
         chart
-            .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
+            .draw_series(LineSeries::new(line.clone(), colour.stroke_width(width)))
             .map_err(|e| err(path, e))?;
-        chart
-            .draw_series(line.iter().map(|&pt| Circle::new(pt, 3, colour.filled())))
-            .map_err(|e| err(path, e))?;
+        draw_markers(chart, path, (c, &line), size, colour)?;
     }
     for k in 0..mine.iter().map(|p| lim(p).len()).max().unwrap_or(0) {
         let line: Vec<(f64, f64)> = mine
@@ -289,14 +333,27 @@ fn legend_row(
         x += w;
         Ok::<(), PlotError>(())
     };
+    let n = names.iter().map(|(c, _)| c + 1).max().unwrap_or(0);
     for (c, name) in names {
         let colour = PALETTE[c % PALETTE.len()];
+        let (width, size) = cycle_width(c, n);
         item(&format!("cycle {name}"), &|(x, y)| {
             area.draw(&PathElement::new(
                 vec![(x, y), (x + 20, y)],
-                colour.stroke_width(2),
+                colour.stroke_width(width),
             ))
-            .and_then(|()| area.draw(&Circle::new((x + 10, y), 3, colour.filled())))
+            .map_err(|e| err(path, e))?;
+            let s = size as i32;
+            let (cx, cy) = (x + 10, y);
+            match c % 4 {
+                0 => area.draw(&Circle::new((cx, cy), size, colour.filled())),
+                1 => area.draw(&Rectangle::new(
+                    [(cx - s, cy - s), (cx + s, cy + s)],
+                    colour.filled(),
+                )),
+                2 => area.draw(&TriangleMarker::new((cx, cy), s + 1, colour.filled())),
+                _ => area.draw(&Circle::new((cx, cy), size + 1, colour.stroke_width(2))),
+            }
             .map_err(|e| err(path, e))
         })?;
     }
@@ -380,7 +437,7 @@ pub fn runs_png(path: &Path, title: &str, points: &[RunPoint]) -> Result<(), Plo
             .map_err(|e| err(path, e))?;
         value_mesh(&mut chart, path, "target speed (m/s)", ylabel)?;
         for c in 0..n_cycles {
-            draw_cycle(&mut chart, path, points, c, get, lim)?;
+            draw_cycle(&mut chart, path, points, (c, n_cycles), get, lim)?;
         }
         mark_infeasible(
             &mut chart,

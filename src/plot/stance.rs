@@ -7,7 +7,8 @@
 //! # Model
 //! ```text
 //! panel (a): f_v (N)          panel (b): f_h (N)
-//! panel (c): |f_t|/f_v = hypot(f_h, f_p)/f_v   where f_v > 0, drawn in [0, 2] (larger
+//! panel (c): |f_t|/f_v = hypot(f_h, f_p)/f_v   where f_v ≥ 5 % of the series' peak f_v
+//!            (below it, in flight, a ratio of two small numbers), drawn in [0, 2] (larger
 //!            values at 2, with a note); shaded: the model's active set
 //!            A = {τ : f_v(τ) ≥ λ · max_grid f_v}   (λ = --active-set, default the queries'
 //!            0.2); dashed: the stored mu_req_robust, what the queries judge
@@ -33,6 +34,10 @@ use crate::stances::params::Heading;
 pub const STANCE_PLOT_PX: (u32, u32) = (1200, 1050);
 /// Width of the legend column on the right, px.
 const LEGEND_PX: u32 = 290;
+/// Panel (c) draws a series' `|f_t|/f_v` where its `f_v` is at least this fraction of its
+/// peak (the 5 % set of the stored `mu_req`): in flight the kinematic force is noise over
+/// noise, and its ratio drew a flat line that read as friction before touchdown.
+pub const RATIO_MIN_FV_FRACTION: f64 = 0.05;
 /// Upper end of the `|f_t|/f_v` axis; larger ratios are drawn there, with a note.
 pub const RATIO_AXIS_MAX: f64 = 2.0;
 /// The time axis extends this fraction of `Δt` before touchdown and after liftoff.
@@ -442,8 +447,12 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
         };
         draw_broken(&mut a, path, &s, &|f| Some(f[2]))?;
         draw_broken(&mut b, path, &s, &|f| Some(f[0]))?;
+        let peak_fv = s.points.iter().map(|p| p.1[2]).fold(0.0, f64::max);
         draw_broken(&mut c, path, &s, &|f| {
-            traction_ratio(*f).map(|r| r.min(RATIO_AXIS_MAX))
+            (f[2] >= RATIO_MIN_FV_FRACTION * peak_fv)
+                .then(|| traction_ratio(*f))
+                .flatten()
+                .map(|r| r.min(RATIO_AXIS_MAX))
         })?;
     }
     let max_active = d

@@ -20,7 +20,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::{err, metre_tick, register_font, titled, PlotError, Verdict};
+use super::{err, register_font, tick_label, titled, PlotError, Verdict};
 use crate::twopac::diagnose::Cause;
 
 /// One validated sample of the 2PAC curve.
@@ -235,8 +235,8 @@ fn view(
         .configure_mesh()
         .x_desc("s, along the path (m)")
         .y_desc(y_desc)
-        .x_label_formatter(&metre_tick)
-        .y_label_formatter(&metre_tick)
+        .x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
         .light_line_style(WHITE.mix(0.0))
         .label_style(("sans-serif", 14))
         .draw()
@@ -433,6 +433,7 @@ fn slack_strip(
         .configure_mesh()
         .x_desc("time (s)")
         .y_desc("s* (N)")
+        .y_label_formatter(&tick_label)
         .light_line_style(WHITE.mix(0.0))
         .label_style(("sans-serif", 13))
         .draw()

@@ -52,6 +52,31 @@ pub fn validation_line(name: &str, v: &Validation) -> String {
     }
 }
 
+/// The name of the 2PAC curve in the summary.
+const CURVE: &str = "2PAC curve";
+
+/// A margin below this fraction of the body weight `m g` is reported as "on the edge of
+/// the support" (0.1 %: 0.7 N for 70 kg).
+pub const EDGE_MARGIN_REL: f64 = 1e-3;
+
+/// The 2PAC curve's smallest robustness margin in words, flagged when the COM runs along
+/// the edge of the support (a valid curve with no room to spare; printed for a valid
+/// curve, an invalid one has its `why:` line).
+fn margin_line(r: &TwopacReport) -> Option<String> {
+    let (m, t, j) = r.planned.smallest_margin()?;
+    let name = r.planned.phase_names.get(j).map_or("", String::as_str);
+    let weight_n = r.planned.mass_kg * crate::math::constants::GRAVITY;
+    let edge = if m.abs() <= EDGE_MARGIN_REL * weight_n {
+        ": the COM runs along the edge of the support there (valid, no room to spare)"
+    } else {
+        ""
+    };
+    let m_shown = if m.abs() < 0.05 { 0.0 } else { m };
+    Some(format!(
+        "smallest robustness margin {m_shown:.1} N at {t:.2} s (phase {j} [{name}]){edge}"
+    ))
+}
+
 /// The summary lines on stdout.
 fn print_summary(r: &TwopacReport, job: &TwopacJob) {
     let p = &r.planned.p;
@@ -77,7 +102,7 @@ fn print_summary(r: &TwopacReport, job: &TwopacJob) {
         r.planned.plan_s * 1e3
     );
     for (name, v, why) in [
-        ("2PAC curve", &r.planned.v_curve, r.planned.why_curve()),
+        (CURVE, &r.planned.v_curve, r.planned.why_curve()),
         (
             "quasi-static baseline (for comparison: it stops at every phase state and transition point)",
             &r.planned.v_qs,
@@ -87,6 +112,10 @@ fn print_summary(r: &TwopacReport, job: &TwopacJob) {
         crate::say!("  {}", validation_line(name, v));
         if let Some(why) = why {
             crate::say!("    why: {why}");
+        }
+        let shown = name == CURVE && v.trajectory_valid;
+        if let (true, Some(line)) = (shown, margin_line(r)) {
+            crate::say!("    {line}");
         }
     }
     crate::say!("  → {}", job.out.display());
