@@ -786,6 +786,8 @@ pub struct JumpQuery {
     pub limits: LimitOptions,
     /// Keep the clips the queries leave out ([`left_out_clips`]).
     pub keep_left_out: bool,
+    /// Build each pair's whole explanation ([`JumpLine::full`]) for `--explain`.
+    pub explain: bool,
     /// Output Parquet file.
     pub out: PathBuf,
 }
@@ -888,7 +890,8 @@ pub struct JumpLine {
     pub why: Option<String>,
     /// Apex height (m) and distance (m) asked of this pair.
     pub asked: (f64, f64),
-    /// The whole answer ([`crate::query::tables::JumpRow::full_explanation`]).
+    /// The whole answer ([`crate::query::tables::JumpRow::full_explanation`]); empty
+    /// unless [`JumpQuery::explain`].
     pub full: Vec<String>,
 }
 
@@ -931,7 +934,11 @@ pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
             feasible: r.jump.as_ref().is_ok_and(|j| j.feasible()),
             why: r.explain(),
             asked: (r.height, r.distance),
-            full: r.full_explanation(),
+            full: if q.explain {
+                r.full_explanation()
+            } else {
+                Vec::new()
+            },
         })
         .collect())
 }

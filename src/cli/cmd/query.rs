@@ -113,6 +113,7 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         target,
         limits: a.lim.options(),
         keep_left_out: a.keep_left_out,
+        explain: a.explain.is_some(),
         out: a.out,
     };
     let lines = jump_query(&q)?;
