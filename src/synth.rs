@@ -29,10 +29,20 @@
 //!
 //! Planted feet are flat (ankle 0.08 m above the floor, toe tip on it) at a footprint
 //! half-way between the hip at touchdown and at liftoff; `platform_m` lifts the right
-//! foot's first running stance onto a step that high. A swing foot stays flat and moves
-//! from footprint P₀ to P₁ in time T as `P₀ + (P₁ − P₀)(u − (1 − r) sin(2πu)/(2π)) +
-//! v_z s (1 − u) e_z` (`u = s/T`), leaving and arriving at 3 m/s (run: 2.2 m/s of it
-//! horizontal), so the contact detector's 2 m/s gate separates it from the floor. The
+//! foot's first running stance onto a step that high. Like a captured foot, a planted foot
+//! bears force before its joint centres come to rest: it touches down and lifts off
+//! `g = 3 cm` above its footprint (the sole's give) and settles over `T = 50 ms`:
+//!
+//! ```text
+//! height above the footprint, s from the nearer contact edge, u = s/T:
+//!   give(s) = g (2u³ − 3u² + 1) − v_e T (u³ − 2u² + u)   (u < 1; else 0)   v_e = 0.6 m/s
+//! ```
+//!
+//! A swing foot stays flat and moves from P₀ to P₁ (the footprints raised by `g`) in time
+//! T as `P₀ + (P₁ − P₀)(u − (1 − r) sin(2πu)/(2π)) + v_z s (1 − u) e_z` (`u = s/T`),
+//! leaving and arriving at 3 m/s (run: 2.2 m/s of it horizontal), so the contact
+//! detector's 2 m/s gate separates it from the floor, and the sub-frame event test (3 cm,
+//! spec com-from-bvh §7.3) is met exactly at the force's first and last frame. The
 //! legs use two-bone IK (knee towards the root heading). The trunk leans forward (run 8°,
 //! jump 4°) with seeded wobbles ≤ 2° per axis on root, spine, neck and head; the arms are
 //! rigid (fixed elbow) and swing at the shoulder. A clip never ends on a touchdown frame.
@@ -103,6 +113,21 @@ const JUMP_STAND_Z: f64 = 0.97; // m, standing COM height
 const SWING_END_SPEED: f64 = 3.0; // m/s, swing foot at liftoff and touchdown
 const RUN_SWING_END_VX: f64 = 2.2; // m/s, its horizontal part in the run
 const ANKLE_Z: f64 = 0.08; // m, ankle above the sole
+/// The sole's give, m: a planted foot first and last bears force this far above the
+/// height where it rests (heel pad, shoe and the foot rolling flat). The captured feet of
+/// the 4 m/s force-plate run are 1.5–2.8 cm above their resting height at the plates'
+/// first 20 N (ankle) and 2.8–3.4 cm at the last (toe tip); the event height of the
+/// sub-frame contact times ([`crate::contacts::timing::EVENT_H_M`], 3 cm), chosen on
+/// those plates, is that foot state, so the generator's feet take it as their give.
+const SOLE_GIVE_M: f64 = crate::contacts::timing::EVENT_H_M;
+/// Time over which the give settles after touchdown (and builds before liftoff), s: the
+/// captured ankle comes to rest about 50 ms after the plates' first 20 N.
+const SOLE_GIVE_S: f64 = 0.05;
+/// Speed of a planted foot at the contact edge itself, m/s (downward at touchdown, upward
+/// at liftoff). The swing meets the give at 3 m/s, so the central-difference speed of the
+/// edge frame is about (3 + 0.6)/2 = 1.8 m/s: below the detector's 2 m/s gate, which
+/// keeps the edge frame in contact, and below the Hermite's monotone limit 3·give/T.
+const SOLE_GIVE_EDGE_MPS: f64 = 0.6;
 const HIP_Y: f64 = 0.09; // m, hip joint lateral offset
 const THIGH: f64 = 0.42;
 const SHANK: f64 = 0.42;
@@ -372,16 +397,18 @@ impl Timeline {
         self.stances[side].iter().any(|s| s.k_a <= k && k <= s.k_b)
     }
 
-    /// Ankle of one foot at frame `k`: planted, or on its swing path.
+    /// Ankle of one foot at frame `k`: planted (sinking into or rising out of the sole's
+    /// give near the contact edges), or on its swing path between the give heights.
     fn ankle(&self, side: usize, k: i64) -> V3 {
         let st = &self.stances[side];
         let Some(i) = st.iter().position(|s| k <= s.k_b) else {
             return st.last().map_or(V3::zeros(), |s| s.ankle);
         };
         if k >= st[i].k_a || i == 0 {
-            return st[i].ankle;
+            return st[i].ankle + V3::z() * self.sole_give(&st[i], k);
         }
-        let (p0, d) = (st[i - 1].ankle, st[i].ankle - st[i - 1].ankle);
+        let lift = V3::z() * SOLE_GIVE_M;
+        let (p0, d) = (st[i - 1].ankle + lift, st[i].ankle - st[i - 1].ankle);
         let s = (k - st[i - 1].k_b) as f64 * self.dt;
         let t = (st[i].k_a - st[i - 1].k_b) as f64 * self.dt;
         let run = self.motion == SynthMotion::Run;
@@ -390,6 +417,26 @@ impl Timeline {
         let vz = (SWING_END_SPEED * SWING_END_SPEED - vh * vh).sqrt();
         let ease = u - (1.0 - r) * (2.0 * PI * u).sin() / (2.0 * PI);
         p0 + d * ease + V3::z() * (vz * s * (1.0 - u))
+    }
+}
+
+impl Timeline {
+    /// Height of a planted foot above its footprint at frame `k` of stance `s`, m: the
+    /// sole's give, [`SOLE_GIVE_M`] at the contact edges, settling to 0 over
+    /// [`SOLE_GIVE_S`] (at most half the stance) as a cubic Hermite that leaves the edge
+    /// at [`SOLE_GIVE_EDGE_MPS`]; an open end (the jump's standing) has none.
+    fn sole_give(&self, s: &Stance, k: i64) -> f64 {
+        let t = SOLE_GIVE_S.min((s.k_b - s.k_a) as f64 * self.dt / 2.0);
+        let settle = |frames: i64| {
+            let u = frames as f64 * self.dt / t;
+            if !(0.0..1.0).contains(&u) {
+                return 0.0;
+            }
+            let h00 = 2.0 * u * u * u - 3.0 * u * u + 1.0;
+            let h10 = u * u * u - 2.0 * u * u + u;
+            SOLE_GIVE_M * h00 - SOLE_GIVE_EDGE_MPS * t * h10
+        };
+        settle(k - s.k_a).max(settle(s.k_b - k))
     }
 }
 
@@ -894,14 +941,56 @@ mod tests {
                         assert!(g.iter().all(|&(h, v)| h > 0.065 || v > 2.05), "{msg}");
                         continue;
                     }
-                    // Planted: still, flat, on the floor, inside the enter gate (with margin).
+                    // Planted: on its footprint, flat, at most the sole's give above the
+                    // floor, inside the enter gate (with margin).
                     let first = (0..=k).rev().take_while(|&i| truth[i]).last().unwrap_or(k);
-                    assert!((pts[0][k] - pts[0][first]).norm() < 1e-7, "{msg}");
-                    assert!(
-                        (pts[0][k].z - ANKLE_Z).abs() < 1e-7 && pts[1][k].z.abs() < 1e-7,
-                        "{msg}"
-                    );
+                    let d = pts[0][k] - pts[0][first];
+                    assert!(d.x.hypot(d.y) < 1e-7, "{msg}");
+                    assert!((pts[0][k].z - pts[1][k].z - ANKLE_Z).abs() < 1e-7, "{msg}");
+                    assert!((-1e-7..=SOLE_GIVE_M + 1e-7).contains(&g[1].0), "{msg}");
                     assert!(g.iter().any(|&(h, v)| h <= 0.04 && v <= 1.95), "{msg}");
+                }
+            }
+        }
+    }
+
+    /// The sub-frame event test of spec com-from-bvh §7.3 (`contacts::timing`) of a foot
+    /// at frame `k`: `min_p max(h_p/H, v_p/V)`.
+    fn event_test(pts: &[Vec<V3>; 2], k: usize, rate: f64, v_event: f64) -> f64 {
+        use crate::contacts::timing::EVENT_H_M;
+        gates(pts, k, rate)
+            .iter()
+            .map(|&(h, v)| (h / EVENT_H_M).max(v / v_event))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn contact_edges_are_where_the_event_test_is_met() {
+        use crate::contacts::timing::{EVENT_LO_V_MPS, EVENT_TD_V_MPS};
+        for o in cases() {
+            let clip = generate(&o);
+            let kins = reread(&clip.bvh, o.up, o.unit_m);
+            let n = kins.len();
+            for (side, truth) in [(0, &clip.contact_left), (1, &clip.contact_right)] {
+                let (ajc, toe) = (LEGS[side][2], LEGS[side][3]);
+                let pts = [
+                    kins.iter().map(|k| k.pos[ajc]).collect(),
+                    kins.iter().map(|k| k.end[toe]).collect(),
+                ];
+                let r = |k: usize, v: f64| event_test(&pts, k, o.frame_rate_hz, v);
+                for (a, b) in crate::contacts::runs(truth) {
+                    // The first and last force frames meet the test exactly (the give's
+                    // 3 cm; 1e-6: the nine printed decimals), the frames outside do not.
+                    if a > 0 {
+                        let (out, at) = (r(a - 1, EVENT_TD_V_MPS), r(a, EVENT_TD_V_MPS));
+                        let msg = format!("{o:?} side {side} touchdown {a}: {out} {at}");
+                        assert!(out > 1.05 && (at - 1.0).abs() < 1e-6, "{msg}");
+                    }
+                    if b + 1 < n {
+                        let (at, out) = (r(b, EVENT_LO_V_MPS), r(b + 1, EVENT_LO_V_MPS));
+                        let msg = format!("{o:?} side {side} liftoff {b}: {at} {out}");
+                        assert!(out > 1.05 && (at - 1.0).abs() < 1e-6, "{msg}");
+                    }
                 }
             }
         }

@@ -1,11 +1,14 @@
-//! Issue 17: the analyst's first hour. The README's demo commands run, its column tables
-//! are the written schemas, the library's provenance (manifest date, command line, tool
-//! version; `stancelib.*` Parquet metadata; query outputs naming their library), `info`,
-//! and the options a newcomer tries first.
+//! Issue 17: the analyst's first hour. The README's demo commands run and answer with
+//! numbers (issue 38 item 6: not all zero or null, queries with feasible rows), the README
+//! stays a manual of at most 300 lines, `docs/first-hour.md` runs as written,
+//! `docs/tables.md` is the written schemas, the library's provenance (manifest date,
+//! command line, tool version; `stancelib.*` Parquet metadata; query outputs naming their
+//! library), `info`, and the options a newcomer tries first.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::SystemTime;
 
 use crate::util::{root, Demo};
 
@@ -13,20 +16,35 @@ fn readme() -> String {
     std::fs::read_to_string(root().join("README.md")).unwrap()
 }
 
-/// The fenced code blocks of `text` with info string `lang`, each as its lines.
-fn fenced_blocks(text: &str, lang: &str) -> Vec<Vec<String>> {
+/// A page of `docs/`.
+fn docs_page(name: &str) -> String {
+    let path = root().join("docs").join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The fenced code blocks of `text` in order: each block's info string and its lines.
+fn blocks(text: &str) -> Vec<(String, Vec<String>)> {
     let mut blocks = Vec::new();
-    let mut cur: Option<Vec<String>> = None;
+    let mut cur: Option<(String, Vec<String>)> = None;
     for line in text.lines() {
         let t = line.trim_start();
         match &mut cur {
-            None if t.starts_with("```") && t[3..].trim() == lang => cur = Some(Vec::new()),
+            None if t.starts_with("```") => cur = Some((t[3..].trim().to_string(), Vec::new())),
             Some(_) if t.starts_with("```") => blocks.extend(cur.take()),
-            Some(b) => b.push(line.to_string()),
+            Some((_, b)) => b.push(line.to_string()),
             None => {}
         }
     }
     blocks
+}
+
+/// The fenced code blocks of `text` with info string `lang`, each as its lines.
+fn fenced_blocks(text: &str, lang: &str) -> Vec<Vec<String>> {
+    blocks(text)
+        .into_iter()
+        .filter(|(l, _)| l == lang)
+        .map(|(_, b)| b)
+        .collect()
 }
 
 /// A shell line without its comment (a `#` at the start or after a space).
@@ -61,8 +79,137 @@ fn demo_commands_are_found_outside_comments_only() {
     );
 }
 
+/// Every file under `dir` (symbolic links not followed) with its modification time and size.
+fn stamps(dir: &Path) -> BTreeMap<PathBuf, (SystemTime, u64)> {
+    let mut out = BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let m = std::fs::symlink_metadata(&p).unwrap();
+            if m.is_dir() {
+                todo.push(p);
+            } else if m.is_file() {
+                out.insert(p, (m.modified().unwrap(), m.len()));
+            }
+        }
+    }
+    out
+}
+
+/// The files of `after` that are new or changed since `before`.
+fn written_since(
+    before: &BTreeMap<PathBuf, (SystemTime, u64)>,
+    after: &BTreeMap<PathBuf, (SystemTime, u64)>,
+) -> Vec<PathBuf> {
+    after
+        .iter()
+        .filter(|(p, s)| before.get(*p) != Some(s))
+        .map(|(p, _)| p.clone())
+        .collect()
+}
+
+/// The finite values of a Parquet table's numeric columns and numeric lists (nulls and
+/// NaN left out).
+fn table_numbers(path: &Path) -> Vec<f64> {
+    use polars::prelude::DataType;
+    let t = stancelib::library::read::Table::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut out = Vec::new();
+    for c in t.df.columns() {
+        let values = match c.dtype() {
+            d if d.is_primitive_numeric() => c.as_materialized_series().clone(),
+            DataType::List(inner) if inner.is_primitive_numeric() => c.list().unwrap().get_inner(),
+            _ => continue,
+        };
+        let values = values.cast(&DataType::Float64).unwrap();
+        out.extend(values.f64().unwrap().iter().flatten());
+    }
+    out.retain(|v| v.is_finite());
+    out
+}
+
+/// The numbers a command printed: whitespace-separated words that parse as finite numbers
+/// once brackets and separators around them are dropped (`(17`, `0.70,`, `1.5:` …).
+fn printed_numbers(text: &str) -> Vec<f64> {
+    text.split(|c: char| c.is_whitespace() || "()[]{},;=".contains(c))
+        .filter_map(|w| w.trim_end_matches([':', '.']).parse::<f64>().ok())
+        .filter(|v| v.is_finite())
+        .collect()
+}
+
+#[test]
+fn printed_numbers_are_the_numeric_words_of_the_output() {
+    let line = "  sk-1: mu 0.70, F_max 2403 N (17 stances; tool 0.1.0) -0.000 run_120hz:R:51";
+    assert_eq!(printed_numbers(line), [0.70, 2403.0, 17.0, -0.0]);
+    assert!(printed_numbers("plot stance: run_120hz_m_yup:L:95 → a.png").is_empty());
+}
+
+/// Whether a written table answers: the rows of its verdict column (`feasible`, or a jump
+/// map's `feasible_exact`), any of them true; `None` when it has no verdict column.
+fn any_feasible(path: &Path) -> Option<bool> {
+    let t = stancelib::library::read::Table::open(path).unwrap();
+    ["feasible", "feasible_exact"]
+        .iter()
+        .find(|c| t.df.column(c).is_ok())
+        .map(|c| t.bools(c).unwrap().into_iter().any(|f| f))
+}
+
+/// Checks what a documented command gave: every Parquet table it wrote (but a library's
+/// `errors.parquet`) holds a finite non-zero number (and, with `answers`, a feasible row when it has a verdict column); a
+/// command that wrote no table printed a finite non-zero number, or drew a picture.
+fn check_numbers(cmd: &str, written: &[PathBuf], stdout: &str, answers: bool) {
+    // A library's `errors.parquet` lists failed inputs: empty is the good answer.
+    let tables: Vec<&PathBuf> = written
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "parquet"))
+        .filter(|p| !p.ends_with("errors.parquet"))
+        .collect();
+    for t in &tables {
+        let n = table_numbers(t);
+        assert!(
+            n.iter().any(|v| *v != 0.0),
+            "`{cmd}` wrote {} whose numbers are all zero or null ({} finite values)",
+            t.display(),
+            n.len()
+        );
+        if answers {
+            assert_ne!(
+                any_feasible(t),
+                Some(false),
+                "`{cmd}`: no feasible row in {}; a README example must answer",
+                t.display()
+            );
+        }
+    }
+    if !tables.is_empty() {
+        return;
+    }
+    let printed = printed_numbers(stdout);
+    if !printed.is_empty() {
+        assert!(
+            printed.iter().any(|v| *v != 0.0),
+            "`{cmd}` printed only zeros:\n{stdout}"
+        );
+        return;
+    }
+    let pictures: Vec<&PathBuf> = written
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    assert!(
+        !pictures.is_empty(),
+        "`{cmd}` wrote no table, printed no number and drew no picture:\n{stdout}"
+    );
+    for p in pictures {
+        assert!(png_size(p).0 > 0, "{}", p.display());
+    }
+}
+
 // See: issue 17 item 1 — the README's query examples pointed to paths `make demo` does not
-// write, and called built commands "not built yet".
+// write, and called built commands "not built yet". Issue 38 item 6 — an example that runs
+// must also answer: its tables and printed numbers are not all zero or null, and a query's
+// table has a feasible row.
 #[test]
 fn readme_sh_blocks_that_use_the_demo_outputs_run() {
     let commands = demo_commands(&readme());
@@ -72,9 +219,191 @@ fn readme_sh_blocks_that_use_the_demo_outputs_run() {
     );
     let demo = Demo::build();
     for c in &commands {
+        let before = stamps(demo.dir.path());
         let (code, out, err) = demo.sh(c);
         assert_eq!(code, 0, "README command `{c}` failed:\n{out}\n{err}");
+        let written = written_since(&before, &stamps(demo.dir.path()));
+        check_numbers(c, &written, &out, true);
     }
+}
+
+// See: issue 38 item 6 — the README is a user's manual; column tables, method and
+// measurement history live in docs/.
+#[test]
+fn readme_is_a_manual_of_at_most_300_lines() {
+    let text = readme();
+    let lines = text.lines().count();
+    assert!(lines <= 300, "README.md has {lines} lines (at most 300)");
+    // It points to the pages that took its reference material, and they exist.
+    for page in [
+        "first-hour.md",
+        "tables.md",
+        "library.md",
+        "queries.md",
+        "editing.md",
+        "decisions.md",
+    ] {
+        assert!(
+            text.contains(&format!("(docs/{page})")),
+            "the README does not link docs/{page}"
+        );
+        assert!(root().join("docs").join(page).is_file(), "no docs/{page}");
+    }
+}
+
+/// The value after `flag` in a command line.
+fn arg<'a>(cmd: &'a str, flag: &str) -> Option<&'a str> {
+    let words: Vec<&str> = cmd.split_whitespace().collect();
+    words.windows(2).find(|w| w[0] == flag).map(|w| w[1])
+}
+
+/// The stance ids and clip names a command takes (`--stance`, `--clip`, and the two ids of
+/// `--pair LIFTOFF:LANDING`, each `clip:label:frame`).
+fn ids_taken(cmd: &str) -> Vec<String> {
+    let mut ids: Vec<String> = ["--stance", "--clip"]
+        .iter()
+        .filter_map(|f| arg(cmd, f))
+        .map(str::to_string)
+        .collect();
+    if let Some(pair) = arg(cmd, "--pair") {
+        let cut = pair
+            .match_indices(':')
+            .nth(2)
+            .map_or(pair.len(), |(i, _)| i);
+        ids.push(pair[..cut].to_string());
+        ids.push(pair[(cut + 1).min(pair.len())..].to_string());
+    }
+    ids
+}
+
+#[test]
+fn ids_taken_splits_a_pair_into_its_two_stance_ids() {
+    assert_eq!(
+        ids_taken("stancelib edit jump --lib l --pair a_1:LR:35:b:LR:125 --out x.bvh"),
+        ["a_1:LR:35", "b:LR:125"]
+    );
+    assert_eq!(
+        ids_taken("stancelib plot clip --lib l --clip jump_1.3m --out p.png"),
+        ["jump_1.3m"]
+    );
+}
+
+/// Whitespace runs as one space, the ends trimmed.
+fn squeeze(line: &str) -> String {
+    line.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+// See: issue 38 item 6 — "a written walkthrough docs/first-hour.md follows a new user from
+// `make demo` to a feasible scaled run, a feasible higher jump and an edited BVH, using
+// only what the terminal prints". Every `sh` command of the page runs (its `make demo`
+// block is the demo library), its numbers are not all zero, the ids it takes were printed
+// by an earlier command, the output the page quotes is what the tool prints, and the
+// three answers are reached.
+#[test]
+fn first_hour_walkthrough_commands_run() {
+    let page = docs_page("first-hour.md");
+    let demo = Demo::build();
+    // The recorded jumps' heights, as `list` reports them.
+    let (code, json, err) = demo.sh("stancelib list out/demo --json");
+    assert_eq!(code, 0, "{err}");
+    let list: serde_json::Value = serde_json::from_str(json.trim()).unwrap();
+    let recorded = list["jumps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j["height_m"].as_f64().unwrap())
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        recorded.is_finite(),
+        "the demo library lists no jump: {list}"
+    );
+    let (mut run, mut jump, mut edit) = (false, false, false);
+    let mut seen = String::new();
+    let mut last: Option<String> = None;
+    let mut n = 0;
+    for (lang, lines) in blocks(&page) {
+        match lang.as_str() {
+            "sh" => {
+                let commands: Vec<String> = lines
+                    .iter()
+                    .map(|l| without_comment(l).to_string())
+                    .filter(|l| !l.is_empty())
+                    .collect();
+                if commands == ["make demo"] {
+                    last = None;
+                    continue;
+                }
+                let mut output = String::new();
+                for c in &commands {
+                    assert!(
+                        c.starts_with("stancelib "),
+                        "not a stancelib command: `{c}`"
+                    );
+                    for id in ids_taken(c) {
+                        assert!(
+                            seen.contains(&id),
+                            "`{c}` takes `{id}`, which no earlier command printed"
+                        );
+                    }
+                    let before = stamps(demo.dir.path());
+                    let (code, out, err) = demo.sh(c);
+                    assert_eq!(code, 0, "docs/first-hour.md: `{c}` failed:\n{out}\n{err}");
+                    let written = written_since(&before, &stamps(demo.dir.path()));
+                    check_numbers(c, &written, &out, false);
+                    let out_file = arg(c, "--out").map(|o| demo.dir.path().join(o));
+                    let out_file = out_file.as_deref();
+                    if c.starts_with("stancelib query run") {
+                        run |= any_feasible(out_file.unwrap()) == Some(true);
+                    }
+                    if c.starts_with("stancelib query jump") {
+                        let t = stancelib::library::read::Table::open(out_file.unwrap()).unwrap();
+                        let feasible = t.bools("feasible").unwrap();
+                        let heights = t.f64s("height_m").unwrap();
+                        jump |= feasible
+                            .iter()
+                            .zip(&heights)
+                            .any(|(f, h)| *f && *h > recorded + 0.05);
+                    }
+                    if c.starts_with("stancelib edit") {
+                        let bvh = out_file.unwrap();
+                        edit |= std::fs::metadata(bvh).is_ok_and(|m| m.len() > 0);
+                    }
+                    output.push_str(&out);
+                    output.push_str(&err);
+                    n += 1;
+                }
+                seen.push_str(&output);
+                last = Some(output);
+            }
+            "text" => {
+                // The terminal output quoted after a command block, trimmed with `…`.
+                let Some(output) = last.take() else { continue };
+                let printed: Vec<String> = output.lines().map(squeeze).collect();
+                for want in lines.iter().map(|l| squeeze(l)) {
+                    if want.is_empty() || want == "…" {
+                        continue;
+                    }
+                    assert!(
+                        printed.iter().any(|p| p.contains(&want)),
+                        "docs/first-hour.md quotes a line the tool does not print:\n{want}\n\
+                         it printed:\n{output}"
+                    );
+                }
+            }
+            _ => last = None,
+        }
+    }
+    assert!(n >= 6, "docs/first-hour.md shows only {n} commands");
+    assert!(
+        run,
+        "no `query run` of docs/first-hour.md answers with a feasible run"
+    );
+    assert!(
+        jump,
+        "no `query jump` of docs/first-hour.md answers a feasible jump higher than the \
+         recorded {recorded:.3} m"
+    );
+    assert!(edit, "no `edit` of docs/first-hour.md wrote a BVH file");
 }
 
 /// Expands a README column token: `a_{x,y,z}`, `<e>` (the four effectors) and
@@ -141,10 +470,10 @@ fn cell_columns(cell: &str) -> Vec<String> {
         .collect()
 }
 
-/// The columns the README documents per file: rows of a table whose first cell is a
+/// The columns a page documents per file: rows of a table whose first cell is a
 /// backticked `*.parquet` name (columns in its last cell), and tables after a
 /// `<!-- columns: FILE -->` marker (columns in the first cell of each row).
-fn readme_columns(text: &str) -> BTreeMap<String, BTreeSet<String>> {
+fn documented_columns(text: &str) -> BTreeMap<String, BTreeSet<String>> {
     let mut out: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     let mut marker: Option<String> = None;
     for line in text.lines() {
@@ -195,37 +524,76 @@ fn parquet_columns(path: &Path) -> BTreeSet<String> {
 
 // See: issue 17 item 1 — columns were missing from the README's tables
 // (`clips.frame_time_s`, `handedness_ok`, `character_id`, `flight_az_median`,
-// `contacts.normal_x/y/z`).
+// `contacts.normal_x/y/z`). Issue 38 item 6 — the tables moved to docs/tables.md, which
+// also documents the query, forces and edit-plan outputs.
 #[test]
-fn readme_column_tables_are_the_written_schemas() {
-    let documented = readme_columns(&readme());
+fn docs_tables_are_the_written_schemas() {
+    let documented = documented_columns(&docs_page("tables.md"));
     let demo = Demo::build();
-    // `joints.parquet` needs `--joints`: write it beside the demo library.
-    let (code, out, err) =
-        demo.sh("stancelib frames fixtures/bvh/run_120hz_m_yup.bvh --joints --out joints");
-    assert_eq!(code, 0, "{out}{err}");
+    // Outputs the demo job does not write: `joints.parquet` (needs `--joints`), a jump
+    // query, the forces and an edit's plan, written beside the demo library.
+    for c in [
+        "stancelib frames fixtures/bvh/run_120hz_m_yup.bvh --joints --out joints",
+        "stancelib query jump --lib out/demo --height 1.2 --distance 0 --out q/jump.parquet",
+        "stancelib forces --lib out/demo --out q/forces.parquet",
+        "stancelib edit jump --lib out/demo --out q/edit.bvh",
+    ] {
+        let (code, out, err) = demo.sh(c);
+        assert_eq!(code, 0, "`{c}`: {out}{err}");
+    }
+    let lib = demo.lib();
+    let q = demo.dir.path().join("q");
     let files = [
-        ("frames.parquet", demo.lib()),
-        ("clips.parquet", demo.lib()),
-        ("contacts.parquet", demo.lib()),
-        ("stances.parquet", demo.lib()),
-        ("errors.parquet", demo.lib()),
-        ("kinematics.parquet", demo.lib()),
-        ("joints.parquet", demo.dir.path().join("joints")),
+        ("frames.parquet", lib.join("frames.parquet")),
+        ("clips.parquet", lib.join("clips.parquet")),
+        ("contacts.parquet", lib.join("contacts.parquet")),
+        ("stances.parquet", lib.join("stances.parquet")),
+        ("errors.parquet", lib.join("errors.parquet")),
+        ("kinematics.parquet", lib.join("kinematics.parquet")),
+        (
+            "kinematics_points.parquet",
+            lib.join("kinematics_points.parquet"),
+        ),
+        (
+            "joints.parquet",
+            demo.dir.path().join("joints/joints.parquet"),
+        ),
+        ("runs.parquet", lib.join("queries/runs.parquet")),
+        (
+            "jump_map.parquet",
+            lib.join("queries/jump_map/jump_map.parquet"),
+        ),
+        (
+            "jump_map_pairs.parquet",
+            lib.join("queries/jump_map/jump_map_pairs.parquet"),
+        ),
+        ("jump.parquet", q.join("jump.parquet")),
+        ("forces.parquet", q.join("forces.parquet")),
+        ("plan.parquet", q.join("edit.plan.parquet")),
     ];
-    for (file, dir) in files {
-        let written = parquet_columns(&dir.join(file));
+    for (file, path) in &files {
+        let written = parquet_columns(path);
         let doc = documented
-            .get(file)
-            .unwrap_or_else(|| panic!("the README has no column table for {file}"));
+            .get(*file)
+            .unwrap_or_else(|| panic!("docs/tables.md has no column table for {file}"));
         let missing: Vec<_> = written.difference(doc).collect();
         let extra: Vec<_> = doc.difference(&written).collect();
         assert!(
             missing.is_empty() && extra.is_empty(),
-            "{file}: written but not in the README: {missing:?}; in the README but not \
-             written: {extra:?}"
+            "{file}: written but not in docs/tables.md: {missing:?}; in docs/tables.md but \
+             not written: {extra:?}"
         );
     }
+    // And nothing documented goes unchecked.
+    let checked: BTreeSet<&str> = files.iter().map(|(f, _)| *f).collect();
+    let unchecked: Vec<_> = documented
+        .keys()
+        .filter(|f| !checked.contains(f.as_str()))
+        .collect();
+    assert!(
+        unchecked.is_empty(),
+        "docs/tables.md documents tables this test does not compare: {unchecked:?}"
+    );
 }
 
 fn manifest(lib: &Path) -> serde_json::Value {
@@ -529,8 +897,12 @@ fn query_run_png_draws_table_1_beside_the_table() {
         "stancelib query run --lib out/demo --speeds 0:6:1 --out q/runs.parquet --png q/runs.png",
     );
     assert_eq!(code, 0, "{out}{err}");
-    // Four panels since issue 37: times, peak force, friction, extension.
-    assert_eq!(png_size(&demo.dir.path().join("q/runs.png")), (1100, 1400));
+    // Four panels since issue 37 (times, peak force, friction, extension), under the
+    // legend row of issue 38.
+    assert_eq!(
+        png_size(&demo.dir.path().join("q/runs.png")),
+        stancelib::plot::runs::RUNS_PLOT_PX
+    );
     assert!(demo.dir.path().join("q/runs.parquet").is_file());
 }
 

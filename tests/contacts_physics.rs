@@ -7,7 +7,7 @@
 //! spec com-from-bvh §7.3, §7.7; `src/contacts/timing.rs`, `src/contacts/support.rs`;
 //! `data/forceplate/SOURCES.md`, `data/bvh/SOURCES.md`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde_json::Value;
 use stancelib::ingest::{ingest, ClipOutcome, ContactRun, IngestOptions};
@@ -131,24 +131,6 @@ fn subframe_contact_events_are_within_half_a_frame_of_the_force_plates() {
     );
 }
 
-/// Every `.bvh` under `dir`, sorted.
-fn bvh_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display())) {
-            let p = e.expect("dir entry").path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "bvh") {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 // See: issue 12 item 6 — a non-ballistic "flight" is a missed support.
 #[test]
 fn no_contact_interval_of_a_real_clip_is_non_ballistic() {
@@ -156,18 +138,14 @@ fn no_contact_interval_of_a_real_clip_is_non_ballistic() {
     else {
         return;
     };
-    // The shared clips whose time base is wrong (data/bvh/SOURCES.md: the backflip plays
-    // about 2× too fast, the fast run 15–25 % too fast): their flights are not ballistic
-    // at the file's clock, whatever the contacts.
-    let time_scaled = ["mass_backflip.bvh", "mass_run_fast.bvh"];
     // The one interval the speed-led rule cannot resolve (measured; see the report of
     // issue 12): CMU 01_13, a playground clip, drops from a bar at frames 1348-1367 while
     // the hands still move at 1.6-3.4 m/s and the feet at 2.4-3.1 m/s: the COM curves at
     // -6 m/s² over 0.16 s, so something still holds it, but nothing is slow. It must be
     // reported in the clip's warnings.
     let unresolved = [("bvh-bulk/cmu/01_13.bvh", 1348, 1367)];
-    let mut files = bvh_files(&data.join("bvh"));
-    files.extend(bvh_files(&data.join("bvh-bulk/cmu")));
+    let mut files = util::bvh_files(&data.join("bvh"));
+    files.extend(util::bvh_files(&data.join("bvh-bulk/cmu")));
     assert!(files.len() > 100, "only {} clips found", files.len());
     let mut out = String::new();
     let mut failures = Vec::new();
@@ -230,7 +208,7 @@ fn no_contact_interval_of_a_real_clip_is_non_ballistic() {
             .filter(|w| w.starts_with("missed support"))
             .count();
         recovered += warned;
-        let scaled = time_scaled.iter().any(|s| name.ends_with(s));
+        let scaled = util::TIME_SCALED_CLIPS.iter().any(|s| name.ends_with(s));
         outln!(out, "{name:<60} non-ballistic no-contact intervals ≥ 0.1 s: {:>2}{}; missed supports re-detected: {warned} {bad:?}", bad.len(), if scaled { " (time-scaled: not checked)" } else { "" });
         if !bad.is_empty() && !scaled {
             failures.push(format!("{name}: {bad:?}"));
@@ -519,9 +497,11 @@ fn skeleton_without_a_head_takes_its_head_from_the_neck_chain() {
     assert!(!c1.is_empty());
 }
 
-// See: issue 12 item 4 — sub-frame times on the noise-free fixtures.
+// See: issue 12 item 4 — sub-frame times on the noise-free fixtures; issue 39 item 5 — the
+// generator's feet now meet the event test at the force's first and last frame, so the
+// 15 ms the rigid feet's early touchdowns needed is gone.
 #[test]
-fn subframe_events_of_the_fixtures_are_within_a_frame_and_15_ms_of_the_truth() {
+fn subframe_events_of_the_fixtures_are_within_a_frame_of_the_truth() {
     let mut out = String::new();
     for case in &util::FIXTURES {
         let clip = generate(&util::fixture_opts(case));
@@ -543,16 +523,10 @@ fn subframe_events_of_the_fixtures_are_within_a_frame_and_15_ms_of_the_truth() {
                     .unwrap_or_else(|| {
                         panic!("{}: no detected run over {effector} {a}-{b}", case.file)
                     });
-                // One frame (two for the jump's two-footed landing after a long flight, spec
-                // §7.3), plus 15 ms: the generator's swing foot comes down at 2.0 m/s
-                // vertically until it is planted, so it passes the 3 cm event height
-                // 0.03/2.04 = 15 ms before the contact (a real foot slows down first).
-                let n_frames = if case.file.starts_with("jump") {
-                    2.0
-                } else {
-                    1.0
-                };
-                let tol = n_frames * dt + 0.015 + 1e-9;
+                // One frame: the feet meet the event test (3 cm, spec §7.3) exactly at
+                // the force's first and last frame (synth module docs, the sole's give);
+                // 1e-9 s: round-off.
+                let tol = dt + 1e-9;
                 for (det, truth, kind) in [
                     (r.td_time_s, t_td, "touchdown"),
                     (r.lo_time_s, t_lo, "liftoff"),
@@ -669,12 +643,12 @@ fn hidden_flights_open_jogs_and_leave_walks() {
     })
     .collect();
     walks.extend(
-        bvh_files(&data.join("bvh").join("walk"))
+        util::bvh_files(&data.join("bvh").join("walk"))
             .into_iter()
             .map(|p| (p, 70.0)),
     );
     walks.extend(
-        bvh_files(&data.join("bvh-bulk").join("cmu"))
+        util::bvh_files(&data.join("bvh-bulk").join("cmu"))
             .into_iter()
             .filter(|p| {
                 let n = p.file_name().unwrap().to_string_lossy();

@@ -263,12 +263,10 @@ fn fixture_stances_match_the_true_contact_runs() {
                 b - a,
                 err_dt / l.dt
             );
-            // One frame time: the true force starts and ends on a frame (closed flag run),
-            // the half-frame convention (spec §1 step 5) adds half a frame at each contact
-            // edge; plus 15 ms per edge: the sub-frame events (contacts::timing) fire where
-            // a foot point crosses 3 cm, and the generator's swing foot lands at 2 m/s
-            // without slowing, so it crosses ~15 ms early; 1e-9 s: round-off.
-            if err_dt.abs() > l.dt + 2.0 * SUBFRAME_GENERATOR_LEAD_S + 1e-9 {
+            // One frame time: the stance edges are sub-frame events (contacts::timing),
+            // met on the generator's feet at the force's first and last frame, or the
+            // half-frame edges (spec §1 step 5) of a quiet split; 1e-9 s: round-off.
+            if err_dt.abs() > l.dt + 1e-9 {
                 failures.push(format!(
                     "{}: Δt {:.5} s vs true {:.5} s",
                     s.stance_id,
@@ -332,9 +330,6 @@ fn param_tolerances(rate: f64) -> (f64, f64, f64) {
         spec.2.min(1.5 * measured.2),
     )
 }
-
-/// How early the sub-frame events fire on the generator's clips, per edge (s).
-const SUBFRAME_GENERATOR_LEAD_S: f64 = 0.015;
 
 /// Worst |Δv| (m/s: vs, ve, vp), |Δz| (m: zs, ze), |Δx| (m) measured on the noise-free run
 /// fixtures (printed by the test), rounded up. The model-consistent `ze` and `x` (spec §3)
@@ -459,6 +454,95 @@ fn run_stance_parameters_match_the_ballistic_truth() {
         );
         if checked == 0 {
             failures.push(format!("{}: no stance with flights on both sides", c.file));
+        }
+    }
+    print!("{out}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Generated runs beyond the fixtures, at the frame rates where the whole-frame phases fall
+/// differently (Hz): the edges of the synth tests' range and rates whose stance is an odd
+/// number of frames.
+const EXTRA_RUN_RATES_HZ: [f64; 5] = [24.0, 50.0, 100.0, 240.0, 1000.0];
+
+// See: issue 39 item 5 — sub-frame stance durations 12–20 ms (1.2–1.4 frames at 60 and
+// 120 Hz) longer than the generator's truth on every running stance: its rigid feet stopped
+// dead at full swing speed on their resting height, so the event test (a captured foot's
+// state at the plates' first and last 20 N: within 3 cm, below 3 and 2 m/s) was met a frame
+// before the force began and a third of a frame after it ended.
+#[test]
+fn run_stance_durations_are_within_a_frame_of_the_truth() {
+    use stancelib::ingest::IngestOptions;
+    use stancelib::synth::SynthOptions;
+    let mut cases: Vec<(String, SynthClip, stancelib::bvh::Bvh)> = util::FIXTURES
+        .iter()
+        .filter(|c| c.motion == SynthMotion::Run)
+        .map(|c| {
+            let bvh = stancelib::bvh::parse_file(&util::fixture_path(c)).expect("fixture parses");
+            (c.file.to_string(), generate(&util::fixture_opts(c)), bvh)
+        })
+        .collect();
+    for rate in EXTRA_RUN_RATES_HZ {
+        let clip = generate(&SynthOptions {
+            frame_rate_hz: rate,
+            duration_s: 2.0,
+            ..Default::default()
+        });
+        let bvh = stancelib::bvh::parse_reader(clip.bvh.as_bytes()).expect("generated BVH");
+        cases.push((format!("run at {rate} Hz (generated)"), clip, bvh));
+    }
+    let mut out = String::new();
+    let mut failures = Vec::new();
+    for (name, truth, bvh) in &cases {
+        let (summary, frames, contacts) = util::ingest_body(bvh, &IngestOptions::default(), name);
+        let dt = summary.frame_time_s;
+        let (stances, _) = build_clip(
+            name,
+            &frames,
+            &summary,
+            &contacts,
+            DEFAULT_MASS_KG,
+            &StanceOptions::default(),
+        );
+        let true_runs = true_stances(truth, dt);
+        let mut worst: f64 = 0.0;
+        let mut checked = 0;
+        for s in &stances {
+            // Every running stance with a contact event at both ends (not cut by the clip).
+            if s.boundary_start != Boundary::Flight || s.boundary_end != Boundary::Flight {
+                continue;
+            }
+            let Some(t) = true_runs
+                .iter()
+                .find(|t| t.k0 as i64 <= s.last_frame && t.k1 as i64 >= s.first_frame)
+            else {
+                failures.push(format!("{}: no true contact run", s.stance_id));
+                continue;
+            };
+            let err = s.dt_s - (t.t1 - t.t0);
+            worst = worst.max(err.abs() / dt);
+            checked += 1;
+            // The target of issue 39: within one frame; 1e-9 s: round-off.
+            if err.abs() > dt + 1e-9 {
+                failures.push(format!(
+                    "{}: duration {:.5} s, truth {:.5} s ({:+.2} frames)",
+                    s.stance_id,
+                    s.dt_s,
+                    t.t1 - t.t0,
+                    err / dt
+                ));
+            }
+        }
+        outln!(
+            out,
+            "{name:<28} {checked} running stances: worst |duration − truth| {:.4} ms ({worst:.4} frames of {:.2} ms)",
+            worst * dt * 1e3,
+            dt * 1e3
+        );
+        if checked == 0 {
+            failures.push(format!(
+                "{name}: no running stance with flights on both sides"
+            ));
         }
     }
     print!("{out}");

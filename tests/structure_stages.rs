@@ -64,6 +64,7 @@ fn contact_stage_entry_points_reproduce_the_ingest_contacts() {
             [pos(1), frames.toe[1].clone()],
         ],
         hands: [None, None],
+        toe_estimated: [0, 1].map(|k| summary.toe_tip_rule[k].as_deref() == Some("fallback")),
     };
     let leg_m = summary.leg_length_m.unwrap();
     let tracks = contacts::tracks(points, leg_m, summary.frame_time_s, &c);

@@ -15,6 +15,9 @@
 //! - `invariance`: translating and turning a real clip moves its COM alike, contacts unchanged.
 //! - `contacts_physics`: sub-frame contact events against the plates, no non-ballistic
 //!   no-contact interval on real clips, a stance on a platform, a skeleton without a head.
+//! - `held_out_jumps`: issue 39 item 4 — real jumps rewritten Z-up, in inches, without End
+//!   Sites or toe joints: landings within a frame of the COM's deceleration and the plates,
+//!   no contact at an apex, flights within 3 m/s² of −g.
 //! - `multicontact`: static (elevated) hand and foot contacts on the climbing clip.
 //! - `forceplate`: contact events and kinematic force against the shared force-plate clips.
 //!
@@ -63,12 +66,18 @@
 //!
 //! # Command line and documentation
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
-//! - `analyst`: issue 17 — the README's demo commands run and its column tables are the
-//!   written schemas; manifest date and command line, query outputs naming their library,
-//!   `info`, negative numbers, `--help` limits, `--quiet` and `--json`.
+//! - `analyst`: issue 17 — the README's demo commands run and answer with numbers (issue 38
+//!   item 6), the README has at most 300 lines, `docs/first-hour.md` runs as written and
+//!   reaches its answers, `docs/tables.md` is the written schemas; manifest date and
+//!   command line, query outputs naming their library, `info`, negative numbers, `--help`
+//!   limits, `--quiet` and `--json`.
 //! - `catalogue`: issue 38 item 2 — `list`: characters, run cycles (against `query run`), jumps.
 //! - `duplicates`: issue 38 item 3 — copied clips reported by `info` and answering once;
 //!   clips a query leaves out named, `--keep-left-out`.
+//! - `masses`: issue 38 item 4 — `--masses` (and the pipeline key): a mass per clip in
+//!   `clips.parquet` and `info`, the default mass a warning, bad tables refused.
+//! - `pictures`: issue 38 item 5 — every picture kind written by its command of
+//!   `docs/pictures.md`, its example there, small.
 //!
 //! # Safety (issue 11)
 //! - `safety_inputs`: reader and numeric items: SG window bound, no silent NaN, 100k-joint
@@ -76,10 +85,14 @@
 //! - `safety_messages`: escaped short error messages, the line bound, CR-only and empty files.
 //! - `safety_limits`: item 6: every documented work limit refused before work (exit 2,
 //!   field and limit named).
+//! - `safety_numbers`: issue 40 item 5: implausible segments, non-finite stance rows and
+//!   out-of-bound 2PAC inputs are errors, never inf or NaN written with status ok.
 //! - `safety_options`: items 10–12: pipelines validated before the library is touched, no
 //!   option accepted and ignored, duplicate JSON/TOML keys refused.
 //! - `safety_outputs`: `--out` never destroys what the tool did not write; input links,
 //!   cycles and special files; per-input errors; stale temporaries; the build lock.
+//! - `safety_reuse`: issue 40 items 1, 4, 7: incremental builds and merges check what they
+//!   reuse against the manifest's content hashes and rows per clip; `frames` never writes into a library.
 //! - `safety_side_inputs`: issue 40 items 2, 3, 8, 10: side inputs as BVH inputs, clip budget, closed stdout, atomic `synth`.
 //!
 //! # Structure (issue 13)
@@ -105,6 +118,7 @@ mod props;
 mod contacts_physics;
 mod fixtures;
 mod forceplate;
+mod held_out_jumps;
 mod invariance;
 mod multicontact;
 mod real_data;
@@ -134,12 +148,17 @@ mod analyst;
 mod catalogue;
 mod cli;
 mod duplicates;
+mod masses;
+mod pictures;
+mod verdicts;
 // Safety
 mod safety_inputs;
 mod safety_limits;
 mod safety_messages;
+mod safety_numbers;
 mod safety_options;
 mod safety_outputs;
+mod safety_reuse;
 mod safety_side_inputs;
 // Structure (issue 13)
 mod structure_edges;

@@ -69,7 +69,7 @@ fn equilibrium_reference_case_r2() {
     assert!((margin[0].unwrap() - 38.05).abs() < 0.01, "{margin:?}");
     assert!((margin[1].unwrap() + 77546.0).abs() < 1.0, "{margin:?}");
     assert_eq!(t.bools("in_equilibrium").unwrap(), [true, false]);
-    assert_eq!(t.strings("status").unwrap(), ["ok", "ok"]);
+    assert_eq!(t.strings("status").unwrap(), ["solved", "solved"]);
     assert_eq!(t.f64s("z_m").unwrap(), [1.0, 1.0]);
 }
 
@@ -93,7 +93,7 @@ fn equilibrium_single_point_contact_only_on_its_vertical() {
     );
     assert_eq!(
         t.strings("status").unwrap(),
-        ["ok", "infeasible", "infeasible"]
+        ["solved", "infeasible", "infeasible"]
     );
     assert_eq!(t.bools("in_equilibrium").unwrap(), [true, false, false]);
     let m = t.opt_f64("margin_n").unwrap();
@@ -195,7 +195,7 @@ fn twopac_flat_walk_outputs() {
         assert!((xyz(&traj, n - 1)[k] - xyz(&phases, phases.height() - 1)[k]).abs() < 1e-9);
         assert!(vel(0)[k].abs() < 1e-9 && vel(n - 1)[k].abs() < 1e-9);
     }
-    // The data clock: starts at the middle of phase 0 (0.2 s), ends at the last mid.
+    // The data clock: starts at the middle of phase 0, ends at the middle of the last.
     let durs: Vec<f64> = json["phases"]
         .as_array()
         .unwrap()
@@ -561,4 +561,149 @@ fn twopac_plans_a_recorded_walk_with_the_library_polytopes() {
     }
     let no_lib = fails(&["twopac", "--clip", &walk_bvh, "--out", &s(&out)]);
     assert!(no_lib.contains("--lib"), "{no_lib}");
+}
+
+// See: issue 38 item 7 — the bundled `walk_flat.json` failed its own dynamic validation
+// (227 of 321 samples, "max s* 238.665 N") and nothing said why. Every bundled phases
+// file must now pass it, as `twopac` prints and `validation.parquet` stores.
+#[test]
+fn issue38_item7_bundled_twopac_examples_pass_their_own_validation() {
+    let mut n = 0;
+    for entry in std::fs::read_dir(fixture("")).unwrap() {
+        let path = entry.unwrap().path();
+        let is_phases = path.extension().is_some_and(|e| e == "json")
+            && read_json(&path)["schema"] == "stancelib.twopac.phases/1";
+        if !is_phases {
+            continue;
+        }
+        let (_d, out, printed) = twopac(&path);
+        assert!(
+            printed.contains("2PAC curve: dynamically valid at all"),
+            "{}:\n{printed}",
+            path.display()
+        );
+        // A valid curve says how much room it leaves (the walk: none, on the feet's edge).
+        assert!(printed.contains("smallest robustness margin"), "{printed}");
+        let v = Table::open(&out.join("validation.parquet")).unwrap();
+        assert_eq!(v.strings("trajectory").unwrap()[0], "2pac");
+        assert!(v.bools("trajectory_valid").unwrap()[0], "{printed}");
+        // The baseline stops at every knot: when it fails, the terminal says why.
+        if !v.bools("trajectory_valid").unwrap()[1] {
+            assert!(printed.contains("why: "), "{printed}");
+        }
+        n += 1;
+    }
+    assert!(n >= 2, "walk_flat.json and hand_wall.json are phases files");
+}
+
+// See: issue 38 item 7 — the walk as first bundled (pasted in as
+// `fixtures/twopac/regressions/walk_flat_issue38.json`: 0.2 s double support, feet 20 cm
+// apart) still fails, and the output says why in words: the COM off the single foot's
+// support (by how many cm) and too fast (|c̈|), in which phases, and the worst s*.
+#[test]
+fn issue38_item7_an_invalid_trajectory_says_why() {
+    let input = fixture("regressions/walk_flat_issue38.json");
+    let (_d, out, printed) = twopac(&input);
+    let curve = printed
+        .lines()
+        .skip_while(|l| !l.contains("2PAC curve"))
+        .take(2)
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(
+        curve.contains("NOT dynamically valid (94 of 321 samples valid"),
+        "{printed}"
+    );
+    for words in [
+        "why: 227 of 321 samples fail",
+        "174 sample(s): the COM is outside the region where the active contacts hold it at rest, up to 6.0 cm outside",
+        "53 sample(s): the contacts hold the COM at rest there but not with its acceleration",
+        "phases 1 [right_foot]",
+        "a contact would have to pull with s* = 238.7 N",
+    ] {
+        assert!(curve.contains(words), "missing {words:?} in\n{curve}");
+    }
+    // The picture's verdict line says the same (its text is not readable back from the
+    // PNG; the picture is written and larger than an empty one).
+    let png = std::fs::read(out.join("trajectory.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
+}
+
+// See: issue 38 item 7 — "status ok" of `equilibrium` meant "the solver ran", also for a
+// COM far outside the support; the status is now `solved`, and the summary counts the
+// states in equilibrium and says why the others are not.
+#[test]
+fn issue38_item7_equilibrium_status_says_how_and_the_summary_says_whether() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, r) = (dir.path().join("p.parquet"), dir.path().join("r.parquet"));
+    // Spec §9 R2: above the centre (in), 1000 m/s² sideways (out, margin < 0).
+    write_points(
+        &p,
+        &[
+            ("x_m", vec![0.0, 0.0]),
+            ("y_m", vec![0.0, 0.0]),
+            ("z_m", vec![1.0, 1.0]),
+            ("ax_mps2", vec![0.0, 1000.0]),
+        ],
+    );
+    let contacts = s(&fixture("r2_contacts.json"));
+    let printed = ok(&[
+        "equilibrium",
+        "--contacts",
+        &contacts,
+        "--points",
+        &s(&p),
+        "--out",
+        &s(&r),
+    ]);
+    let t = Table::open(&r).unwrap();
+    assert_eq!(t.strings("status").unwrap(), ["solved", "solved"]);
+    assert_eq!(t.bools("in_equilibrium").unwrap(), [true, false]);
+    assert!(
+        printed
+            .contains("1 of 2 COM state(s) in equilibrium; not: 1 outside the region (margin ≤ 0)"),
+        "{printed}"
+    );
+    assert!(!printed.contains("status ok"), "{printed}");
+}
+
+// See: issue 38 item 7 — `equilibrium --png` ran 8 s without a word while reporting the
+// 0.46 s of the verdicts. The summary now times the picture too, and the slice solves
+// LPs only near the region (a handful of the 6,400 cells for four points).
+#[test]
+fn issue38_item7_equilibrium_png_time_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, r, png) = (
+        dir.path().join("p.parquet"),
+        dir.path().join("r.parquet"),
+        dir.path().join("r.png"),
+    );
+    write_points(
+        &p,
+        &[
+            ("x_m", vec![0.0, 0.3]),
+            ("y_m", vec![0.0, 0.0]),
+            ("z_m", vec![0.9, 0.9]),
+        ],
+    );
+    let printed = ok(&[
+        "equilibrium",
+        "--contacts",
+        &s(&fixture("r2_contacts.json")),
+        "--points",
+        &s(&p),
+        "--out",
+        &s(&r),
+        "--png",
+        &s(&png),
+    ]);
+    let slice = printed
+        .split("region slice 6400 cells (")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{printed}"));
+    let lps: usize = slice.split(' ').next().unwrap().parse().unwrap();
+    // The 0.1 × 0.2 m rectangle and a cell diagonal around it: well under a tenth.
+    assert!(lps > 0 && lps < 640, "{lps} LPs: {printed}");
+    assert!(slice.contains(" s, total "), "{printed}");
+    assert!(png.is_file());
 }

@@ -526,8 +526,12 @@ pub struct RunQueryArgs {
     /// Output Parquet file.
     #[arg(long)]
     pub out: PathBuf,
-    /// Also draw Table 1 as a figure (PNG): β_h, mu_min and the leg extension against
-    /// speed, with the limits dashed and infeasible speeds marked.
+    /// Also draw Table 1 as a figure (PNG) of four panels against the target speed: (a)
+    /// each stance's contact time and step period, (b) the cycle's peak force against
+    /// F_max, (c) the friction it needs, mu_min, against μ, (d) the leg extension extremes
+    /// against χ_min and χ_max; one colour and marker per cycle, the limits dashed, each
+    /// infeasible speed marked on the panel of the limit it violates, and under the title
+    /// the speeds at which every cycle is feasible.
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// How contact time and step period change with speed: `auto` (the character's own
@@ -539,6 +543,11 @@ pub struct RunQueryArgs {
     /// a clip whose flights say its time base is wrong); they are named on stderr.
     #[arg(long = "keep-left-out")]
     pub keep_left_out: bool,
+    /// Print one answer in full: the cycle whose first stance is this id (at each speed),
+    /// with its gait-law times and, per stance, its scaling and every limit with value,
+    /// limit and margin.
+    #[arg(long, value_name = "STANCE_ID")]
+    pub explain: Option<String>,
 }
 
 impl RunQueryArgs {
@@ -561,13 +570,30 @@ pub struct JumpArgs {
     /// Library folder.
     #[arg(long)]
     pub lib: PathBuf,
-    /// Flight apex height above the liftoff contact, m.
-    #[arg(long, allow_hyphen_values = true)]
-    pub height: f64,
+    /// Flight apex height above the liftoff contact, m (the same for every pair).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        required_unless_present = "height_scale"
+    )]
+    pub height: Option<f64>,
+    /// Each pair's own recorded apex height times this (e.g. 1.1: 10 % higher than
+    /// recorded), instead of `--height`.
+    #[arg(long = "height-scale", conflicts_with = "height")]
+    pub height_scale: Option<f64>,
     /// Jump distance (liftoff start apex to landing end apex, along the heading), m;
-    /// negative is backwards.
+    /// negative is backwards. Needed with `--height`.
     #[arg(long, allow_hyphen_values = true)]
-    pub distance: f64,
+    pub distance: Option<f64>,
+    /// Each pair's own recorded distance times this, instead of `--distance` (default 1
+    /// with `--height-scale`: the recorded distance).
+    #[arg(long = "distance-scale", conflicts_with = "distance")]
+    pub distance_scale: Option<f64>,
+    /// Print one answer in full: a rank of the printed table, or a stance id (the
+    /// best-ranked pair with that liftoff or landing), with the flight and, per side, its
+    /// scaling and every limit with value, limit and margin.
+    #[arg(long, value_name = "RANK|STANCE_ID")]
+    pub explain: Option<String>,
     /// Rows printed (the file has every pair).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
@@ -605,6 +631,10 @@ pub struct MapJumpsArgs {
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also draw `jump_map_agreement.png`: where the fast filters (paper eq 10, 12) and the
+    /// exact check agree (a developer diagnostic; the IoU is in `jump_map.json` anyway).
+    #[arg(long)]
+    pub diagnostics: bool,
 }
 
 impl MapJumpsArgs {
@@ -639,6 +669,10 @@ pub struct BodyArgs {
     /// Body mass in kg (default: body file, else 70).
     #[arg(long)]
     pub mass: Option<f64>,
+    /// Per-clip body masses: a CSV table `clip,mass_kg[,sex]` (clip name or glob; the first
+    /// matching row wins, over --mass). A clip without a mass gets 70 kg and a warning.
+    #[arg(long)]
+    pub masses: Option<PathBuf>,
     /// File unit: m, cm, mm, in, cmu, or metres per file unit (default: detected).
     #[arg(long)]
     pub unit: Option<String>,
@@ -680,12 +714,11 @@ impl BodyArgs {
     /// [`max_threads`](crate::pipeline::batch::max_threads).
     pub fn overrides(&self) -> anyhow::Result<Overrides> {
         crate::pipeline::batch::check_threads("--threads", self.threads)?;
-        let mass_kg = match self.mass {
-            Some(m) if !(m.is_finite() && m > 0.0) => {
-                anyhow::bail!("--mass must be a positive number of kg, found {m}")
-            }
-            m => m,
-        };
+        if let Some(m) = self.mass {
+            crate::ingest::masses::check_body_mass(m)
+                .map_err(|e| anyhow::anyhow!("--mass: {e}"))?;
+        }
+        let mass_kg = self.mass;
         let unit_m = match &self.unit {
             Some(u) => Some(parse_unit(u).ok_or_else(|| {
                 anyhow::anyhow!("--unit: '{u}' is not m, cm, mm, in, cmu or a positive number")
@@ -700,6 +733,7 @@ impl BodyArgs {
             static_contacts: self.static_contacts,
             no_hands: self.no_hands,
             joints: self.joints,
+            masses: self.masses.clone(),
         })
     }
 }
@@ -887,8 +921,9 @@ pub struct PlotStanceArgs {
     /// `f{x,y,z}_n`; N, the BVH file's axes).
     #[arg(long)]
     pub plates: Option<PathBuf>,
-    /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1].
-    #[arg(long = "active-set", default_value_t = crate::constraints::ACTIVE_FRACTION)]
+    /// Shade the active set `f_v ≥ FRACTION · max f_v` of the model, FRACTION in [0, 1]
+    /// (default: the queries' friction check, whose `mu_req_robust` the plot shows).
+    #[arg(long = "active-set", default_value_t = crate::query::feasibility::DEFAULT_QUERY_ACTIVE_FRACTION)]
     pub active_set: f64,
     /// Output PNG file.
     #[arg(long)]

@@ -4,7 +4,8 @@
 //! # Model
 //! ```text
 //! run a..b:  t_TD = t[a] − dt/2 (null at the first kept frame), t_LO = t[b] + dt/2 (null at the last)
-//!            td_time, lo_time: feet, sub-frame times (contacts::timing); hands, t_TD and t_LO
+//!            td_time, lo_time: feet, sub-frame times (contacts::timing), or the touchdown
+//!            of a landing found from the foot's motion (contacts::landing); hands, t_TD and t_LO
 //! origin    = mean of the effector's contact points over the run
 //! yaw       = atan2 of the mean horizontal ankle→toe (wrist→MET3) direction; facing from the
 //!             hips when that is vertical
@@ -118,9 +119,12 @@ pub fn collect(
                 last_frame: frame[b],
                 t_td_s: (a > 0).then(|| time_s[a] - dt / 2.0),
                 t_lo_s: (b + 1 < n).then(|| time_s[b] + dt / 2.0),
-                td_time_s: (a > 0).then(|| match e < 2 && !own.is_empty() {
-                    true => timing::touchdown(own, time_s, a, b, prev_end),
-                    false => time_s[a] - dt / 2.0,
+                td_time_s: (a > 0).then(|| match (timeline.landing_s[e][a], e < 2) {
+                    (Some(t), _) => t,
+                    (None, true) if !own.is_empty() => {
+                        timing::touchdown(own, time_s, a, b, prev_end)
+                    }
+                    _ => time_s[a] - dt / 2.0,
                 }),
                 lo_time_s: (b + 1 < n).then(|| match e < 2 && !own.is_empty() {
                     true => timing::liftoff(own, time_s, a, b, next_start),

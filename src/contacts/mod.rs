@@ -5,9 +5,13 @@
 //! ```text
 //! EffectorPoints ─ tracks ─▶ ContactTracks ─ detect ─▶ ContactTimeline
 //!     ─ runs_and_flights ─▶ contact runs (contact_runs::collect, sub-frame events: timing)
+//!                           landings of estimated toe tips from the foot's motion (landing)
 //!                           physics cross-check (support::cross_check, speed-led rule)
+//!                           hidden flights of jogs (hidden_flight)
 //!                           flights of the no-contact runs (flights, §7.7)
 //! ```
+//! The last four steps are departures from spec §7.3 that check the contacts against the
+//! body's physics; `support_check` (on by default) turns them on.
 //! Data flow: contact-point trajectories (metres, Z up) → [`floor`] heights →
 //! [`mod@detect`] flags per effector → [`flight`] diagnostics of the no-contact runs.
 //!
@@ -19,6 +23,7 @@ pub mod detect;
 pub mod flight;
 pub mod floor;
 pub mod hidden_flight;
+pub mod landing;
 pub mod options;
 pub mod support;
 pub mod timeline;
@@ -62,9 +67,10 @@ pub struct ContactEvents {
     pub warnings: Vec<String>,
 }
 
-/// Contact runs and flights of a detected timeline; with `opts.support_check`, the physics
-/// cross-check first ([`support::cross_check`]: it may add speed-led frames to `timeline`),
-/// and a warning for every missed support it could not resolve.
+/// Contact runs and flights of a detected timeline; with `opts.support_check`, first the
+/// landings of feet with an estimated toe tip ([`landing`]) and the physics cross-check
+/// ([`support::cross_check`]: it may add speed-led frames to `timeline`), and a warning for
+/// every missed support it could not resolve.
 pub fn runs_and_flights(
     tracks: &ContactTracks,
     timeline: &mut ContactTimeline,
@@ -74,7 +80,10 @@ pub fn runs_and_flights(
     let mut runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
     let mut warnings = Vec::new();
     if opts.support_check {
+        find_landings(tracks, timeline, motion, opts, &mut runs_out);
         warnings = support::cross_check(tracks, timeline, motion, opts, &mut runs_out);
+        // Again for the speed-led runs: a landing the height rule lost entirely.
+        find_landings(tracks, timeline, motion, opts, &mut runs_out);
         open_hidden_flights(tracks, timeline, motion, opts, &mut runs_out);
     }
     let flights = flight::flights(&timeline.contact, &runs_out, motion);
@@ -82,7 +91,7 @@ pub fn runs_and_flights(
         for f in flights.iter().filter(|f| support::is_missed_support(f)) {
             warnings.push(support::missed_support_warning(
                 f,
-                "no support found (no foot or hand slow enough)",
+                "no support found (no foot or hand slow enough where the COM is held up)",
             ));
         }
     }
@@ -90,6 +99,22 @@ pub fn runs_and_flights(
         runs: runs_out,
         flights,
         warnings,
+    }
+}
+
+/// The landings of feet with an estimated toe tip ([`landing`]): each found starts its run
+/// earlier, and `runs_out` is collected again.
+fn find_landings(
+    tracks: &ContactTracks,
+    timeline: &mut ContactTimeline,
+    motion: &ClipMotion,
+    opts: &ContactOptions,
+    runs_out: &mut Vec<ContactRun>,
+) {
+    let landings = landing::find(tracks, timeline, motion, runs_out, opts.foot.h_on);
+    if !landings.is_empty() {
+        landing::apply(timeline, &landings);
+        *runs_out = contact_runs::collect(tracks, timeline, motion, opts.static_mode);
     }
 }
 

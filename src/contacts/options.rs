@@ -65,7 +65,9 @@ pub struct ContactOptions {
     /// Local floor half-window, s.
     pub floor_window_s: f64,
     /// Physics cross-check: re-detect the support of a non-ballistic no-contact interval
-    /// with the speed-led rule ([`crate::contacts::support`]); on by default.
+    /// with the speed-led rule ([`crate::contacts::support`]), open the hidden flights of
+    /// jogs ([`crate::contacts::hidden_flight`]) and find the landings of feet with an
+    /// estimated toe tip from their own motion ([`crate::contacts::landing`]); on by default.
     pub support_check: bool,
 }
 

@@ -32,6 +32,9 @@ pub struct EffectorPoints {
     pub feet: [[Vec<V3>; 2]; 2],
     /// Wrist centre and MET3 of the left and right hand; `None` without that arm.
     pub hands: [Option<[Vec<V3>; 2]>; 2],
+    /// Per foot: its toe tip is the ingest's fallback estimate (spec com-from-bvh §4.3), a
+    /// fixed offset from the ankle that never pitches with the foot.
+    pub toe_estimated: [bool; 2],
 }
 
 /// What the detector sees of a clip: the local floor and, per effector
@@ -47,6 +50,10 @@ pub struct ContactTracks {
     pub points: [Vec<Vec<V3>>; 4],
     /// Frame time, s.
     pub dt: f64,
+    /// `L_leg / NOMINAL_LEG_M`: the scale of the clearances and height bounds.
+    pub leg_scale: f64,
+    /// Per foot: its toe tip is estimated ([`EffectorPoints::toe_estimated`]).
+    pub toe_estimated: [bool; 2],
 }
 
 impl ContactTracks {
@@ -69,6 +76,9 @@ pub struct ContactTimeline {
     pub surface_z: [Vec<Option<f64>>; 4],
     /// Found by the speed-led rule of the physics cross-check ([`super::support`]).
     pub speed_led: [Vec<bool>; 4],
+    /// On the first frame of a run that a foot's own motion started
+    /// ([`super::landing`]): its sub-frame touchdown, s.
+    pub landing_s: [Vec<Option<f64>>; 4],
 }
 
 fn heights_z(v: &[V3]) -> Vec<f64> {
@@ -88,6 +98,7 @@ pub fn tracks(pts: EffectorPoints, leg_m: f64, dt: f64, opts: &ContactOptions) -
     };
     let mut tracks: [Vec<PointTrack>; 4] = Default::default();
     let mut points: [Vec<Vec<V3>>; 4] = Default::default();
+    let toe_estimated = pts.toe_estimated;
     let [feet_l, feet_r] = pts.feet;
     for (k, [ankle, toe]) in [feet_l, feet_r].into_iter().enumerate() {
         let foot = |p: &[V3], clearance: f64| {
@@ -118,12 +129,15 @@ pub fn tracks(pts: EffectorPoints, leg_m: f64, dt: f64, opts: &ContactOptions) -
         tracks,
         points,
         dt,
+        leg_scale: sc,
+        toe_estimated,
     }
 }
 
 /// The contact timeline of a clip (§7.3, §7.4, §7.6): hysteresis with gap filling and
 /// minimum durations per effector, and the static mode when `opts.static_mode`. No
-/// speed-led frames yet ([`super::support::cross_check`] adds them).
+/// speed-led frames or landings from the foot's motion yet ([`super::support::cross_check`]
+/// and [`super::landing`] add them).
 pub fn detect(tracks: &ContactTracks, opts: &ContactOptions) -> ContactTimeline {
     let n = tracks.n_frames();
     let rate = 1.0 / tracks.dt;
@@ -155,6 +169,7 @@ pub fn detect(tracks: &ContactTracks, opts: &ContactOptions) -> ContactTimeline 
         static_contact: stat,
         surface_z: surf,
         speed_led: std::array::from_fn(|_| vec![false; n]),
+        landing_s: std::array::from_fn(|_| vec![None; n]),
     }
 }
 

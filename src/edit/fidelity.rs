@@ -492,7 +492,7 @@ impl Fidelity {
         format!(
             "trunk lean {:.1}…{:.1}° (recorded {:.1}…{:.1}°), knee flexion {:.1}…{:.1}° \
              (recorded {:.1}…{:.1}°){flights}, root acceleration ≤ {:.1} g (recorded {:.1} g), \
-             {} frame(s) above {:.1} g where the recording is not",
+             {} frame(s) above {:.1} g where the recording is not{}",
             self.lean_edited_deg[0],
             self.lean_edited_deg[1],
             self.lean_recorded_deg[0],
@@ -504,7 +504,12 @@ impl Fidelity {
             self.root_accel_max_mps2 / G_MPS2,
             self.source_root_accel_max_mps2 / G_MPS2,
             self.spikes.len(),
-            self.options.spike_mps2 / G_MPS2
+            self.options.spike_mps2 / G_MPS2,
+            if self.options.spikes {
+                ""
+            } else {
+                " (reported, not checked for a run: FidelityOptions::run)"
+            }
         )
     }
 }

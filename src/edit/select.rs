@@ -420,7 +420,10 @@ pub fn given_pair(lib: &StanceLibrary, p: &str) -> Result<(usize, usize)> {
         lib.stances
             .iter()
             .position(|s| s.stance_id == id)
-            .ok_or_else(|| bad(format!("unknown stance {id}")))
+            .ok_or_else(|| {
+                let held = lib.stances.iter().map(|s| s.stance_id.as_str());
+                bad(crate::stances::ids::unknown_stance_message(id, held))
+            })
     };
     // Stance ids hold ':' themselves (<clip>:<label>:<frame>): split at the middle ':'.
     let parts: Vec<&str> = p.split(':').collect();

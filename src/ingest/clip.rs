@@ -62,7 +62,9 @@ pub(super) fn run(
 
     // Contacts (§7), flights (§7.7) and the physics cross-check.
     let c = &opts.contacts;
-    let effector = effector_points(lm, &frames, &toe);
+    let fallback = |r: &Option<String>| r.as_deref() == Some(ToeTipRule::Fallback.as_str());
+    let toe_estimated = [0, 1].map(|k| fallback(&summary.toe_tip_rule[k]));
+    let effector = effector_points(lm, &frames, &toe, toe_estimated);
     let effector_pos = effector_positions(&effector);
     let tracks = contacts::tracks(effector, body.leg_m, dt, c);
     let mut timeline = contacts::detect(&tracks, c);
@@ -199,7 +201,12 @@ fn com_derivatives(com_pos: &[V3], dt: f64, skip: usize) -> Result<(Vec<V3>, Vec
 
 /// The contact points of every effector: ankle and toe tip per foot; wrist and MET3 per
 /// hand with an arm.
-fn effector_points(lm: &Landmarks, frames: &[&[V3]], toe: &[Vec<V3>; 2]) -> EffectorPoints {
+fn effector_points(
+    lm: &Landmarks,
+    frames: &[&[V3]],
+    toe: &[Vec<V3>; 2],
+    toe_estimated: [bool; 2],
+) -> EffectorPoints {
     let track = |p: &dyn Fn(&[V3]) -> V3| -> Vec<V3> { frames.iter().map(|fp| p(fp)).collect() };
     let foot = |k: usize, s: Side| [track(&|fp| fp[lm.limb(s).ankle]), toe[k].clone()];
     let hand = |s: Side| {
@@ -211,6 +218,7 @@ fn effector_points(lm: &Landmarks, frames: &[&[V3]], toe: &[Vec<V3>; 2]) -> Effe
     EffectorPoints {
         feet: [foot(0, Side::L), foot(1, Side::R)],
         hands: [hand(Side::L), hand(Side::R)],
+        toe_estimated,
     }
 }
 

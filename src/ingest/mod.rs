@@ -17,6 +17,7 @@
 
 pub mod body;
 mod clip;
+pub mod masses;
 mod points;
 
 use std::collections::BTreeMap;
@@ -64,6 +65,37 @@ pub struct IngestOptions {
     pub joints: bool,
     /// Character id from the body file (`id`); derived from the skeleton when `None`.
     pub character_id: Option<String>,
+    /// Whether `mass_kg` was given (`--mass`, a body or pipeline `mass_kg`); the default
+    /// mass is a warning on every clip that no masses row names.
+    pub mass_given: bool,
+    /// Per-clip masses (`--masses`, pipeline `masses`), first over `mass_kg`.
+    #[serde(serialize_with = "masses::serialize_rows")]
+    pub masses: Option<std::sync::Arc<masses::MassTable>>,
+}
+
+/// Where a clip's body mass came from (`clips.parquet` `mass_source`).
+pub const MASS_SOURCE_DEFAULT: &str = "default";
+/// `--mass` or a body or pipeline file's `mass_kg`.
+pub const MASS_SOURCE_GIVEN: &str = "mass_kg";
+
+impl IngestOptions {
+    /// The mass, sex and `mass_source` of one clip: the first masses row that matches it
+    /// (`table <file>:<line>`), else `mass_kg` (given or the default).
+    pub fn body_of(&self, clip: &str) -> (f64, Sex, String) {
+        match self
+            .masses
+            .as_ref()
+            .and_then(|t| t.lookup(clip).map(|r| (t, r)))
+        {
+            Some((t, r)) => (
+                r.mass_kg,
+                r.sex.unwrap_or(self.sex),
+                format!("table {}:{}", t.file, r.line),
+            ),
+            None if self.mass_given => (self.mass_kg, self.sex, MASS_SOURCE_GIVEN.into()),
+            None => (self.mass_kg, self.sex, MASS_SOURCE_DEFAULT.into()),
+        }
+    }
 }
 
 impl Default for IngestOptions {
@@ -77,6 +109,8 @@ impl Default for IngestOptions {
             contacts: ContactOptions::default(),
             joints: false,
             character_id: None,
+            mass_given: false,
+            masses: None,
         }
     }
 }
@@ -147,6 +181,8 @@ pub struct ClipSummary {
     pub s_eff: Option<f64>,
     /// Advisory messages.
     pub warnings: Vec<String>,
+    /// Where the body mass came from: `table <file>:<line>`, `mass_kg` (given) or `default`.
+    pub mass_source: String,
     /// Character id (stance-model §11): the body file's `id`, else `sk-` + 12 hex digits.
     pub character_id: Option<String>,
 }
@@ -197,8 +233,9 @@ pub fn check_point_samples(n_points: usize, n_frames: usize) -> Result<()> {
 ///
 /// # Errors
 /// More point samples than [`MAX_POINT_SAMPLES`] (`ErrorKind::Limit`, checked before the
-/// skeleton is used);
-/// A partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that
+/// skeleton is used); a segment far longer than the skeleton's others
+/// (`ErrorKind::Skeleton`, [`crate::skeleton::plausibility`]: before forward kinematics);
+/// a partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that
 /// names no joint (`ErrorKind::Skeleton`); a frame time so short that the smoothing window
 /// exceeds `MAX_SAVGOL_WINDOW` (`ErrorKind::Smoothing`, checked before any per-frame
 /// work); offsets and angles so large that a leg length, a position, the COM or its
@@ -214,6 +251,7 @@ pub fn ingest(bvh: &Bvh, opts: &IngestOptions) -> Result<ClipOutcome> {
     };
     let skel = Skeleton::from_bvh(bvh);
     check_point_samples(skel.n_points(), m.n_frames())?;
+    crate::skeleton::plausibility::check_segments(&skel)?;
     let rest = fk::rest_pose(&skel);
     let lm = match landmarks::map(&skel, &rest, &opts.landmarks)? {
         Mapping::NotABody => {

@@ -138,10 +138,8 @@ pub fn select_stances<'a>(
                 .iter()
                 .find(|s| s.stance.stance_id == id)
                 .ok_or_else(|| {
-                    let n = stances.len();
-                    let first = stances.first().map_or("", |s| s.stance.stance_id.as_str());
-                    let msg =
-                        format!("no stance '{id}' in this library ({n} stances, e.g. '{first}')");
+                    let held = stances.iter().map(|s| s.stance.stance_id.as_str());
+                    let msg = crate::stances::ids::unknown_stance_message(id, held);
                     Error::column(path, stances::STANCE_ID, None, msg)
                 })?;
             found.push(s);

@@ -63,6 +63,9 @@ pub struct LibraryInfo {
     /// Clips whose file repeats another clip's content (clip, the first clip by name with
     /// that content): the queries answer with the first only.
     pub duplicates: Vec<(String, String)>,
+    /// Clips by where their body mass came from (`table`: `--masses`, `mass_kg`: given,
+    /// `default`: 70 kg assumed); empty for a library written before `mass_source`.
+    pub masses_by_source: Counts,
 }
 
 impl LibraryInfo {
@@ -148,7 +151,23 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
         limits: m.get("limits").cloned().unwrap_or_default(),
         beyond_bounds: beyond_bounds(&clips, &stances)?,
         duplicates: duplicates(&clips)?,
+        masses_by_source: masses_by_source(lib),
     })
+}
+
+/// Clips by the kind of their `mass_source` (`table <file>:<line>` counts as `table`);
+/// empty when `clips.parquet` has no such column (written before it existed).
+fn masses_by_source(lib: &Path) -> Counts {
+    let Ok(t) = Table::open_columns(&lib.join(CLIPS_FILE), &[clips::MASS_SOURCE]) else {
+        return Counts::new();
+    };
+    let Ok(v) = t.strings(clips::MASS_SOURCE) else {
+        return Counts::new();
+    };
+    counts(
+        v.iter()
+            .map(|s| Some(s.split(' ').next().unwrap_or_default())),
+    )
 }
 
 /// The clips of the library `lib` whose file repeats an earlier clip's content (clip, the
@@ -234,6 +253,19 @@ impl fmt::Display for LibraryInfo {
         writeln!(f, "  manifest sha256 {}", self.manifest_sha256)?;
         write_counts(f, "clips", &self.clips_by_status)?;
         write_counts(f, "characters (clips)", &self.clips_by_character)?;
+        if !self.masses_by_source.is_empty() {
+            write_counts(f, "masses (clips)", &self.masses_by_source)?;
+            if self
+                .masses_by_source
+                .contains_key(crate::ingest::MASS_SOURCE_DEFAULT)
+            {
+                writeln!(
+                    f,
+                    "  warning: `default` clips were given {} kg: no --mass, mass_kg or --masses row named them",
+                    crate::ingest::DEFAULT_MASS_KG
+                )?;
+            }
+        }
         write_counts(f, "stances by label", &self.stances_by_label)?;
         write_counts(f, "  starting at", &self.boundary_start)?;
         write_counts(f, "  ending at", &self.boundary_end)?;

@@ -10,6 +10,7 @@ pub mod clip_view;
 pub(crate) mod columns;
 pub mod forces;
 pub mod info;
+pub mod integrity;
 pub mod kinematics;
 pub mod layout;
 pub mod plates;

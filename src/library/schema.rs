@@ -280,7 +280,7 @@ pub mod errors {
 }
 
 /// Columns of `clips.parquet`, in order.
-pub const CLIPS_COLUMNS: [&str; 24] = clips::COLUMNS;
+pub const CLIPS_COLUMNS: [&str; 25] = clips::COLUMNS;
 /// Fields of the `flights` struct in `clips.parquet`.
 pub const FLIGHT_FIELDS: [&str; 11] = flights::COLUMNS;
 /// Columns of `contacts.parquet`, in order.
@@ -331,6 +331,9 @@ pub mod clips {
     pub const CHARACTER_ID: &str = "character_id";
     /// `mass_kg`: Body mass, kg.
     pub const MASS: &str = "mass_kg";
+    /// `mass_source`: Where the body mass came from: `table <file>:<line>` (`--masses`),
+    /// `mass_kg` (`--mass`, a body or pipeline file) or `default` (70 kg assumed, a warning).
+    pub const MASS_SOURCE: &str = "mass_source";
     /// `skeleton`: The landmark mapping (JSON).
     pub const SKELETON: &str = "skeleton";
     /// `toe_tip_rule_left`: How the left toe tip was found.
@@ -346,7 +349,7 @@ pub mod clips {
     /// `warnings`: Advisory messages (list).
     pub const WARNINGS: &str = "warnings";
     /// Every column, in file order.
-    pub const COLUMNS: [&str; 24] = [
+    pub const COLUMNS: [&str; 25] = [
         PATH,
         CLIP,
         CONTENT_SHA256,
@@ -364,6 +367,7 @@ pub mod clips {
         LEG_LENGTH,
         CHARACTER_ID,
         MASS,
+        MASS_SOURCE,
         SKELETON,
         TOE_TIP_RULE_LEFT,
         TOE_TIP_RULE_RIGHT,

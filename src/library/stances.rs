@@ -83,6 +83,69 @@ pub fn stances_table(rows: &[Stance]) -> PolarsResult<DataFrame> {
     DataFrame::new_infer_height(cols)
 }
 
+/// A non-finite number in a stance row ([`first_non_finite`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NonFiniteCell {
+    /// The stance.
+    pub stance_id: String,
+    /// The column (a list or struct column: the value is one of its elements).
+    pub column: String,
+    /// The value (NaN, +∞ or −∞).
+    pub value: f64,
+}
+
+/// The first non-finite number of the rows `rows` would write (column by column; nulls are
+/// no values): the last guard before `stances.parquet`, so that a stance of inf or NaN
+/// becomes a per-clip error instead of a row.
+///
+/// # Errors
+/// The rows cannot be made a table.
+pub fn first_non_finite(rows: &[Stance]) -> PolarsResult<Option<NonFiniteCell>> {
+    if rows.is_empty() {
+        return Ok(None);
+    }
+    let df = stances_table(rows)?;
+    Ok(df.columns().iter().find_map(|c| {
+        non_finite_row(c.as_materialized_series()).map(|(row, value)| NonFiniteCell {
+            stance_id: rows[row].stance_id.clone(),
+            column: c.name().to_string(),
+            value,
+        })
+    }))
+}
+
+/// The first row of `s` holding a non-finite float, in a float column or in the floats of
+/// a list or struct column, with the value.
+fn non_finite_row(s: &Series) -> Option<(usize, f64)> {
+    match s.dtype() {
+        DataType::Float64 => s
+            .f64()
+            .ok()?
+            .iter()
+            .enumerate()
+            .find_map(|(i, v)| v.filter(|x| !x.is_finite()).map(|x| (i, x))),
+        DataType::Float32 => non_finite_row(&s.cast(&DataType::Float64).ok()?),
+        DataType::List(_) => s
+            .list()
+            .ok()?
+            .amortized_iter()
+            .enumerate()
+            .find_map(|(i, inner)| {
+                inner
+                    .and_then(|v| non_finite_row(v.as_ref()))
+                    .map(|(_, x)| (i, x))
+            }),
+        DataType::Struct(_) => s
+            .struct_()
+            .ok()?
+            .fields_as_series()
+            .iter()
+            .filter_map(non_finite_row)
+            .min_by_key(|(i, _)| *i),
+        _ => None,
+    }
+}
+
 /// Ids, frames, times, boundaries, adjacent flights, heading and the parameters (`stance_id`
 /// … `mass_kg`).
 fn identity_columns(rows: &[Stance]) -> PolarsResult<Vec<Column>> {

@@ -229,6 +229,10 @@ pub fn clips_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
             clips::MASS,
             records.iter().map(|r| r.mass_kg).collect::<Vec<_>>(),
         ),
+        col(
+            clips::MASS_SOURCE,
+            s(&|r| Some(r.summary.mass_source.clone())),
+        ),
         col(clips::SKELETON, s(&|r| r.summary.skeleton.clone())),
         col(
             clips::TOE_TIP_RULE_LEFT,

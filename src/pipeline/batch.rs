@@ -14,7 +14,7 @@ use super::inputs::{bvh_too_large, open_input};
 pub use super::inputs::{check_input, discover, none_readable, InputProblem, MAX_BVH_BYTES};
 use super::names::clip_names;
 use crate::error::{Error, ErrorKind, Result};
-use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions};
+use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions, MASS_SOURCE_DEFAULT};
 use crate::library::write::FramesWriter;
 use crate::library::{ClipRecord, ClipStatus, Status};
 
@@ -40,6 +40,31 @@ fn hex(bytes: &[u8]) -> String {
 
 /// Ingest one file into its record. Never fails: errors become an `error` record.
 pub fn ingest_file(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecord {
+    let (mass_kg, sex, mass_source) = opts.body_of(&clip);
+    let own;
+    let opts = if (mass_kg, sex) == (opts.mass_kg, opts.sex) {
+        opts
+    } else {
+        own = IngestOptions {
+            mass_kg,
+            sex,
+            ..opts.clone()
+        };
+        &own
+    };
+    let mut rec = ingest_with(path, clip, opts);
+    if mass_source == MASS_SOURCE_DEFAULT && rec.status == Status::Ok {
+        rec.summary.warnings.push(format!(
+            "body mass {mass_kg} kg assumed: no --mass, mass_kg or --masses row names this \
+             clip (forces in newtons scale with it)"
+        ));
+    }
+    rec.summary.mass_source = mass_source;
+    rec
+}
+
+/// [`ingest_file`] with the clip's own mass and sex in `opts`.
+fn ingest_with(path: &Path, clip: String, opts: &IngestOptions) -> ClipRecord {
     let mut rec = ClipRecord {
         path: path.display().to_string(),
         clip,
@@ -244,7 +269,8 @@ pub fn worker_pool(files: &[PathBuf], threads: usize) -> anyhow::Result<rayon::T
 /// included.
 ///
 /// # Errors
-/// No readable input, a pool that cannot start, an unwritable output folder.
+/// No readable input, a pool that cannot start, an unwritable output folder, or an output
+/// folder that holds a library ([`super::output::refuse_library`]).
 pub fn frames_into(
     files: &[PathBuf],
     out: &Path,
@@ -252,6 +278,7 @@ pub fn frames_into(
     threads: usize,
 ) -> anyhow::Result<Vec<ClipStatus>> {
     use anyhow::Context;
+    super::output::refuse_library(out)?;
     let pool = worker_pool(files, threads)?;
     pool.install(|| stream_frames(files, out, opts))
         .with_context(|| format!("writing tables to {}", out.display()))

@@ -15,7 +15,9 @@
 //! With `incremental`, the rows of clips whose path, content hash and options are those
 //! of the previous library are taken from it instead of being rebuilt; the result is the
 //! same, byte for byte, as a full rebuild (rows are re-sorted by the same keys and cast to
-//! the same schema).
+//! the same schema). Nothing is taken from a table whose bytes are not those its manifest
+//! recorded, nor from a clip whose rows are not as many as recorded
+//! ([`crate::library::integrity`]): those clips are rebuilt and the summary says why.
 //!
 //! With a [`Shard`], only the inputs of that shard are built, and the library also keeps
 //! its kinematic samples and a `shard` entry in its manifest for [`super::merge`].
@@ -41,6 +43,9 @@ use super::shard::{inputs_fingerprint, shard_of, Shard};
 use super::sink::{combine, pe, strings, ClipCursor, LibrarySink, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
+use crate::library::integrity::{
+    check_clip_rows, check_table, recorded_clip_rows, recorded_digests, Mismatch,
+};
 use crate::library::layout::Layout;
 use crate::library::provenance::library_layout;
 use crate::library::read::read_parquet;
@@ -49,7 +54,7 @@ use crate::library::schema::{
     SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::scratch::{scratch_name, Scratch};
-use crate::library::stances::{errors_table, stances_table, ErrorRow};
+use crate::library::stances::{errors_table, first_non_finite, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, joints_table};
 use crate::library::{ClipRecord, ClipStatus, Status};
 use crate::stances::build::StanceNote;
@@ -120,6 +125,9 @@ pub struct BuildSummary {
     pub stances: usize,
     /// Clips whose rows came from the previous library (`incremental`).
     pub reused: usize,
+    /// Why the previous library's rows were not reused, where it was there but did not
+    /// match its manifest or this build (`incremental`; one line each).
+    pub not_reused: Vec<String>,
 }
 
 /// Ingest and build (pure apart from reading the input files).
@@ -198,7 +206,29 @@ fn build_one(
         _ => (Vec::new(), Vec::new()),
     };
     bar.done(1, r.frames.as_ref().map_or(0, |f| f.frame.len() as u64));
-    (r, out)
+    refuse_non_finite(r, out)
+}
+
+/// A clip whose stances hold a non-finite number (inf or NaN in any column) becomes a
+/// per-clip error of stage `stances`, with no rows: the last guard before the tables.
+fn refuse_non_finite(mut r: ClipRecord, out: ClipStances) -> (ClipRecord, ClipStances) {
+    let found = match first_non_finite(&out.0) {
+        Ok(None) => return (r, out),
+        Ok(Some(cell)) => format!(
+            "stance {}: {} is {} (not finite): the clip's offsets, angles or body values \
+             overflow; no row of it is written",
+            crate::error::echo(&cell.stance_id),
+            cell.column,
+            cell.value
+        ),
+        Err(e) => format!("its stance rows cannot be checked: {e}"),
+    };
+    r.status = Status::Error;
+    r.error_stage = Some("stances");
+    r.message = Some(format!("{}: {found}", r.path));
+    r.frames = None;
+    r.contacts = Vec::new();
+    (r, (Vec::new(), Vec::new()))
 }
 
 /// The report of a batch of built clips: records in clip order, their error rows (failed
@@ -273,21 +303,61 @@ impl Tables {
     }
 }
 
-/// Clips of the previous library at `out` that can be reused for `named`.
-fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTreeSet<String> {
-    let manifest: Option<serde_json::Value> = std::fs::read_to_string(out.join(MANIFEST_FILE))
+/// What an incremental build takes from the previous library at its output.
+#[derive(Default)]
+struct Reuse {
+    /// The clips whose rows are reused.
+    clips: BTreeSet<String>,
+    /// Why rows were not reused although the library was there (one line each).
+    refused: Vec<String>,
+    /// The previous library's tables, open for the reused clips.
+    previous: Option<Previous>,
+}
+
+/// Most clips a refusal names one by one (the rest are counted).
+const REFUSED_CLIPS_NAMED: usize = 10;
+
+/// Clips of the previous library at `out` that can be reused for `named`: the library's
+/// options and layout are this build's, every table it gives rows from has the content
+/// hash its manifest recorded ([`crate::library::integrity`]), and per clip the input's
+/// path and content are unchanged and its rows in every table are as many as recorded.
+/// Anything else is rebuilt, with a line in `refused` saying why.
+fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str, joints: bool) -> Reuse {
+    let Some(manifest) = std::fs::read_to_string(out.join(MANIFEST_FILE))
         .ok()
-        .and_then(|t| serde_json::from_str(&t).ok());
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+    else {
+        return Reuse::default();
+    };
+    let all = |why: String| Reuse {
+        refused: vec![format!("{}: {why}: every clip is rebuilt", out.display())],
+        ..Reuse::default()
+    };
     let current: Option<serde_json::Value> = serde_json::from_str(fingerprint).ok();
-    if current.is_none() || manifest.as_ref().and_then(|m| m.get("options")) != current.as_ref() {
-        return BTreeSet::new();
+    if current.is_none() || manifest.get("options") != current.as_ref() {
+        return all("the library was built with other options".into());
     }
     // Rows of another table layout cannot be copied into this one.
     if library_layout(out).as_deref() != Some(SCHEMA_VERSION) {
-        return BTreeSet::new();
+        return all(format!(
+            "the library is not of table layout {SCHEMA_VERSION}"
+        ));
+    }
+    let Ok(mut t) = Tables::empty(joints) else {
+        return Reuse::default();
+    };
+    let mut read: Vec<&'static str> = t.named().into_iter().map(|(n, _)| n).collect();
+    read.push(ERRORS_FILE);
+    let recorded = recorded_digests(&manifest);
+    let checked: Vec<std::result::Result<(), Mismatch>> = read
+        .par_iter()
+        .map(|f| check_table(out, f, recorded.as_ref()))
+        .collect();
+    if let Some(Err(m)) = checked.into_iter().find(|c| c.is_err()) {
+        return all(m.to_string());
     }
     let Ok(clips) = read_parquet(&out.join(CLIPS_FILE)) else {
-        return BTreeSet::new();
+        return all(format!("{CLIPS_FILE} cannot be read"));
     };
     let prev: BTreeMap<String, (String, String, String)> = strings(&clips, clips::CLIP)
         .into_iter()
@@ -299,7 +369,7 @@ fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTree
         )
         .map(|(c, ((p, h), s))| (c, (p, h, s)))
         .collect();
-    named
+    let unchanged: BTreeSet<String> = named
         .par_iter()
         .filter_map(|(path, clip)| {
             let (p, h, s) = prev.get(clip)?;
@@ -308,7 +378,55 @@ fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str) -> BTree
                 && file_sha256(path).as_deref() == Some(h.as_str());
             same.then(|| clip.clone())
         })
-        .collect()
+        .collect();
+    if unchanged.is_empty() {
+        return Reuse::default();
+    }
+    let previous = match Previous::open(out, &mut t) {
+        Ok(p) => p,
+        Err(e) => return all(format!("{e}")),
+    };
+    let rows = recorded_clip_rows(&manifest);
+    let found: Vec<(&str, BTreeMap<&str, u64>)> = previous
+        .cursors
+        .iter()
+        .filter(|(name, _)| *name != CLIPS_FILE)
+        .map(|(name, cur)| (*name, cur.rows_per_clip()))
+        .collect();
+    let mut clips = BTreeSet::new();
+    let mut mismatched: Vec<Mismatch> = Vec::new();
+    for clip in unchanged {
+        let found = found
+            .iter()
+            .map(|(name, per_clip)| {
+                let n = per_clip.get(clip.as_str()).copied().unwrap_or(0);
+                check_clip_rows(&rows, &clip, name, n)
+            })
+            .find(|c| c.is_err());
+        match found {
+            Some(Err(m)) => mismatched.push(m),
+            _ => {
+                clips.insert(clip);
+            }
+        }
+    }
+    let mut refused: Vec<String> = mismatched
+        .iter()
+        .take(REFUSED_CLIPS_NAMED)
+        .map(|m| format!("{}: {m}: the clip is rebuilt", out.display()))
+        .collect();
+    if mismatched.len() > REFUSED_CLIPS_NAMED {
+        refused.push(format!(
+            "{}: {} more clips whose rows are not as recorded are rebuilt",
+            out.display(),
+            mismatched.len() - REFUSED_CLIPS_NAMED
+        ));
+    }
+    Reuse {
+        clips,
+        refused,
+        previous: Some(previous),
+    }
 }
 
 /// The previous library at the output, read forward in clip order for the reused clips.
@@ -317,6 +435,7 @@ struct Previous {
 }
 
 impl Previous {
+    /// Open the tables of the library `out` that `t` (empty tables of this build) names.
     fn open(out: &Path, t: &mut Tables) -> Result<Previous> {
         let cursors = t
             .named()
@@ -397,10 +516,14 @@ pub fn build_into(
     }
     named.sort_by(|a, b| a.1.cmp(&b.1));
     let fingerprint = opts.fingerprint();
-    let reuse = if plan.incremental {
-        reusable(out, &named, &fingerprint)
+    let Reuse {
+        clips: reuse,
+        refused,
+        previous,
+    } = if plan.incremental {
+        reusable(out, &named, &fingerprint, opts.ingest.joints)
     } else {
-        BTreeSet::new()
+        Reuse::default()
     };
     let (default_clips, max_bytes) = super::batch::default_batch_bounds();
     let max_clips = match plan.batch_clips {
@@ -412,15 +535,17 @@ pub fn build_into(
         records: Vec::new(),
         stances: 0,
         reused: reuse.len(),
+        not_reused: refused,
     };
     replace_library(out, |tmp| {
         let joints = opts.ingest.joints;
         let mut sink = LibrarySink::create(tmp, joints, true, plan.shard.is_some())?;
-        let mut prev = if reuse.is_empty() {
-            None
-        } else {
-            sink.push_errors(previous_errors(out, &reuse)?);
-            Some(Previous::open(out, sink.template())?)
+        let mut prev = match previous {
+            Some(p) if !reuse.is_empty() => {
+                sink.push_errors(previous_errors(out, &reuse)?);
+                Some(p)
+            }
+            _ => None,
         };
         // Batch i is written while batch i + 1 is built (two batches in memory at most,
         // `ordered`): the writing is mostly one thread's work, and the other workers build

@@ -16,7 +16,9 @@ use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
     choose_jump, choose_run, jump_stances, ChosenRun, EditLimits, JumpTarget, RunTarget,
 };
-use crate::edit::{EditOptions, MAX_CYCLES, MAX_FPS, MIN_FPS, RUN_KNEE_SLACK_DEG};
+use crate::edit::{
+    EditOptions, DEFAULT_JUMP_SWING_HOLD_S, MAX_CYCLES, MAX_FPS, MIN_FPS, RUN_KNEE_SLACK_DEG,
+};
 use crate::ingest::body::BodyModel;
 use crate::library::provenance::library_body;
 use crate::library::read::{read_clip_sources, read_stance_timing};
@@ -171,7 +173,7 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
         }),
     )?;
     let title = format!(
-        "edit run: {:.2} m/s, cycle {first}, {} cycles",
+        "Can cycle {first} run at {:.2} m/s? The edited run ({} cycles)",
         e.run.speed_mps, e.cycles
     );
     finish(t, edit, kv, title, (used, achieved))
@@ -253,10 +255,12 @@ pub fn edit_jump(e: &JumpEdit) -> anyhow::Result<EditReport> {
             "limits": limits.form.name(), "mu": limits.mu, "active_set": limits.active,
         }),
     )?;
-    let title = format!("edit jump: apex {h:.2} m, distance {d:.2} m, {ids}");
+    // A jump in place printed "distance -0.00 m", which read as backwards.
+    let d_shown = if d.abs() < 0.005 { 0.0 } else { d };
+    let title = format!("Can {ids} jump {h:.2} m high, {d_shown:.2} m far? The edited jump");
     let (h0, d0) = recorded_jump(&lib.stances[i], &lib.stances[j]);
     let achieved = format!(
-        "apex {h:.3} m, distance {d:.3} m (recorded {h0:.3} m, {d0:.3} m: × {:.3} in height)",
+        "apex {h:.3} m, distance {d_shown:.3} m (recorded {h0:.3} m, {d0:.3} m: × {:.3} in height)",
         h / h0
     );
     finish(t, edit, kv, title, (ids, achieved))
@@ -342,6 +346,9 @@ fn compute(
         if least.is_finite() {
             opts.min_knee_flexion_deg = (least - RUN_KNEE_SLACK_DEG).max(0.0);
         }
+    }
+    if kind != PlanKind::Run {
+        opts.swing_hold_s = DEFAULT_JUMP_SWING_HOLD_S;
     }
     let edited = pose_motion(&reference, &path, &sources, &opts, frame_time_s);
     let footprints = path.stances.iter().map(|s| s.contact_point()).collect();

@@ -1,7 +1,7 @@
 //! What an edit writes besides the BVH: the plan table `FILE.plan.parquet` (one row per
 //! output frame, columns in [`crate::library::schema::edit_plan`]) and the plot data of
-//! `FILE.png` (planned COM path, footprints, a stick figure every
-//! [`PLOT_STICK_EVERY_S`]).
+//! `FILE.png` (planned COM path, footprints, [`PLOT_POSES`] sampled poses, the body's
+//! facing and the verdicts).
 
 use std::path::{Path, PathBuf};
 
@@ -13,11 +13,12 @@ use crate::edit::path::Phase;
 use crate::edit::plan::EditStance;
 use crate::edit::pose::{EditedMotion, Reference};
 use crate::library::schema::edit_plan as col;
-use crate::plot::edit::EditPlot;
+use crate::plot::edit::{EditPlot, Pose};
 use crate::skeleton::fk::FkWorkspace;
 
-/// Stick figures in the plot, s apart.
-pub const PLOT_STICK_EVERY_S: f64 = 0.1;
+/// Stick figures in the plot: this many poses, evenly spread over the output frames
+/// (first and last included), so that they stand apart along the direction of travel.
+pub const PLOT_POSES: usize = 6;
 
 /// Everything an edit computes before anything is written.
 pub struct EditOutputs {
@@ -141,18 +142,24 @@ pub fn plan_table(e: &EditOutputs) -> PolarsResult<DataFrame> {
     DataFrame::new_infer_height(cols)
 }
 
-/// The plot of an edit: the planned COM, the footprints and the bones of a stick figure
-/// every [`PLOT_STICK_EVERY_S`].
+/// The plot of an edit: the planned COM, the footprints, [`PLOT_POSES`] sampled poses,
+/// the body's mean facing (from the hips) and the verdicts.
 pub fn plot_of(e: &EditOutputs, title: String) -> EditPlot {
     let body = &e.reference.body;
     let sk = &body.skeleton;
     let m = &e.edited.motion;
-    let every = ((PLOT_STICK_EVERY_S / m.frame_time_s).round() as usize).max(1);
+    let n = m.n_frames();
     let mut ws = FkWorkspace::new(sk);
     let (mut file, mut pts) = (vec![[0.0; 3]; sk.n_points()], vec![[0.0; 3]; sk.n_points()]);
-    let mut bones = Vec::new();
-    for fr in (0..m.n_frames()).step_by(every) {
+    let mut frames: Vec<usize> = (0..PLOT_POSES.min(n))
+        .map(|k| (k * n.saturating_sub(1)) / (PLOT_POSES - 1).max(1))
+        .collect();
+    frames.dedup();
+    let mut poses = Vec::with_capacity(frames.len());
+    let mut facing = [0.0; 2];
+    for fr in frames {
         body.points(&mut ws, m.row(fr), &mut file, &mut pts);
+        let mut bones = Vec::new();
         for j in 0..sk.n_joints() {
             if let Some(p) = sk.parents[j] {
                 bones.push([pts[p], pts[j]]);
@@ -161,11 +168,24 @@ pub fn plot_of(e: &EditOutputs, title: String) -> EditPlot {
         for (e_i, (j, _)) in sk.end_sites.iter().enumerate() {
             bones.push([pts[*j], pts[sk.n_joints() + e_i]]);
         }
+        // Forward = (left hip − right hip) × up, horizontal.
+        let (l, r) = (pts[body.landmarks.left.hip], pts[body.landmarks.right.hip]);
+        facing = [facing[0] + (l[1] - r[1]), facing[1] - (l[0] - r[0])];
+        poses.push(Pose {
+            time_s: fr as f64 * m.frame_time_s,
+            bones,
+        });
     }
+    let norm = facing[0].hypot(facing[1]);
     EditPlot {
         title,
         com: e.edited.frames.iter().map(|f| f.com_plan).collect(),
         footprints: e.footprints.clone(),
-        bones,
+        poses,
+        facing: (norm > 1e-9).then(|| [facing[0] / norm, facing[1] / norm]),
+        violated: e.violated.clone(),
+        n_frames: e.edited.frames.len(),
+        frame_time_s: m.frame_time_s,
+        unconverged: e.edited.frames.iter().filter(|f| !f.converged).count(),
     }
 }

@@ -295,6 +295,10 @@ pub const MAX_POINTS_BYTES: u64 = 256 << 20;
 /// The text is read whole and its samples take 32 bytes per row.
 pub const MAX_PLATES_BYTES: u64 = 256 << 20;
 
+/// Largest masses table read (CSV), bytes (64 MiB): a row per clip of a million-clip
+/// collection at about 40 bytes a row, read whole ([`crate::ingest::masses::MAX_MASS_ROWS`]).
+pub const MAX_MASSES_BYTES: u64 = 64 << 20;
+
 /// A file the tool reads besides the BVH inputs of a batch. Every kind is read through
 /// [`open_side_input`] with the rules of a BVH input: regular files only (a FIFO, socket
 /// or device is never opened), at most the kind's size bound ([`SideInput::max_bytes`]),
@@ -316,6 +320,8 @@ pub enum SideInput {
     Plates,
     /// `twopac --clip` (BVH, [`MAX_BVH_BYTES`] as every clip).
     Clip,
+    /// `--masses` or a pipeline's `masses` (CSV, [`MAX_MASSES_BYTES`]).
+    Masses,
 }
 
 impl SideInput {
@@ -329,6 +335,7 @@ impl SideInput {
             SideInput::Points => "points table",
             SideInput::Plates => "plates file",
             SideInput::Clip => "clip",
+            SideInput::Masses => "masses table",
         }
     }
 
@@ -343,6 +350,7 @@ impl SideInput {
             SideInput::Phases | SideInput::Contacts => (MAX_JSON_BYTES, "MAX_JSON_BYTES"),
             SideInput::Points => (MAX_POINTS_BYTES, "MAX_POINTS_BYTES"),
             SideInput::Plates => (MAX_PLATES_BYTES, "MAX_PLATES_BYTES"),
+            SideInput::Masses => (MAX_MASSES_BYTES, "MAX_MASSES_BYTES"),
             SideInput::Clip => return BVH_BOUND,
         };
         Bound { max, limit }

@@ -14,7 +14,7 @@ use super::build::{BuildOptions, BuildPlan};
 use super::inputs::{read_body, read_pipeline};
 use super::output::OutputRules;
 use super::queries::{query_stages, MapQuery, RunQuery};
-use super::spec::{expand_inputs, relative_to, resolve, resolve_fit, Overrides};
+use super::spec::{expand_inputs, relative_to, resolve, resolve_fit, with_masses, Overrides};
 use crate::force_model::ForceModelKind;
 use crate::library::layout::Layout;
 
@@ -69,7 +69,14 @@ pub fn pipeline_job(path: &Path, cl: &CommandLine<'_>) -> anyhow::Result<Pipelin
         .or_else(|| pipe.body.as_deref().map(|b| relative_to(path, b)));
     let body = body_path.as_deref().map(read_body).transpose()?;
     let opts = BuildOptions {
-        ingest: resolve(body.as_ref(), Some(&pipe), cl.overrides),
+        ingest: with_masses(
+            resolve(body.as_ref(), Some(&pipe), cl.overrides),
+            cl.overrides
+                .masses
+                .clone()
+                .or_else(|| pipe.masses.as_deref().map(|m| relative_to(path, m)))
+                .as_deref(),
+        )?,
         stances: resolve_fit(Some(&pipe), cl.force_model),
     };
     let lib = relative_to(path, &pipe.out);

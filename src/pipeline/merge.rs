@@ -4,7 +4,11 @@
 //! # Model
 //! ```text
 //! check:  every shard is a finished shard library; same schema, tool version, options,
-//!         shard count and input list (manifest `shard.inputs_sha256`); indices 1..N once each
+//!         shard count and input list (manifest `shard.inputs_sha256`); indices 1..N once each;
+//!         every table of every shard has the bytes its manifest recorded
+//!         (`library::integrity`), before anything is written
+//! rows:   every row of a shard belongs to one of the shard's clips, keys unique (checked
+//!         as the rows are read; a failure leaves the previous library in place)
 //! rows:   per-clip tables read forward in clip order from every shard, a batch of clips
 //!         (about one row group of frames) at a time, sorted by the table's keys, appended;
 //!         the per-frame tables (one row group per clip, `schema::group_column`) are not
@@ -24,11 +28,13 @@ use std::time::Instant;
 
 use super::build::replace_library;
 use super::output::{claim, is_library, OutputRules};
-use super::sink::{sorted, ClipCursor, Defer, LibrarySink, Tables};
+use super::sink::{sorted, ClipCursor, Defer, Detached, LibrarySink, Tables};
 use crate::error::{Error, Result};
+use crate::library::integrity::{check_table, recorded_digests, Digests};
 use crate::library::layout::{locate, table_exists, Layout};
 use crate::library::read::read_parquet;
 use crate::library::row_groups::GroupFileReader;
+use crate::library::schema::sort_keys;
 use crate::library::schema::{
     group_column, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, STANCES_FILE,
@@ -52,6 +58,8 @@ struct ShardLib {
     dir: PathBuf,
     index: usize,
     manifest: serde_json::Value,
+    /// The tables the merge reads.
+    tables: Vec<&'static str>,
 }
 
 fn bad(dir: &Path, why: impl std::fmt::Display) -> Error {
@@ -111,7 +119,37 @@ fn open_shard(dir: &Path) -> Result<ShardLib> {
         dir: dir.to_path_buf(),
         index: index as usize,
         manifest,
+        tables: need,
     })
+}
+
+/// Check every table the merge reads of every shard against its shard's manifest
+/// (content hashes, `library::integrity`), in parallel; the error names the shard and the
+/// table.
+fn verify_shards(libs: &[ShardLib]) -> Result<()> {
+    use rayon::prelude::*;
+    let jobs: Vec<(&ShardLib, &'static str, Option<Digests>)> = libs
+        .iter()
+        .flat_map(|lib| {
+            let recorded = recorded_digests(&lib.manifest);
+            lib.tables.iter().map(move |t| (lib, *t, recorded.clone()))
+        })
+        .collect();
+    let checked: Vec<Result<()>> = jobs
+        .par_iter()
+        .map(|(lib, table, recorded)| {
+            check_table(&lib.dir, table, recorded.as_ref()).map_err(|m| {
+                bad(
+                    &lib.dir,
+                    format!(
+                        "{table}: {m}; the shard is damaged or holds another library's \
+                         table: build this shard again"
+                    ),
+                )
+            })
+        })
+        .collect();
+    checked.into_iter().collect()
 }
 
 /// The manifest fields all shards of one build share.
@@ -267,9 +305,10 @@ impl GroupCursor {
         }
     }
 
-    /// Append the row groups of `clip` (the next ones of the shard) to `w`; a group of a
-    /// clip before `clip` means the shard's tables disagree.
-    fn copy_clip(&mut self, clip: &str, w: &mut TableWriter, dir: &Path) -> Result<()> {
+    /// Append the row groups of `clip` (the next ones of the shard) to `w`, their rows
+    /// returned; a group of a clip before `clip` means the shard's tables disagree.
+    fn copy_clip(&mut self, clip: &str, w: &mut TableWriter, dir: &Path) -> Result<u64> {
+        let mut rows = 0u64;
         while let Some(next) = self.next_clip()? {
             match next.as_slice().cmp(clip.as_bytes()) {
                 std::cmp::Ordering::Greater => break,
@@ -291,10 +330,11 @@ impl GroupCursor {
                     // `next_clip` has just read this group's entry.
                     let g = g.ok_or_else(|| bad(dir, format!("{}: no row group", self.table)))?;
                     w.push_group(&g)?;
+                    rows += g.rows() as u64;
                 }
             }
         }
-        Ok(())
+        Ok(rows)
     }
 }
 
@@ -316,7 +356,7 @@ fn side_ended(out: &Path, why: &str) -> Error {
 /// shard's `groups` (one cursor per table of `writers`, in that order) into `writers`, then
 /// refuse a shard with groups left; `stop` (set when the rest of the merge `out` ended)
 /// ends the copy early with an error. Runs beside the rest of the merge and hands the
-/// writers back.
+/// writers back with the rows copied per clip.
 fn copy_groups(
     plan: &[(String, usize, usize)],
     libs: &[ShardLib],
@@ -324,7 +364,8 @@ fn copy_groups(
     mut writers: Vec<(&'static str, TableWriter)>,
     stop: &AtomicBool,
     out: &Path,
-) -> Result<Vec<(&'static str, TableWriter)>> {
+) -> Result<Detached> {
+    let mut clip_rows = crate::library::integrity::ClipRows::new();
     for (clip, _, k) in plan {
         if stop.load(Ordering::Relaxed) {
             return Err(side_ended(out, "the row group copy was stopped"));
@@ -335,7 +376,8 @@ fn copy_groups(
                 .find(|(n, _)| *n == g.table)
                 .map(|(_, w)| w)
                 .ok_or_else(|| bad(&libs[*k].dir, format!("{}: no writer", g.table)))?;
-            g.copy_clip(clip, w, &libs[*k].dir)?;
+            let n = g.copy_clip(clip, w, &libs[*k].dir)?;
+            crate::library::integrity::add_clip_rows(&mut clip_rows, clip, g.table, n);
         }
     }
     // Every shard's per-clip groups were copied: one left holds a clip its shard's clips
@@ -345,7 +387,7 @@ fn copy_groups(
             g.refuse_leftover(&lib.dir)?;
         }
     }
-    Ok(writers)
+    Ok(Detached { writers, clip_rows })
 }
 
 /// Spill a shard's samples table into `sink` a row group's worth at a time (never the
@@ -386,6 +428,7 @@ pub fn merge_into(
             .map(|d| open_shard(d))
             .collect::<Result<Vec<_>>>()?,
     )?;
+    verify_shards(&libs)?;
     let _claim = claim(out, shards, rules)?;
     let t0 = Instant::now();
     let options = libs[0].manifest.get("options").cloned().unwrap_or_default();
@@ -512,6 +555,7 @@ fn merge_rows(
                 .collect::<Result<Vec<_>>>()?,
         );
     }
+    let owner: BTreeMap<&str, usize> = plan.iter().map(|(c, _, k)| (c.as_str(), *k)).collect();
     let mut start = 0;
     while start < plan.len() {
         check_copy(copy_failed)?;
@@ -523,10 +567,11 @@ fn merge_rows(
         }
         let last = plan[end - 1].0.clone();
         let mut t = Tables::empty(joints)?;
-        for shard in cursors.iter_mut() {
+        for (k, shard) in cursors.iter_mut().enumerate() {
             for ((name, df), cur) in t.named().into_iter().zip(shard.iter_mut()) {
                 let Some(cur) = cur else { continue };
                 if let Some(rows) = cur.take_through(&last, &|_| true)? {
+                    check_owner(&rows, name, k, &owner, libs)?;
                     let rows = super::sink::cast_like(rows, df, name)?;
                     df.vstack_mut(&rows)
                         .map_err(|e| Error::io(name, "cannot stack rows", e))?;
@@ -535,6 +580,7 @@ fn merge_rows(
         }
         for (name, df) in t.named() {
             *df = sorted(std::mem::take(df), name)?;
+            check_unique(df, name, &owner, libs)?;
         }
         summary.failed += t
             .clips
@@ -549,7 +595,88 @@ fn merge_rows(
         super::memory::release_free_memory();
         start = end;
     }
+    // Rows of a clip after the last one are never taken above.
+    for (shard, lib) in cursors.iter().zip(libs) {
+        for (cur, name) in shard.iter().zip(names) {
+            if let Some(clip) = cur.as_ref().and_then(|c| c.next_clip()) {
+                return Err(bad(
+                    &lib.dir,
+                    format!(
+                        "{name} holds rows of clip {}, not one of the shard's clips \
+                         ({CLIPS_FILE})",
+                        crate::error::echo(clip)
+                    ),
+                ));
+            }
+        }
+    }
     Ok(())
+}
+
+/// Refuse rows of table `name` read from shard `k` of `libs` that belong to a clip of
+/// another shard or of none (`owner`: the shard of every clip).
+fn check_owner(
+    rows: &polars::prelude::DataFrame,
+    name: &str,
+    k: usize,
+    owner: &BTreeMap<&str, usize>,
+    libs: &[ShardLib],
+) -> Result<()> {
+    let clips = super::sink::strings(rows, "clip");
+    let Some(c) = clips.iter().find(|c| owner.get(c.as_str()) != Some(&k)) else {
+        return Ok(());
+    };
+    let whose = match owner.get(c.as_str()) {
+        Some(o) => format!("a clip of {}", libs[*o].dir.display()),
+        None => format!("in no shard's {CLIPS_FILE}"),
+    };
+    Err(bad(
+        &libs[k].dir,
+        format!(
+            "{name} holds rows of clip {} ({whose}), not one of this shard's clips",
+            crate::error::echo(c)
+        ),
+    ))
+}
+
+/// Refuse a table `name` of merged rows (sorted by its keys, `schema::sort_keys`) where
+/// two rows have the same keys; the error names the shard of the clip (`owner`).
+fn check_unique(
+    df: &polars::prelude::DataFrame,
+    name: &str,
+    owner: &BTreeMap<&str, usize>,
+    libs: &[ShardLib],
+) -> Result<()> {
+    let keys = sort_keys(name);
+    let cols: Vec<&polars::prelude::Column> =
+        keys.iter().filter_map(|k| df.column(k).ok()).collect();
+    if name == ERRORS_FILE || cols.len() != keys.len() {
+        return Ok(());
+    }
+    let same = |i: usize| {
+        cols.iter()
+            .all(|c| matches!((c.get(i - 1), c.get(i)), (Ok(a), Ok(b)) if a == b))
+    };
+    let Some(i) = (1..df.height()).find(|&i| same(i)) else {
+        return Ok(());
+    };
+    let key: Vec<String> = cols
+        .iter()
+        .map(|c| c.get(i).map(|v| v.to_string()).unwrap_or_default())
+        .collect();
+    let clip = super::sink::strings(&df.slice(i as i64, 1), "clip");
+    let shard = clip
+        .first()
+        .and_then(|c| owner.get(c.as_str()))
+        .map_or(Path::new("merge"), |k| libs[*k].dir.as_path());
+    Err(bad(
+        shard,
+        format!(
+            "{name} holds two rows of key ({}) = ({})",
+            keys.join(", "),
+            crate::error::echo(&key.join(", "))
+        ),
+    ))
 }
 
 #[cfg(test)]

@@ -119,6 +119,26 @@ pub fn is_library(dir: &Path) -> bool {
             .is_some_and(|m| manifest_says_library(&m))
 }
 
+/// Refuse a folder of tables `out` (`frames --out`) that holds a stancelib library
+/// ([`is_library`]): writing its frames, clips and contacts tables there would leave the
+/// library's other tables and manifest describing clips it no longer holds.
+///
+/// # Errors
+/// `out` is a library.
+pub fn refuse_library(out: &Path) -> Result<()> {
+    if !is_library(out) {
+        return Ok(());
+    }
+    Err(refused(
+        out,
+        format!(
+            "holds a stancelib library ({MANIFEST_FILE}): `frames` would replace its frames, \
+             clips and contacts tables under its other tables; give another folder, or \
+             rebuild the library with `build`"
+        ),
+    ))
+}
+
 fn manifest_says_library(m: &serde_json::Value) -> bool {
     match m.get("schema") {
         Some(s) => s

@@ -132,6 +132,7 @@ fn stance_plot(job: &StancePlotJob) -> anyhow::Result<(StancePlot, Vec<String>)>
         StancePlot {
             stance_id: s.stance.stance_id.clone(),
             mu_req: s.stance.coef.mu_req,
+            mu_req_robust: s.stance.coef.mu_req_robust,
             td_lo_s: (td, lo),
             heading: s.heading,
             model: sample_forces(&s.stance.model, s.times, &s.heading),

@@ -20,6 +20,7 @@ use crate::library::write::write_atomic;
 use crate::plot::{jump_map_png, write_png};
 use crate::query::feasibility::{check_mu, LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::gait::{GaitLaw, LawChoice};
+use crate::query::jump::recorded_jump;
 use crate::query::limits::{
     absolute_limits, left_out_clips, left_out_line, stance_limits, LeftOut,
 };
@@ -197,6 +198,8 @@ pub struct RunQuery {
     pub gait_law: LawChoice,
     /// Keep the clips the queries leave out ([`left_out_clips`]).
     pub keep_left_out: bool,
+    /// Explain in full the cycle whose first stance has this id (`--explain`).
+    pub explain: Option<String>,
 }
 
 /// One printed line of `query run`: a cycle at one speed (its first stance's values).
@@ -239,6 +242,9 @@ pub struct RunReport {
     pub n_speeds: usize,
     /// The lines, speed-major.
     pub lines: Vec<RunLine>,
+    /// `--explain`: the explained cycle at each speed, a blank line between speeds
+    /// ([`RunRow::full_explanation`]).
+    pub explained: Vec<String>,
 }
 
 /// Runs `query run` and writes its table (and figure).
@@ -271,6 +277,17 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
         skipped.iter().map(clip_of),
     );
     check_sweep("--speeds", cycles.len(), q.speeds.len())?;
+    if let Some(id) = &q.explain {
+        let firsts = cycles
+            .iter()
+            .map(|c| lib.stances[c.stances[0]].stance_id.as_str());
+        anyhow::ensure!(
+            firsts.clone().any(|f| f == id),
+            "--explain: {}",
+            crate::stances::ids::unknown_stance_message(id, firsts)
+                .replace("no stance", "no run cycle starting at stance")
+        );
+    }
     // Absolute limits of the target character: the source character's, scaled by §9.
     let limits: BTreeMap<String, Limits> = absolute_limits(&lib)
         .into_iter()
@@ -326,7 +343,7 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
     if let Some(png) = &q.png {
         let points = run_points(&rows, scaled.len());
         let title = format!(
-            "query run: {} cycle(s), limits {}, gait law {}{}",
+            "At which speeds can the run cycles run? ({} cycle(s), limits {}, gait law {}{})",
             scaled.len(),
             form.name(),
             q.gait_law.name(),
@@ -338,10 +355,17 @@ pub fn run_query(q: &RunQuery) -> anyhow::Result<RunReport> {
         );
         write_png(png, |p| crate::plot::runs::runs_png(p, &title, &points))?;
     }
+    let explained = q.explain.as_ref().map_or_else(Vec::new, |id| {
+        rows.iter()
+            .filter(|r| &r.stances[0].stance.stance_id == id)
+            .flat_map(|r| r.full_explanation().into_iter().chain([String::new()]))
+            .collect()
+    });
     Ok(RunReport {
         n_cycles: scaled.len(),
         n_speeds: q.speeds.len(),
         lines: rows.iter().map(run_line).collect(),
+        explained,
     })
 }
 
@@ -397,6 +421,7 @@ fn run_points(rows: &[RunRow], n_cycles: usize) -> Vec<crate::plot::runs::RunPoi
             };
             crate::plot::runs::RunPoint {
                 cycle: i % n_cycles.max(1),
+                cycle_name: r.stances[0].stance.stance_id.clone(),
                 speed_mps: r.candidate.speed,
                 contact_s: solved
                     .iter()
@@ -431,6 +456,9 @@ pub struct MapQuery {
     pub keep_left_out: bool,
     /// Output folder.
     pub out: PathBuf,
+    /// Also draw `jump_map_agreement.png`, the fast filters against the exact check (a
+    /// developer diagnostic).
+    pub diagnostics: bool,
 }
 
 /// What `map jumps` found.
@@ -450,7 +478,30 @@ pub struct MapReport {
     pub iou: f64,
     /// Time spent computing the map, s.
     pub elapsed_s: f64,
+    /// Per pair, most feasible cells first ([`PairAnswer`]).
+    pub pair_answers: Vec<PairAnswer>,
 }
+
+/// One pair of `map jumps` in words: how much of the grid it can jump, and whether it can
+/// jump its own recorded jump and one [`HIGHER_BY`] higher, each with its deciding limit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairAnswer {
+    /// Liftoff stance id.
+    pub liftoff: String,
+    /// Landing stance id.
+    pub landing: String,
+    /// Cells feasible by the exact check, of `cells`.
+    pub feasible_cells: usize,
+    /// Cells of the grid.
+    pub cells: usize,
+    /// The recorded jump: `None` feasible, else why not ([`crate::query::tables::JumpRow::explain`]).
+    pub recorded: Option<String>,
+    /// The recorded jump with its apex [`HIGHER_BY`] times as high, same distance.
+    pub higher: Option<String>,
+}
+
+/// The factor on the recorded apex height `map jumps` reports per pair ("10 % higher").
+pub const HIGHER_BY: f64 = 1.1;
 
 /// Runs `map jumps` and writes `jump_map.parquet`, `jump_map_pairs.parquet`,
 /// `jump_map.json` and the figures into its folder.
@@ -504,6 +555,12 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         &(serde_json::to_string_pretty(&summary)? + "\n"),
     )?;
     map_figures(&q.out, &map, &pool)?;
+    let pair_answers = pair_answers(&map, &pool, &limits);
+    if q.diagnostics {
+        write_png(&q.out.join(JUMP_MAP_AGREEMENT_PNG), |p| {
+            crate::plot::jump_map_agreement_png(p, &map, "all characters")
+        })?;
+    }
     Ok(MapReport {
         liftoffs: map.liftoffs.len(),
         landings: map.landings.len(),
@@ -516,8 +573,62 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         ),
         iou,
         elapsed_s: elapsed,
+        pair_answers,
     })
 }
+
+/// [`PairAnswer`] of every pair of the map, most feasible cells first (ties: ids).
+fn pair_answers(
+    map: &JumpMap,
+    pool: &[Prepared],
+    limits: &dyn Fn(&Prepared) -> Limits,
+) -> Vec<PairAnswer> {
+    let verdicts = |height: f64| -> BTreeMap<(String, String), Option<String>> {
+        let target = JumpTarget::Scaled {
+            height,
+            distance: 1.0,
+        };
+        ranked_jump_pairs(pool, |a, b| target.of(a, b), limits)
+            .iter()
+            .map(|r| {
+                let ids = (
+                    r.liftoff.stance.stance_id.clone(),
+                    r.landing.stance.stance_id.clone(),
+                );
+                (ids, r.explain())
+            })
+            .collect()
+    };
+    let (own, higher) = (verdicts(1.0), verdicts(HIGHER_BY));
+    let cells = map.heights.len() * map.speeds.len();
+    let mut out: Vec<PairAnswer> = map
+        .pairs
+        .iter()
+        .map(|p| {
+            let ids = (
+                pool[p.liftoff].stance.stance_id.clone(),
+                pool[p.landing].stance.stance_id.clone(),
+            );
+            PairAnswer {
+                feasible_cells: p.exact.iter().filter(|&&e| e).count(),
+                cells,
+                recorded: own.get(&ids).cloned().flatten(),
+                higher: higher.get(&ids).cloned().flatten(),
+                liftoff: ids.0,
+                landing: ids.1,
+            }
+        })
+        .collect();
+    out.sort_by(|a, b| {
+        b.feasible_cells
+            .cmp(&a.feasible_cells)
+            .then_with(|| (&a.liftoff, &a.landing).cmp(&(&b.liftoff, &b.landing)))
+    });
+    out
+}
+
+/// The `--diagnostics` picture of `map jumps` in its output folder.
+pub const JUMP_MAP_AGREEMENT_PNG: &str = "jump_map_agreement.png";
 
 /// `jump_map.png`, and one `jump_map_<character>.png` each when the pool has several.
 fn map_figures(out: &Path, map: &JumpMap, pool: &[Prepared]) -> anyhow::Result<()> {
@@ -623,6 +734,7 @@ pub fn query_stages(
             png: None,
             gait_law: gait_law_choice(q.gait_law.as_deref())?,
             keep_left_out: q.keep_left_out.unwrap_or(false),
+            explain: None,
         }),
         None => None,
     };
@@ -634,6 +746,7 @@ pub fn query_stages(
             limits,
             keep_left_out: q.keep_left_out.unwrap_or(false),
             out: dir.join("jump_map"),
+            diagnostics: false,
         }),
         _ => None,
     };
@@ -667,16 +780,96 @@ fn axis_or(flag: &str, given: Option<&str>, default: Axis) -> anyhow::Result<Vec
 pub struct JumpQuery {
     /// Library folder.
     pub lib: PathBuf,
-    /// Apex height above the liftoff contact, m.
-    pub height_m: f64,
-    /// Jump distance, m.
-    pub distance_m: f64,
+    /// The jump asked of every pair.
+    pub target: JumpTarget,
     /// Limit options (default form: relative).
     pub limits: LimitOptions,
     /// Keep the clips the queries leave out ([`left_out_clips`]).
     pub keep_left_out: bool,
+    /// Build each pair's whole explanation ([`JumpLine::full`]) for `--explain`.
+    pub explain: bool,
     /// Output Parquet file.
     pub out: PathBuf,
+}
+
+/// The jump `query jump` asks of each pair: absolute, or relative to the pair's recorded
+/// jump ([`recorded_jump`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum JumpTarget {
+    /// Apex height above the liftoff contact and distance, m, the same for every pair.
+    Absolute {
+        /// m.
+        height_m: f64,
+        /// m.
+        distance_m: f64,
+    },
+    /// The pair's recorded apex height and distance times these.
+    Scaled {
+        /// Factor on the recorded apex height.
+        height: f64,
+        /// Factor on the recorded distance.
+        distance: f64,
+    },
+}
+
+impl JumpTarget {
+    /// `(height, distance)` asked of the pair (liftoff `p1`, landing `p2`), m.
+    pub fn of(&self, p1: &Prepared, p2: &Prepared) -> (f64, f64) {
+        match *self {
+            JumpTarget::Absolute {
+                height_m,
+                distance_m,
+            } => (height_m, distance_m),
+            JumpTarget::Scaled { height, distance } => {
+                let (h0, d0) = recorded_jump(&p1.stance, &p2.stance);
+                (h0 * height, d0 * distance)
+            }
+        }
+    }
+
+    /// Each number finite, and the scales positive.
+    ///
+    /// # Errors
+    /// The option that is not.
+    pub fn check(&self) -> anyhow::Result<()> {
+        let (a, b, scaled) = match *self {
+            JumpTarget::Absolute {
+                height_m,
+                distance_m,
+            } => (height_m, distance_m, false),
+            JumpTarget::Scaled { height, distance } => (height, distance, true),
+        };
+        let names = if scaled {
+            ["--height-scale", "--distance-scale"]
+        } else {
+            ["--height", "--distance"]
+        };
+        for (n, v) in names.iter().zip([a, b]) {
+            anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
+        }
+        if scaled {
+            check_scale(names[0], a)?;
+            anyhow::ensure!(
+                b >= 0.0,
+                "{} must be ≥ 0 (0: a jump in place), found {b}",
+                names[1]
+            );
+        }
+        Ok(())
+    }
+
+    /// The target for the query's options JSON.
+    fn json(&self) -> serde_json::Value {
+        match *self {
+            JumpTarget::Absolute {
+                height_m,
+                distance_m,
+            } => serde_json::json!({"height_m": height_m, "distance_m": distance_m}),
+            JumpTarget::Scaled { height, distance } => {
+                serde_json::json!({"height_scale": height, "distance_scale": distance})
+            }
+        }
+    }
 }
 
 /// One ranked pair of `query jump`.
@@ -695,6 +888,11 @@ pub struct JumpLine {
     /// Why not, with the deciding value, limit and margin
     /// ([`crate::query::tables::JumpRow::explain`]).
     pub why: Option<String>,
+    /// Apex height (m) and distance (m) asked of this pair.
+    pub asked: (f64, f64),
+    /// The whole answer ([`crate::query::tables::JumpRow::full_explanation`]); empty
+    /// unless [`JumpQuery::explain`].
+    pub full: Vec<String>,
 }
 
 /// Runs `query jump`: ranks every pair (feasible first, then the least force change),
@@ -704,21 +902,19 @@ pub struct JumpLine {
 /// A height or distance that is not a number, bad limit options, an unreadable library,
 /// an unwritable output.
 pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
-    for (n, v) in [("--height", q.height_m), ("--distance", q.distance_m)] {
-        anyhow::ensure!(v.is_finite(), "{n} must be a number, found {v}");
-    }
+    q.target.check()?;
     let (form, mu) = q.limits.form(LimitForm::Absolute)?;
     let active = q.limits.active_fraction()?;
     let (lib, pool) = load_pool(&q.lib, active)?;
     let pool = pool_without_left_out("query jump", &lib, pool, q.keep_left_out);
     let absolute = absolute_limits(&lib);
     let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);
-    let rows = ranked_jump_pairs(&pool, q.height_m, q.distance_m, lim);
+    let rows = ranked_jump_pairs(&pool, |a, b| q.target.of(a, b), lim);
     let mut df = jump_table(&rows)?;
     let kv = query_kv(
         &q.lib,
         serde_json::json!({
-            "query": "jump", "lib": q.lib, "height_m": q.height_m, "distance_m": q.distance_m,
+            "query": "jump", "lib": q.lib, "target": q.target.json(),
             "limits": form.name(), "mu": mu, "active_set": active,
         }),
     )?;
@@ -737,6 +933,12 @@ pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
             }),
             feasible: r.jump.as_ref().is_ok_and(|j| j.feasible()),
             why: r.explain(),
+            asked: (r.height, r.distance),
+            full: if q.explain {
+                r.full_explanation()
+            } else {
+                Vec::new()
+            },
         })
         .collect())
 }

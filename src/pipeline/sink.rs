@@ -11,8 +11,11 @@
 //! kinematics:  per contact frame (frame, x, y, z) in a scratch file, indexed per
 //!              (character_id, effector, clip)                          [samples, on disk]
 //!              per character (leg length of its first clip)
-//! manifest:    per clip (content hash, status); errors rows
+//! manifest:    per clip (content hash, status, rows per table); errors rows
 //! ```
+//! Once the tables are written, the manifest records every file's SHA-256 and each clip's
+//! rows per table ([`crate::library::integrity`]), what an incremental build and a merge
+//! check before they take rows from the library.
 //! The samples are the kinematic summary a shard writes (`kinematics_samples.parquet`) and
 //! a merge reads back instead of the frames. Every table is sorted by its keys before it is
 //! appended (rows of one batch), and batches arrive in clip order, so the files are the
@@ -26,6 +29,9 @@ use polars::prelude::*;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::library::integrity::{
+    add_clip_rows, library_digests, ClipRows, CLIP_ROWS_KEY, TABLES_KEY,
+};
 use crate::library::kinematics::{
     add_character_legs, facets_table, points_frame, samples_table, Facet, PointRows, Sample,
 };
@@ -204,6 +210,8 @@ pub(crate) struct LibrarySink {
     clip_facts: BTreeMap<String, ClipFacts>,
     inputs: BTreeMap<String, String>,
     status: Vec<String>,
+    /// Rows per clip of each per-clip table but `clips.parquet` (one a clip).
+    clip_rows: ClipRows,
     n_stances: usize,
     /// Samples come from the frames of each batch (a build), or are given (a merge).
     compute_samples: bool,
@@ -238,6 +246,7 @@ impl LibrarySink {
             clip_facts: BTreeMap::new(),
             inputs: BTreeMap::new(),
             status: Vec::new(),
+            clip_rows: ClipRows::new(),
             n_stances: 0,
             compute_samples,
             keep_samples,
@@ -286,6 +295,11 @@ impl LibrarySink {
         }
         // The tables are written side by side on the worker pool (each its own file); a
         // detached table's writer is elsewhere, so its rows cannot come here.
+        for (name, df) in t.named() {
+            if name != CLIPS_FILE {
+                count_clip_rows(&mut self.clip_rows, name, df);
+            }
+        }
         let mut named: BTreeMap<&str, &mut DataFrame> = t.named().into_iter().collect();
         let jobs: Vec<(&mut DataFrame, &mut TableWriter)> = self
             .writers
@@ -337,11 +351,18 @@ impl LibrarySink {
         shard: Option<serde_json::Value>,
         layout: Layout,
     ) -> Result<()> {
-        self.finish_with(fingerprint, t0, shard, layout, || Ok(Vec::new()), &|| {})
+        self.finish_with(
+            fingerprint,
+            t0,
+            shard,
+            layout,
+            || Ok(Detached::default()),
+            &|| {},
+        )
     }
 
     /// [`LibrarySink::finish`] for a sink with detached writers ([`LibrarySink::detach`]):
-    /// `rejoin` hands them back, filled. It is called on a thread of its own as the finish
+    /// `rejoin` hands them back, filled, with the rows per clip written through them. It is called on a thread of its own as the finish
     /// starts, and the writers get their footers there, so whatever fills them (and their
     /// footers) overlaps the polytopes, the longest part of the finish. `cancel` is called
     /// when the rest of the finish fails or panics, before `rejoin`'s thread is waited
@@ -352,7 +373,7 @@ impl LibrarySink {
         t0: Instant,
         shard: Option<serde_json::Value>,
         layout: Layout,
-        rejoin: impl FnOnce() -> Result<Vec<(&'static str, TableWriter)>> + Send,
+        rejoin: impl FnOnce() -> Result<Detached> + Send,
         cancel: &(dyn Fn() + Sync),
     ) -> Result<()> {
         let dir = self.dir.clone();
@@ -372,12 +393,13 @@ impl LibrarySink {
         ];
         // The detached writers are handed back and get their footers on a thread of their
         // own, beside the rest (in a build there are none).
-        std::thread::scope(|scope| {
-            let detached = scope.spawn(|| -> Result<()> {
-                for (_, w) in rejoin()? {
+        let detached_rows = std::thread::scope(|scope| {
+            let detached = scope.spawn(|| -> Result<ClipRows> {
+                let back = rejoin()?;
+                for (_, w) in back.writers {
                     w.finish(&kv)?;
                 }
-                Ok(())
+                Ok(back.clip_rows)
             });
             let mut failed = Defer::new(cancel);
             let ours = self.finish_tables(&mut errors, &kv);
@@ -394,9 +416,15 @@ impl LibrarySink {
             });
             ours.and(theirs)
         })?;
+        for (clip, tables) in detached_rows {
+            for (table, n) in tables {
+                add_clip_rows(&mut self.clip_rows, &clip, &table, n);
+            }
+        }
         if layout == Layout::Dataset {
             convert_to_dataset(&dir)?;
         }
+        let digests = library_digests(&dir)?;
         let count = |s: &str| self.status.iter().filter(|v| *v == s).count();
         let mut manifest = serde_json::json!({
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
@@ -413,6 +441,8 @@ impl LibrarySink {
                 "failed": count("error"), "stances": self.n_stances,
             },
             "failures": strings(&errors, "message"),
+            TABLES_KEY: digests,
+            CLIP_ROWS_KEY: self.clip_rows,
             "wall_time_s": t0.elapsed().as_secs_f64(),
         });
         if let (Some(s), Some(m)) = (shard, manifest.as_object_mut()) {
@@ -440,6 +470,38 @@ impl LibrarySink {
             write_samples(&self.samples, &self.dir, kv)?;
         }
         kinematics(&self.samples, &self.legs, &self.dir, kv)
+    }
+}
+
+/// Writers handed back to [`LibrarySink::finish_with`], filled, with the rows per clip
+/// written through them (table names as [`add_clip_rows`] takes them).
+#[derive(Default, Debug)]
+pub(crate) struct Detached {
+    pub writers: Vec<(&'static str, TableWriter)>,
+    pub clip_rows: ClipRows,
+}
+
+/// Add the rows per clip of `df` (rows of table `name`, whole clips in clip order) to
+/// `rows`.
+fn count_clip_rows(rows: &mut ClipRows, name: &str, df: &DataFrame) {
+    let Ok(clips) = df.column(frames::CLIP).and_then(|c| c.str().cloned()) else {
+        return;
+    };
+    let mut run: Option<(&str, u64)> = None;
+    for c in clips.iter() {
+        let c = c.unwrap_or_default();
+        match &mut run {
+            Some((last, n)) if *last == c => *n += 1,
+            _ => {
+                if let Some((last, n)) = run.take() {
+                    add_clip_rows(rows, last, name, n);
+                }
+                run = Some((c, 1));
+            }
+        }
+    }
+    if let Some((last, n)) = run {
+        add_clip_rows(rows, last, name, n);
     }
 }
 
@@ -654,6 +716,20 @@ impl ClipCursor {
             cache: None,
             whole,
         })
+    }
+
+    /// The clip of the next rows not read yet, if any are left.
+    pub fn next_clip(&self) -> Option<&str> {
+        self.runs.get(self.next).map(|(c, _)| c.as_str())
+    }
+
+    /// The table's rows per clip (all of them, read or not).
+    pub fn rows_per_clip(&self) -> BTreeMap<&str, u64> {
+        let mut out: BTreeMap<&str, u64> = BTreeMap::new();
+        for (c, n) in &self.runs {
+            *out.entry(c.as_str()).or_default() += *n as u64;
+        }
+        out
     }
 
     /// Rows `start .. start + len`, read a row group's worth at a time through the cache.

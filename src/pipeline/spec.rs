@@ -141,6 +141,8 @@ pub struct PipelineFile {
     pub body: Option<String>,
     /// Body mass, kg.
     pub mass_kg: Option<f64>,
+    /// Per-clip masses (CSV: `clip,mass_kg[,sex]`), relative to the pipeline file.
+    pub masses: Option<String>,
     /// Unit override for every input.
     pub unit: Option<UnitValue>,
     /// Up-axis override for every input.
@@ -229,12 +231,8 @@ fn check_common(
     let bad =
         |key: &str, msg: String| Error::config(Some(path.to_path_buf()), key_line(text, key), msg);
     if let Some(m) = mass_kg {
-        if !(m.is_finite() && m > 0.0) {
-            return Err(bad(
-                "mass_kg",
-                format!("mass_kg must be positive, found {m}"),
-            ));
-        }
+        crate::ingest::masses::check_body_mass(m)
+            .map_err(|e| bad("mass_kg", format!("mass_kg: {e}")))?;
     }
     if let Some(u) = unit {
         if unit_value(u).is_none() {
@@ -466,6 +464,8 @@ pub struct Overrides {
     pub no_hands: bool,
     /// `--joints`.
     pub joints: bool,
+    /// `--masses`: a per-clip masses table (read by [`with_masses`]).
+    pub masses: Option<std::path::PathBuf>,
 }
 
 /// Resolve options: CLI > pipeline > body > default.
@@ -492,6 +492,9 @@ pub fn resolve(
         }
     }
     o.mass_kg = cli.mass_kg.unwrap_or(o.mass_kg);
+    o.mass_given = cli.mass_kg.is_some()
+        || pipe.is_some_and(|p| p.mass_kg.is_some())
+        || body.is_some_and(|b| b.mass_kg.is_some());
     o.unit_m = cli.unit_m.or(o.unit_m);
     o.up_axis = cli.up_axis.or(o.up_axis);
     o.contacts.static_mode |= cli.static_contacts;
@@ -546,6 +549,21 @@ pub fn resolve_fit(
         o.fit.model = m;
     }
     o
+}
+
+/// `o` with the per-clip masses table at `path` (`--masses`, or a pipeline's `masses`),
+/// when one is given.
+///
+/// # Errors
+/// The file cannot be read as a side input (regular file, size bound) or is not a masses
+/// table (the error names the file, line and field).
+pub fn with_masses(mut o: IngestOptions, path: Option<&Path>) -> Result<IngestOptions> {
+    if let Some(p) = path {
+        let text = super::inputs::read_side_text(p, super::inputs::SideInput::Masses)?;
+        let table = crate::ingest::masses::parse_masses(&text, &p.display().to_string())?;
+        o.masses = Some(std::sync::Arc::new(table));
+    }
+    Ok(o)
 }
 
 /// Expand a pipeline's input globs (relative to the pipeline file's folder).

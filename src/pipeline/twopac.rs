@@ -12,9 +12,10 @@ use anyhow::Context;
 use rayon::prelude::*;
 
 use super::twopac_tables::{form_name, TrajectoryRow};
-use crate::plot::trajectory::TrajectoryPlot;
+use crate::plot::trajectory::{CurveSample, PhaseSpan, TrajectoryPlot};
 use crate::twopac::bezier::ComState;
 use crate::twopac::clip::{phases_from_runs, RecordedRun, Recording};
+use crate::twopac::diagnose::Failure;
 use crate::twopac::phases::{KinematicsRef, PhasesFile};
 use crate::twopac::polytope::Polytope;
 use crate::twopac::region::{static_region, RegionStatus};
@@ -268,13 +269,16 @@ pub fn rows(traj: &(dyn ComTrajectory + Sync), p: &Plan, v: &Validation) -> Vec<
         .collect()
 }
 
-/// What `trajectory.png` draws of a plan: contacts, the 2PAC curve, the quasi-static
-/// polyline, transition points, phase states and the invalid samples.
+/// What `trajectory.png` draws of a plan: contacts, the 2PAC curve with its validated
+/// samples and their causes of failure (`fails`, [`crate::twopac::diagnose::failures`]),
+/// the quasi-static polyline, transition points, phase states and the phases on the time
+/// axis.
 pub fn plot_data(
     phases: &[Phase],
     p: &Plan,
     curve: &[TrajectoryRow],
     qs: &QuasiStatic,
+    fails: &[Failure],
 ) -> TrajectoryPlot {
     let mut contacts: Vec<Vec<[f64; 3]>> = Vec::new();
     for c in phases.iter().flat_map(|ph| &ph.contacts) {
@@ -283,23 +287,52 @@ pub fn plot_data(
             contacts.push(pts);
         }
     }
+    let cause_at = |t: f64| {
+        fails
+            .iter()
+            .find(|f| (f.t_s - t).abs() < 1e-9)
+            .map(|f| f.cause)
+    };
+    let (t0, t1) = p.span_s();
+    let bounds: Vec<f64> = std::iter::once(t0)
+        .chain(p.switch_times_s.iter().copied())
+        .chain(std::iter::once(t1))
+        .collect();
     TrajectoryPlot {
         title: format!(
-            "2PAC COM trajectory: {} phases, {} transitions, {} windows",
+            "Is the 2PAC COM trajectory dynamically valid? ({} contact phases, {} transitions)",
             phases.len(),
             p.transitions.len(),
-            p.windows.len()
         ),
+        verdict: None,
         contacts,
         curve: curve.iter().map(|r| r.state.pos).collect(),
         quasi_static: qs.knots.iter().map(|k| k.1).collect(),
         transitions: p.transitions.iter().map(|t| t.point.com).collect(),
         phase_states: p.phase_states.iter().map(|s| s.com).collect(),
         recorded: Vec::new(),
-        invalid: curve
+        samples: curve
             .iter()
-            .filter(|r| !r.valid)
-            .map(|r| r.state.pos)
+            .map(|r| CurveSample {
+                t_s: r.t_s,
+                pos: r.state.pos,
+                slack_n: r.slack_n,
+                cause: (!r.valid).then(|| cause_at(r.t_s)).flatten(),
+            })
+            .collect(),
+        phases: phases
+            .iter()
+            .zip(bounds.windows(2))
+            .map(|(ph, w)| PhaseSpan {
+                start_s: w[0],
+                end_s: w[1],
+                effectors: ph
+                    .contacts
+                    .iter()
+                    .map(|c| c.effector.as_str())
+                    .collect::<Vec<_>>()
+                    .join("+"),
+            })
             .collect(),
     }
 }

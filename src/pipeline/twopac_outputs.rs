@@ -17,8 +17,11 @@ use super::twopac_tables::{
 use crate::library::atomic::write_text_atomic;
 use crate::library::write::write_atomic;
 use crate::plot::trajectory::trajectory_png;
+use crate::plot::trajectory::{curve_verdict, CurveSample};
 use crate::plot::write_png;
+use crate::plot::Verdict;
 use crate::twopac::clip::{rms_to_recording, Recording};
+use crate::twopac::diagnose::{explain, failures, Cause, Failure};
 use crate::twopac::phases::{parse_phases, PhasesFile};
 use crate::twopac::trajectory::{
     phase_diagnostics, plan, ComTrajectory, Phase, PhaseDiagnostic, Plan, PlanOptions, QuasiStatic,
@@ -126,6 +129,14 @@ pub struct Planned {
     pub v_curve: Validation,
     /// §7 validation of the baseline.
     pub v_qs: Validation,
+    /// The 2PAC curve's invalid samples with their causes.
+    pub fail_curve: Vec<Failure>,
+    /// The baseline's invalid samples with their causes.
+    pub fail_qs: Vec<Failure>,
+    /// The effectors of each phase (`left_foot+right_foot`), to name phases in words.
+    pub phase_names: Vec<String>,
+    /// Body mass, kg.
+    pub mass_kg: f64,
     /// Samples of the 2PAC curve.
     pub curve_rows: Vec<TrajectoryRow>,
     /// Samples of the baseline.
@@ -171,6 +182,8 @@ pub fn plan_phases(
     let diags = phase_diagnostics(&p, phases);
     let v_curve = validate(&p, &p.forms, DEFAULT_STEP_S);
     let v_qs = validate(&qs, &p.forms, DEFAULT_STEP_S);
+    let fail_curve = failures(&p, &p.forms, &v_curve);
+    let fail_qs = failures(&qs, &p.forms, &v_qs);
     let curve_rows = rows(&p, &p, &v_curve);
     let qs_rows = rows(&qs, &p, &v_qs);
     let timings = timings(phases, &p, file.mass_kg, &file.start, &opts);
@@ -180,11 +193,69 @@ pub fn plan_phases(
         diags,
         v_curve,
         v_qs,
+        fail_curve,
+        fail_qs,
+        phase_names: phase_names(phases),
+        mass_kg: file.mass_kg,
         curve_rows,
         qs_rows,
         timings,
         plan_s,
     })
+}
+
+/// The effectors of each phase, joined by `+` (`left_foot+right_foot`).
+pub fn phase_names(phases: &[Phase]) -> Vec<String> {
+    phases
+        .iter()
+        .map(|p| {
+            let e: Vec<&str> = p.contacts.iter().map(|c| c.effector.as_str()).collect();
+            e.join("+")
+        })
+        .collect()
+}
+
+impl Planned {
+    /// Why the 2PAC curve fails its validation, in words (`None` when valid).
+    pub fn why_curve(&self) -> Option<String> {
+        explain(&self.v_curve, &self.fail_curve, &self.phase_names)
+    }
+
+    /// The verdict line of `trajectory.png`: the 2PAC curve's, then the baseline's.
+    pub fn plot_verdict(&self, samples: &[CurveSample]) -> Verdict {
+        let v = curve_verdict(samples);
+        let n = self.v_qs.samples.len();
+        let qs = if self.v_qs.trajectory_valid {
+            "the quasi-static baseline too".to_string()
+        } else {
+            let main = Cause::ALL
+                .into_iter()
+                .max_by_key(|c| self.fail_qs.iter().filter(|f| f.cause == *c).count())
+                .map_or(String::new(), |c| c.as_str().replace('_', " "));
+            format!(
+                "quasi-static baseline not ({} of {n} samples fail, mostly {main})",
+                self.fail_qs.len()
+            )
+        };
+        Verdict::new(format!("{}; {qs}", v.text), v.ok)
+    }
+
+    /// The 2PAC curve's smallest robustness margin (N, §8.2, with each sample's own
+    /// acceleration), its time (s) and phase: how far the COM stays from the edge of
+    /// what the contacts can hold (≈ 0: it runs along the edge of the support). `None`
+    /// without a finite margin (force closure, infeasible samples).
+    pub fn smallest_margin(&self) -> Option<(f64, f64, usize)> {
+        self.curve_rows
+            .iter()
+            .filter_map(|r| r.verdict.margin_n.map(|m| (m, r.t_s, r.phase)))
+            .filter(|(m, _, _)| m.is_finite())
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
+    /// Why the quasi-static baseline fails its validation, in words (`None` when valid).
+    pub fn why_qs(&self) -> Option<String> {
+        explain(&self.v_qs, &self.fail_qs, &self.phase_names)
+    }
 }
 
 /// Writes the tables, `timings.json`, `trajectory.png` and (with a recording)
@@ -224,7 +295,8 @@ pub fn write_outputs(
         write_atomic(out, name, &mut df, &kv)?;
     }
     write_json(&out.join("timings.json"), &r.timings)?;
-    let mut data = plot_data(phases, p, &r.curve_rows, &r.qs);
+    let mut data = plot_data(phases, p, &r.curve_rows, &r.qs, &r.fail_curve);
+    data.verdict = Some(r.plot_verdict(&data.samples));
     if let (Some(rec), Some(first), Some(last)) =
         (recorded, r.curve_rows.first(), r.curve_rows.last())
     {

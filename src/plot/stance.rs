@@ -1,12 +1,19 @@
-//! The per-stance force plot (`stancelib plot stance`): the model's force against the
-//! kinematic force m(a + g) and, when given, the plate force, over clip time.
+//! The per-stance force plot (`stancelib plot stance`): does the stance's force model
+//! match the measured force, and how much friction does the stance need? The model's
+//! force against the kinematic force m(a + g) and, when given, the plate force, over clip
+//! time. The verdict line gives the model's fit to the kinematic force (and the plates)
+//! and the friction the queries judge, `mu_req_robust` (on the 20 % active set).
 //!
 //! # Model
 //! ```text
 //! panel (a): f_v (N)          panel (b): f_h (N)
-//! panel (c): |f_t|/f_v = hypot(f_h, f_p)/f_v   where f_v > 0, drawn in [0, 2] (larger
+//! panel (c): |f_t|/f_v = hypot(f_h, f_p)/f_v   where f_v ≥ 5 % of the series' peak f_v
+//!            (below it, in flight, a ratio of two small numbers), drawn in [0, 2] (larger
 //!            values at 2, with a note); shaded: the model's active set
-//!            A = {τ : f_v(τ) ≥ λ · max_grid f_v}   (λ = --active-set)
+//!            A = {τ : f_v(τ) ≥ λ · max_grid f_v}   (λ = --active-set, default the queries'
+//!            0.2); dashed: the stored mu_req_robust, what the queries judge
+//! fit:  RMS over the measured samples in [touchdown, liftoff] of f_v,model − f_v,measured,
+//!       the model linearly interpolated on its grid; good when ≤ FIT_OK_REL · max f_v
 //! stance axes of a world force F: (F·e_h, F·e_p, F_z)   (Heading::to_stance)
 //! ```
 //!
@@ -19,7 +26,7 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
-use super::{err, register_font, PlotError};
+use super::{err, register_font, titled, PlotError, Verdict};
 use crate::force_model::export::ForceSample;
 use crate::stances::params::Heading;
 
@@ -27,10 +34,76 @@ use crate::stances::params::Heading;
 pub const STANCE_PLOT_PX: (u32, u32) = (1200, 1050);
 /// Width of the legend column on the right, px.
 const LEGEND_PX: u32 = 290;
+/// Panel (c) draws a series' `|f_t|/f_v` where its `f_v` is at least this fraction of its
+/// peak (the 5 % set of the stored `mu_req`): in flight the kinematic force is noise over
+/// noise, and its ratio drew a flat line that read as friction before touchdown.
+pub const RATIO_MIN_FV_FRACTION: f64 = 0.05;
 /// Upper end of the `|f_t|/f_v` axis; larger ratios are drawn there, with a note.
 pub const RATIO_AXIS_MAX: f64 = 2.0;
 /// The time axis extends this fraction of `Δt` before touchdown and after liftoff.
 pub const TIME_PAD_FRACTION: f64 = 0.15;
+
+/// The fit is good news when its RMS error of `f_v` is at most this fraction of the
+/// model's peak `f_v`.
+pub const FIT_OK_REL: f64 = 0.1;
+
+/// RMS of `f_v,model − f_v,measured` over the measured samples in `[td, lo]` (N), the
+/// model linearly interpolated on its grid; `None` without such samples.
+pub fn fit_rms_n(d: &StancePlot, measured: &WorldForces) -> Option<f64> {
+    let (td, lo) = d.td_lo_s;
+    let model_at = |t: f64| {
+        let k = d.model.partition_point(|s| s.time_s < t);
+        let (a, b) = (d.model.get(k.checked_sub(1)?)?, d.model.get(k)?);
+        let w = if b.time_s > a.time_s {
+            (t - a.time_s) / (b.time_s - a.time_s)
+        } else {
+            0.0
+        };
+        Some(a.f_stance[2] + w * (b.f_stance[2] - a.f_stance[2]))
+    };
+    let sq: Vec<f64> = measured
+        .samples
+        .iter()
+        .filter(|(t, _)| (td..=lo).contains(t))
+        .filter_map(|(t, f)| Some((model_at(*t)? - d.heading.to_stance(*f)[2]).powi(2)))
+        .collect();
+    (!sq.is_empty()).then(|| (sq.iter().sum::<f64>() / sq.len() as f64).sqrt())
+}
+
+/// The verdict of the stance plot: the model's fit to the kinematic force (and the
+/// plates), and the friction the queries judge.
+pub fn stance_verdict(d: &StancePlot) -> Verdict {
+    let peak = d
+        .model
+        .iter()
+        .map(|s| s.f_stance[2])
+        .fold(0.0f64, f64::max)
+        .max(1.0);
+    let mut ok = true;
+    let mut fits = Vec::new();
+    for m in std::iter::once(&d.kinematic).chain(&d.plate) {
+        if let Some(rms) = fit_rms_n(d, m) {
+            ok &= rms <= FIT_OK_REL * peak;
+            let name = m.label.split(' ').next().unwrap_or("measured");
+            fits.push(format!(
+                "{rms:.0} N RMS from the {name} f_v ({:.0} % of peak)",
+                100.0 * rms / peak
+            ));
+        }
+    }
+    let fit = if fits.is_empty() {
+        "no measured sample to compare".to_string()
+    } else {
+        format!("model {}", fits.join(", "))
+    };
+    Verdict::new(
+        format!(
+            "{fit}; friction needed μ_req_robust = {:.3} (20 % active set, what the queries judge)",
+            d.mu_req_robust
+        ),
+        ok && !fits.is_empty(),
+    )
+}
 
 /// A measured force series (kinematic or plate): clip time (s) and world force (N, Z up).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -46,8 +119,11 @@ pub struct WorldForces {
 pub struct StancePlot {
     /// `<clip>:<label>:<first frame>`.
     pub stance_id: String,
-    /// The model's stored required friction `mu_req`.
+    /// The model's stored required friction on the paper's 5 % active set, `mu_req`.
     pub mu_req: f64,
+    /// The model's stored required friction on the 20 % active set, `mu_req_robust`: what
+    /// the queries judge.
+    pub mu_req_robust: f64,
     /// Touchdown and liftoff, clip time (s).
     pub td_lo_s: (f64, f64),
     /// The stance frame.
@@ -272,6 +348,16 @@ fn legend(
     .map_err(|e| err(path, e))?;
     area.draw(&text("touchdown, liftoff", y))
         .map_err(|e| err(path, e))?;
+    y += 28;
+    area.draw(&DashedPathElement::new(
+        vec![(x, y), (x + 30, y)],
+        8,
+        5,
+        RED.stroke_width(2),
+    ))
+    .map_err(|e| err(path, e))?;
+    area.draw(&text("μ_req_robust (panel c)", y))
+        .map_err(|e| err(path, e))?;
     y += 44;
     let small = ("sans-serif", 14).into_font();
     for n in notes {
@@ -290,10 +376,11 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
     register_font();
     let root = BitMapBackend::new(path, STANCE_PLOT_PX).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let title = format!("Stance {}   ·   model μ_req = {:.3}", d.stance_id, d.mu_req);
-    let root = root
-        .titled(&title, ("sans-serif", 22))
-        .map_err(|e| err(path, e))?;
+    let title = format!(
+        "Stance {}: does the force model match the measured force?",
+        d.stance_id
+    );
+    let root = titled(&root, path, &title, &stance_verdict(d))?;
     let (charts, side) = root.split_horizontally(STANCE_PLOT_PX.0 - LEGEND_PX);
     let panels = charts.split_evenly((3, 1));
     let series = d.series();
@@ -343,6 +430,13 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
     for chart in [&mut a, &mut b, &mut c] {
         draw_events(chart, path, d.td_lo_s)?;
     }
+    c.draw_series(std::iter::once(DashedPathElement::new(
+        vec![(x.0, d.mu_req_robust), (x.1, d.mu_req_robust)],
+        8,
+        5,
+        RED.stroke_width(2),
+    )))
+    .map_err(|e| err(path, e))?;
     // Measured series first, the model on top.
     for s in series.iter().rev() {
         let s = Series {
@@ -353,8 +447,12 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
         };
         draw_broken(&mut a, path, &s, &|f| Some(f[2]))?;
         draw_broken(&mut b, path, &s, &|f| Some(f[0]))?;
+        let peak_fv = s.points.iter().map(|p| p.1[2]).fold(0.0, f64::max);
         draw_broken(&mut c, path, &s, &|f| {
-            traction_ratio(*f).map(|r| r.min(RATIO_AXIS_MAX))
+            (f[2] >= RATIO_MIN_FV_FRACTION * peak_fv)
+                .then(|| traction_ratio(*f))
+                .flatten()
+                .map(|r| r.min(RATIO_AXIS_MAX))
         })?;
     }
     let max_active = d
@@ -367,9 +465,12 @@ pub fn stance_png(path: &Path, d: &StancePlot) -> Result<(), PlotError> {
     let notes = vec![
         format!("touchdown {td:.3} s, liftoff {lo:.3} s"),
         format!("Δt = {:.3} s", lo - td),
-        format!("active set: f_v ≥ {} · max f_v", d.active_fraction),
-        "  of the model".to_string(),
+        format!("shaded: f_v ≥ {} · max f_v", d.active_fraction),
+        "  of the model (--active-set)".to_string(),
         format!("model max |f_t|/f_v there: {max_active:.3}"),
+        format!("stored μ_req_robust: {:.3}", d.mu_req_robust),
+        "  (20 % set; the queries' check)".to_string(),
+        format!("stored μ_req: {:.3} (5 % set)", d.mu_req),
         "forces: applied on the body,".to_string(),
         "  stance axes h (heading),".to_string(),
         "  p (left), v (up)".to_string(),

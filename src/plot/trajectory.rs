@@ -1,26 +1,59 @@
-//! `trajectory.png` of `twopac` (spec two-pac §8): a side view and a top view of the
-//! contacts, phase states, transition points, the 2PAC curve, the quasi-static polyline,
-//! the recorded COM (`--clip`) and the curve's dynamically invalid samples, with equal
-//! scales on both axes of a view (metres).
+//! `trajectory.png` of `twopac` (spec two-pac §8): is the planned COM trajectory
+//! dynamically valid, and where and why not? A side view and a top view of the contacts,
+//! phase states, transition points, the 2PAC curve, the quasi-static polyline and the
+//! recorded COM (`--clip`), with equal scales on both axes of a view (metres); the
+//! stretches of the curve that fail the dynamic validation are highlighted under it in the
+//! colour of their cause ([`crate::twopac::diagnose::Cause`]); below, the validation slack
+//! `s*` over time with the phases and their contacts. The verdict line gives the 2PAC
+//! curve's and the baseline's verdicts.
 //!
 //! The views are along the path's own direction, not world x (a walk along y would
 //! collapse): `s` is the horizontal direction from the curve's start to its end (or, for
 //! a path that returns to its start, the principal horizontal direction of all points),
-//! `l` the horizontal direction to its left, and `z` up.
+//! `l` the horizontal direction to its left, and `z` up; a direction within 10° of a world
+//! axis is snapped to it ([`SNAP_TO_AXIS_RAD`]).
 
 use std::path::Path;
 
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::{err, register_font, PlotError};
+use super::{err, register_font, tick_label, titled, PlotError, Verdict};
+use crate::twopac::diagnose::Cause;
+
+/// One validated sample of the 2PAC curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurveSample {
+    /// Time, s.
+    pub t_s: f64,
+    /// COM, world m.
+    pub pos: [f64; 3],
+    /// Validation slack `s*`, N (`+∞`: no force distribution).
+    pub slack_n: f64,
+    /// Why the sample fails; `None` when valid.
+    pub cause: Option<Cause>,
+}
+
+/// One phase on the time axis: `[start, end)` (s) and its contacts' effectors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhaseSpan {
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// `left_foot+right_foot`.
+    pub effectors: String,
+}
 
 /// What `trajectory.png` shows (world frame, m).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TrajectoryPlot {
     /// Title.
     pub title: String,
+    /// The verdict line.
+    pub verdict: Option<Verdict>,
     /// Each contact's points (a rectangle's 4 corners, or one point).
     pub contacts: Vec<Vec<[f64; 3]>>,
     /// The 2PAC COM curve, sampled.
@@ -33,13 +66,52 @@ pub struct TrajectoryPlot {
     pub phase_states: Vec<[f64; 3]>,
     /// The recorded COM over the planned span (`--clip`), empty otherwise.
     pub recorded: Vec<[f64; 3]>,
-    /// Samples of the 2PAC curve that fail the dynamic validation.
-    pub invalid: Vec<[f64; 3]>,
+    /// The validated samples of the 2PAC curve (the §7 times).
+    pub samples: Vec<CurveSample>,
+    /// The phases on the time axis.
+    pub phases: Vec<PhaseSpan>,
+}
+
+/// The colour of a cause of failure.
+pub fn cause_colour(c: Cause) -> RGBColor {
+    match c {
+        Cause::OffSupport => RGBColor(220, 30, 30),
+        Cause::TooFast => RGBColor(230, 140, 0),
+        Cause::NoForce => RGBColor(130, 0, 160),
+    }
+}
+
+/// Legend text of a cause of failure.
+fn cause_label(c: Cause) -> &'static str {
+    match c {
+        Cause::OffSupport => "invalid: COM outside the static support of the contacts",
+        Cause::TooFast => "invalid: held at rest, not at this acceleration",
+        Cause::NoForce => "invalid: no contact force can hold it",
+    }
+}
+
+/// A path direction within this angle of a world axis (±x, ±y) is drawn along that axis,
+/// rad (10°): a walk that ends on one foot, beside its start line, would otherwise show
+/// its square-set feet turned by a few degrees.
+pub const SNAP_TO_AXIS_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
+
+/// `e` turned onto the nearest world axis when it is within [`SNAP_TO_AXIS_RAD`] of it.
+fn snapped(e: [f64; 2]) -> [f64; 2] {
+    let axes = [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]];
+    axes.into_iter()
+        .find(|a| (e[0] * a[0] + e[1] * a[1]).clamp(-1.0, 1.0).acos() <= SNAP_TO_AXIS_RAD)
+        .unwrap_or(e)
 }
 
 /// The unit horizontal direction `e_s` of the path: start to end of the curve, else the
-/// principal horizontal axis of every point, else world x.
+/// principal horizontal axis of every point, else world x; snapped to a world axis within
+/// [`SNAP_TO_AXIS_RAD`].
 pub fn path_direction(d: &TrajectoryPlot) -> [f64; 2] {
+    snapped(raw_path_direction(d))
+}
+
+/// [`path_direction`] before snapping.
+fn raw_path_direction(d: &TrajectoryPlot) -> [f64; 2] {
     let unit = |v: [f64; 2]| {
         let n = v[0].hypot(v[1]);
         (n > 1e-6).then(|| [v[0] / n, v[1] / n])
@@ -83,12 +155,27 @@ pub fn along_path(d: &TrajectoryPlot) -> TrajectoryPlot {
         transitions: all(&d.transitions),
         phase_states: all(&d.phase_states),
         recorded: all(&d.recorded),
-        invalid: all(&d.invalid),
+        samples: d
+            .samples
+            .iter()
+            .map(|c| CurveSample {
+                pos: f(&c.pos),
+                ..*c
+            })
+            .collect(),
+        phases: d.phases.clone(),
+        verdict: d.verdict.clone(),
     }
 }
 
 /// Pixel size of one view.
-const VIEW_PX: (u32, u32) = (760, 640);
+const VIEW_PX: (u32, u32) = (760, 600);
+/// Height of the slack strip under the views, px.
+const STRIP_PX: u32 = 300;
+/// Height of the title and verdict lines, px.
+const TITLE_PX: u32 = 70;
+/// Width of the highlight under an invalid stretch of the curve, px.
+const HIGHLIGHT_PX: u32 = 9;
 /// Label areas of a view, px (x axis, y axis).
 const LABEL_PX: (u32, u32) = (45, 60);
 
@@ -133,7 +220,7 @@ fn view(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     path: &Path,
     d: &TrajectoryPlot,
-    (caption, k, y_desc, legend): (&str, usize, &str, SeriesLabelPosition),
+    (caption, k, y_desc, legend): (&str, usize, &str, Option<SeriesLabelPosition>),
 ) -> Result<(), PlotError> {
     let pr = |p: &[f64; 3]| (p[0], p[k]);
     let (xr, yr) = ranges(d, 0, k);
@@ -148,39 +235,45 @@ fn view(
         .configure_mesh()
         .x_desc("s, along the path (m)")
         .y_desc(y_desc)
+        .x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
+        .light_line_style(WHITE.mix(0.0))
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(|e| err(path, e))?;
     draw_contacts(&mut chart, path, d, k)?;
-    for (pts, colour, width, label) in [
-        (
-            &d.quasi_static,
-            RGBColor(255, 140, 0),
-            2,
-            "quasi-static polyline",
-        ),
-        (&d.curve, RGBColor(30, 90, 200), 3, "2PAC COM curve"),
-    ] {
-        chart
-            .draw_series(LineSeries::new(
-                pts.iter().map(pr),
-                colour.stroke_width(width),
-            ))
-            .map_err(|e| err(path, e))?
-            .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(width))
-            });
-    }
-    draw_markers(&mut chart, path, d, k)?;
+    draw_invalid(&mut chart, path, d, k)?;
+    let olive = RGBColor(120, 120, 40);
     chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(legend)
-        .draw()
-        .map_err(|e| err(path, e))?;
+        .draw_series(DashedLineSeries::new(
+            d.quasi_static.iter().map(pr),
+            7,
+            4,
+            olive.stroke_width(2),
+        ))
+        .map_err(|e| err(path, e))?
+        .label("quasi-static polyline (baseline)")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], olive.stroke_width(2)));
+    let blue = RGBColor(30, 90, 200);
+    chart
+        .draw_series(LineSeries::new(
+            d.curve.iter().map(pr),
+            blue.stroke_width(2),
+        ))
+        .map_err(|e| err(path, e))?
+        .label("2PAC COM curve")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue.stroke_width(2)));
+    draw_markers(&mut chart, path, d, k)?;
+    if let Some(position) = legend {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .position(position)
+            .draw()
+            .map_err(|e| err(path, e))?;
+    }
     Ok(())
 }
 
@@ -261,34 +354,182 @@ fn draw_markers(
                 PathElement::new(vec![(x, y), (x + 16, y)], black.stroke_width(2))
             });
     }
-    if !d.invalid.is_empty() {
+    Ok(())
+}
+
+/// The invalid stretches of the curve: a wide band under it, coloured by cause, one
+/// legend entry per cause present.
+fn draw_invalid(
+    chart: &mut Chart<'_, '_>,
+    path: &Path,
+    d: &TrajectoryPlot,
+    k: usize,
+) -> Result<(), PlotError> {
+    let pr = |p: &[f64; 3]| (p[0], p[k]);
+    for cause in Cause::ALL {
+        let colour = cause_colour(cause);
+        let style = colour.mix(0.55).stroke_width(HIGHLIGHT_PX);
+        let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+        let mut open = false;
+        for (i, s) in d.samples.iter().enumerate() {
+            if s.cause == Some(cause) {
+                if !open {
+                    // Start the band at the previous sample, so one sample shows too.
+                    let from = i.checked_sub(1).map_or(s.pos, |j| d.samples[j].pos);
+                    runs.push(vec![pr(&from)]);
+                }
+                if let Some(r) = runs.last_mut() {
+                    r.push(pr(&s.pos));
+                }
+                open = true;
+            } else {
+                open = false;
+            }
+        }
+        if runs.is_empty() {
+            continue;
+        }
         chart
-            .draw_series(
-                d.invalid
-                    .iter()
-                    .map(|p| Cross::new(pr(p), 4, RED.stroke_width(2))),
-            )
+            .draw_series(runs.into_iter().map(|r| PathElement::new(r, style)))
             .map_err(|e| err(path, e))?
-            .label(format!("dynamically invalid samples ({})", d.invalid.len()))
-            .legend(|(x, y)| Cross::new((x + 8, y), 4, RED.stroke_width(2)));
+            .label(cause_label(cause))
+            .legend(move |(x, y)| {
+                PathElement::new(
+                    vec![(x, y), (x + 16, y)],
+                    colour.mix(0.55).stroke_width(HIGHLIGHT_PX),
+                )
+            });
     }
     Ok(())
 }
 
-/// Draws `trajectory.png`: side view (s–z) left, top view (s–l) right, in the path's
-/// coordinates ([`along_path`]).
+/// The validation slack `s*` of the curve's samples over time, coloured by cause, over
+/// the phases (alternately shaded, numbered and named).
+fn slack_strip(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    path: &Path,
+    d: &TrajectoryPlot,
+) -> Result<(), PlotError> {
+    let t0 = d.samples.first().map_or(0.0, |s| s.t_s);
+    let t1 = d.samples.last().map_or(1.0, |s| s.t_s).max(t0 + 1e-3);
+    let finite_max = d
+        .samples
+        .iter()
+        .map(|s| s.slack_n)
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max);
+    let top = (finite_max * 1.25).max(1.0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            "validation slack s* of the 2PAC curve (0 = the contacts hold the COM; ∞ drawn at the top); shaded: phases and their contacts",
+            ("sans-serif", 16),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(LABEL_PX.1)
+        .build_cartesian_2d(t0..t1, 0.0..top)
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("s* (N)")
+        .y_label_formatter(&tick_label)
+        .light_line_style(WHITE.mix(0.0))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| err(path, e))?;
+    let grey = RGBColor(225, 225, 225);
+    for (j, p) in d.phases.iter().enumerate() {
+        let (a, b) = (p.start_s.max(t0), p.end_s.min(t1));
+        if b <= a {
+            continue;
+        }
+        if j % 2 == 0 {
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(a, 0.0), (b, top)],
+                    grey.mix(0.6).filled(),
+                )))
+                .map_err(|e| err(path, e))?;
+        }
+        let style = ("sans-serif", 11)
+            .into_font()
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Center, VPos::Top));
+        let name = p.effectors.replace("_foot", "").replace("_hand", " hand");
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("{j}: {name}"),
+                (0.5 * (a + b), top * 0.97),
+                style,
+            )))
+            .map_err(|e| err(path, e))?;
+    }
+    let line: Vec<(f64, f64)> = d
+        .samples
+        .iter()
+        .map(|s| (s.t_s, s.slack_n.min(top)))
+        .collect();
+    let blue = RGBColor(30, 90, 200);
+    chart
+        .draw_series(LineSeries::new(line, blue.stroke_width(1)))
+        .map_err(|e| err(path, e))?;
+    chart
+        .draw_series(d.samples.iter().filter_map(|s| {
+            let c = s.cause?;
+            Some(Circle::new(
+                (s.t_s, s.slack_n.min(top)),
+                3,
+                cause_colour(c).filled(),
+            ))
+        }))
+        .map_err(|e| err(path, e))?;
+    Ok(())
+}
+
+/// The verdict of a validated 2PAC curve: valid, or how many samples fail and mostly why.
+pub fn curve_verdict(samples: &[CurveSample]) -> Verdict {
+    let n = samples.len();
+    let bad: Vec<Cause> = samples.iter().filter_map(|s| s.cause).collect();
+    if bad.is_empty() {
+        return Verdict::new(
+            format!("2PAC curve dynamically valid (all {n} samples)"),
+            true,
+        );
+    }
+    let main = Cause::ALL
+        .into_iter()
+        .max_by_key(|c| bad.iter().filter(|b| *b == c).count())
+        .unwrap_or(Cause::OffSupport);
+    Verdict::new(
+        format!(
+            "2PAC curve NOT dynamically valid: {} of {n} samples fail, mostly because {}",
+            bad.len(),
+            main.describe()
+        ),
+        false,
+    )
+}
+
+/// Draws `trajectory.png`: side view (s–z, with the legend of both views) left, top view
+/// (s–l) right, in the path's coordinates ([`along_path`]), the slack strip below; the verdict is `d.verdict`, else
+/// [`curve_verdict`].
 ///
 /// # Errors
 /// The file cannot be written or the font cannot be used.
 pub fn trajectory_png(path: &Path, d: &TrajectoryPlot) -> Result<(), PlotError> {
     register_font();
     let d = &along_path(d);
-    let root = BitMapBackend::new(path, (2 * VIEW_PX.0, VIEW_PX.1 + 40)).into_drawing_area();
+    let size = (2 * VIEW_PX.0, VIEW_PX.1 + STRIP_PX + TITLE_PX);
+    let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let root = root
-        .titled(&d.title, ("sans-serif", 22))
-        .map_err(|e| err(path, e))?;
-    let (left, right) = root.split_horizontally(VIEW_PX.0);
+    let verdict = d
+        .verdict
+        .clone()
+        .unwrap_or_else(|| curve_verdict(&d.samples));
+    let root = titled(&root, path, &d.title, &verdict)?;
+    let (views, strip) = root.split_vertically(VIEW_PX.1);
+    let (left, right) = views.split_horizontally(VIEW_PX.0);
     view(
         &left,
         path,
@@ -297,20 +538,16 @@ pub fn trajectory_png(path: &Path, d: &TrajectoryPlot) -> Result<(), PlotError> 
             "Side view along the path (s–z)",
             2,
             "z (m)",
-            SeriesLabelPosition::MiddleRight,
+            Some(SeriesLabelPosition::MiddleRight),
         ),
     )?;
     view(
         &right,
         path,
         d,
-        (
-            "Top view (s–l)",
-            1,
-            "l, left of the path (m)",
-            SeriesLabelPosition::UpperRight,
-        ),
+        ("Top view (s–l)", 1, "l, left of the path (m)", None),
     )?;
+    slack_strip(&strip, path, d)?;
     root.present().map_err(|e| err(path, e))?;
     Ok(())
 }

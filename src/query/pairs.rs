@@ -6,13 +6,13 @@ use super::jump::{is_landing, is_liftoff, jump, Jump};
 use super::pool::Prepared;
 use super::tables::JumpRow;
 
-/// Every same-character (liftoff, landing) pair of `pool` solved for a jump of apex
-/// `height` (m) and `distance` (m), each side checked against `limits`, ranked: feasible
+/// Every same-character (liftoff, landing) pair of `pool` solved for the jump `target`
+/// asks of it (apex height above the liftoff contact, distance; m), each side checked
+/// against `limits`, ranked: feasible
 /// first, then the least change of the recorded forces; ties by stance ids.
 pub fn ranked_jump_pairs<'a>(
     pool: &'a [Prepared],
-    height: f64,
-    distance: f64,
+    target: impl Fn(&Prepared, &Prepared) -> (f64, f64),
     limits: impl Fn(&Prepared) -> Limits,
 ) -> Vec<JumpRow<'a>> {
     let ups: Vec<&Prepared> = pool.iter().filter(|p| is_liftoff(&p.stance)).collect();
@@ -21,14 +21,17 @@ pub fn ranked_jump_pairs<'a>(
         .iter()
         .flat_map(|&p1| downs.iter().map(move |&p2| (p1, p2)))
         .filter(|(p1, p2)| p1.stance.character_id == p2.stance.character_id)
-        .map(|(p1, p2)| JumpRow {
-            liftoff: p1,
-            landing: p2,
-            height,
-            distance,
-            limits: [limits(p1), limits(p2)],
-            jump: jump(p1, p2, height, distance, Some([limits(p1), limits(p2)]))
-                .map_err(|e| e.to_string()),
+        .map(|(p1, p2)| {
+            let (height, distance) = target(p1, p2);
+            JumpRow {
+                liftoff: p1,
+                landing: p2,
+                height,
+                distance,
+                limits: [limits(p1), limits(p2)],
+                jump: jump(p1, p2, height, distance, Some([limits(p1), limits(p2)]))
+                    .map_err(|e| e.to_string()),
+            }
         })
         .collect();
     rank(&mut rows);

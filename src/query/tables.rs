@@ -27,33 +27,77 @@ pub fn violation_name(v: Violation) -> &'static str {
     }
 }
 
-/// The four measured constraints of a scaled stance as the exact check applies them
-/// ([`Limits::effective`]): `(constraint, value, limit, the comparison that fails, unit,
-/// decimals)`.
-fn measured(
-    verdict: &Verdict,
-    lim: &Limits,
-) -> [(Violation, f64, f64, char, &'static str, usize); 4] {
+/// One limit of the exact check (§7.4) applied to a scaled stance: the stance's value, the
+/// limit as the check applies it ([`Limits::effective`]) and which side of it is allowed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LimitCheck {
+    /// The constraint ([`violation_name`]).
+    pub violation: Violation,
+    /// The scaled stance's value (`F_peak` N, `μ_req`, `ext_min`/`ext_max` m).
+    pub value: f64,
+    /// The limit, same unit.
+    pub limit: f64,
+    /// `true`: the value must not exceed the limit (eq 6, 7, 8 upper); `false`: not fall
+    /// below it (eq 8 lower).
+    pub upper: bool,
+}
+
+impl LimitCheck {
+    /// `(unit, decimals)` of the value and limit.
+    fn unit(&self) -> (&'static str, usize) {
+        match self.violation {
+            Violation::Force => (" N", 0),
+            Violation::Friction => ("", 3),
+            _ => (" m", 3),
+        }
+    }
+
+    /// Room left before the limit, in its unit: negative when the value is beyond it.
+    pub fn margin(&self) -> f64 {
+        if self.upper {
+            self.limit - self.value
+        } else {
+            self.value - self.limit
+        }
+    }
+
+    /// `force 1812 N > 1750 N (by 62 N)` when beyond the limit, `force 1543 N ≤ 1750 N
+    /// (margin 207 N)` within it.
+    pub fn line(&self) -> String {
+        let (unit, d) = self.unit();
+        let (name, value, limit, m) = (
+            violation_name(self.violation),
+            self.value,
+            self.limit,
+            self.margin(),
+        );
+        let (op, word) = match (self.upper, m < 0.0) {
+            (true, true) => ('>', "by"),
+            (true, false) => ('≤', "margin"),
+            (false, true) => ('<', "by"),
+            (false, false) => ('≥', "margin"),
+        };
+        let m = m.abs();
+        format!("{name} {value:.d$}{unit} {op} {limit:.d$}{unit} ({word} {m:.d$}{unit})")
+    }
+}
+
+/// The four limits of the exact check of a scaled stance, in the order of [`Violation`]:
+/// peak force (eq 6), friction on the active set (eq 7), shortest and longest extension
+/// (eq 8).
+pub fn limit_checks(verdict: &Verdict, lim: &Limits) -> [LimitCheck; 4] {
     let l = lim.effective();
+    let c = |violation, value, limit, upper| LimitCheck {
+        violation,
+        value,
+        limit,
+        upper,
+    };
     [
-        (Violation::Force, verdict.f_peak, l.f_max, '>', " N", 0),
-        (Violation::Friction, verdict.mu_req, l.mu, '>', "", 3),
-        (
-            Violation::ExtensionMin,
-            verdict.ext_min,
-            l.chi_min,
-            '<',
-            " m",
-            3,
-        ),
-        (
-            Violation::ExtensionMax,
-            verdict.ext_max,
-            l.chi_max,
-            '>',
-            " m",
-            3,
-        ),
+        c(Violation::Force, verdict.f_peak, l.f_max, true),
+        c(Violation::Friction, verdict.mu_req, l.mu, true),
+        c(Violation::ExtensionMin, verdict.ext_min, l.chi_min, false),
+        c(Violation::ExtensionMax, verdict.ext_max, l.chi_max, true),
     ]
 }
 
@@ -62,52 +106,78 @@ fn measured(
 /// `force 1812 N > 1750 N (by 62 N)`. `None` when feasible.
 pub fn violation_detail(verdict: &Verdict, lim: &Limits) -> Option<String> {
     let v = verdict.violated?;
-    let Some(&(_, value, limit, op, unit, digits)) =
-        measured(verdict, lim).iter().find(|m| m.0 == v)
-    else {
-        return Some(violation_name(v).to_string());
-    };
-    let by = (value - limit).abs();
-    Some(format!(
-        "{} {value:.digits$}{unit} {op} {limit:.digits$}{unit} (by {by:.digits$}{unit})",
-        violation_name(v)
-    ))
+    Some(
+        limit_checks(verdict, lim)
+            .iter()
+            .find(|c| c.violation == v)
+            .map_or_else(|| violation_name(v).to_string(), LimitCheck::line),
+    )
 }
 
 /// The constraint a feasible scaled stance is nearest to breaking (least margin as a
-/// fraction of its limit), with its value, limit and margin in units:
-/// `extension_max 1.012 m ≤ 1.050 m (margin 0.038 m)`, and that fraction (0.036 there).
-/// `None` when infeasible or no value is finite.
+/// fraction of its limit), as its [`LimitCheck::line`] (`extension_max 1.012 m ≤ 1.050 m
+/// (margin 0.038 m)`), and that fraction (0.036 there). `None` when infeasible or no value
+/// is finite.
 pub fn tightest_detail(verdict: &Verdict, lim: &Limits) -> Option<(f64, String)> {
     if !verdict.feasible {
         return None;
     }
-    let relative = |&(_, value, limit, op, ..): &(Violation, f64, f64, char, &str, usize)| {
-        let margin = if op == '>' {
-            limit - value
-        } else {
-            value - limit
-        };
-        margin / limit.abs().max(f64::MIN_POSITIVE)
-    };
-    let m = measured(verdict, lim);
-    let tight = m
+    let relative = |c: &LimitCheck| c.margin() / c.limit.abs().max(f64::MIN_POSITIVE);
+    limit_checks(verdict, lim)
         .iter()
-        .filter(|m| m.1.is_finite() && m.2.is_finite())
-        .min_by(|a, b| relative(a).total_cmp(&relative(b)))?;
-    let &(v, value, limit, op, unit, digits) = tight;
-    let (ok, by) = if op == '>' {
-        ('≤', limit - value)
-    } else {
-        ('≥', value - limit)
-    };
-    Some((
-        relative(tight),
-        format!(
-            "{} {value:.digits$}{unit} {ok} {limit:.digits$}{unit} (margin {by:.digits$}{unit})",
-            violation_name(v)
-        ),
-    ))
+        .filter(|c| c.value.is_finite() && c.limit.is_finite())
+        .min_by(|a, b| relative(a).total_cmp(&relative(b)))
+        .map(|c| (relative(c), c.line()))
+}
+
+/// Every check of one scaled stance, one line each, the deciding one marked: what
+/// `--explain` prints under the stance's scaling.
+pub fn stance_explanation(verdict: &Verdict, lim: &Limits) -> Vec<String> {
+    let mut lines: Vec<String> = limit_checks(verdict, lim)
+        .iter()
+        .map(|c| {
+            let mark = if verdict.violated == Some(c.violation) {
+                "   ← deciding"
+            } else {
+                ""
+            };
+            format!("{}{mark}", c.line())
+        })
+        .collect();
+    lines.push(match verdict.violated {
+        None => "exact check: feasible (β ≥ 0 and f_v ≥ 0 throughout as well)".to_string(),
+        Some(v @ (Violation::Beta | Violation::Unilateral)) => {
+            format!("{}   ← deciding", violation_name(v))
+        }
+        Some(v) => format!("exact check: infeasible, first by {}", violation_name(v)),
+    });
+    lines
+}
+
+/// One scaled stance of an explanation: `  stance ID: β_h …, β_p …, β_v …; touchdown …
+/// s, liftoff … s, end apex … s` and its checks, or why it has no scaling.
+fn scaled_stance_lines<E: std::fmt::Display>(
+    id: &str,
+    s: Result<&ScaledStance, E>,
+    lim: &Limits,
+) -> Vec<String> {
+    match s {
+        Err(e) => vec![format!("  stance {id}: no admissible scaling: {e}")],
+        Ok(s) => {
+            let (b, so) = (s.solution.beta, &s.solution);
+            let mut out = vec![format!(
+                "  stance {id}: β_h {:.3}, β_p {:.3}, β_v {:.3}; touchdown {:.3} s, liftoff \
+                 {:.3} s, end apex {:.3} s (from the start apex)",
+                b[0], b[1], b[2], so.t_td, so.t_lo, so.t_e
+            )];
+            out.extend(
+                stance_explanation(&s.verdict, lim)
+                    .into_iter()
+                    .map(|l| format!("    {l}")),
+            );
+            out
+        }
+    }
 }
 
 /// One `query run` row: a cycle at one speed for one character.
@@ -165,6 +235,39 @@ impl RunRow<'_> {
                     Ok(s) => violation_detail(&s.verdict, lim).map(|d| format!("{id}: {d}")),
                 }
             })
+    }
+
+    /// The whole answer, for `--explain`: the cycle at its speed, the gait law's times, and
+    /// per stance its scaling and every limit with value, limit and margin
+    /// ([`stance_explanation`]).
+    pub fn full_explanation(&self) -> Vec<String> {
+        let c = &self.candidate;
+        let t = &c.timing;
+        let mut out = vec![
+            format!(
+                "cycle {} at {:.2} m/s (recorded {:.2} m/s): {}",
+                self.stances[0].stance.stance_id,
+                c.speed,
+                c.v_orig,
+                if c.feasible() {
+                    "feasible"
+                } else {
+                    "infeasible"
+                }
+            ),
+            format!(
+                "  gait law {}: contact time × {:.3} (σ_c), step period × {:.3} (σ_T), speed \
+                 change × {:.3} (κ)",
+                t.law.source.name(),
+                t.sigma_c,
+                t.sigma_t,
+                t.kappa
+            ),
+        ];
+        for ((s, p), lim) in c.stances.iter().zip(self.stances).zip(&self.limits) {
+            out.extend(scaled_stance_lines(&p.stance.stance_id, s.as_ref(), lim));
+        }
+        out
     }
 
     /// A cycle aggregate over its solved stances; `None` unless both solved.
@@ -315,6 +418,37 @@ impl JumpRow<'_> {
                     violation_detail(&s.verdict, lim).map(|d| format!("{n}: {d}"))
                 }),
         }
+    }
+
+    /// The whole answer, for `--explain`: the pair, the requested and achieved flight, and
+    /// per side its scaling and every limit with value, limit and margin.
+    pub fn full_explanation(&self) -> Vec<String> {
+        let (up, down) = (
+            &self.liftoff.stance.stance_id,
+            &self.landing.stance.stance_id,
+        );
+        let mut out = vec![format!(
+            "pair {up} → {down}: apex {:.3} m above the liftoff contact, distance {:.3} m: {}",
+            self.height,
+            self.distance,
+            match &self.jump {
+                Ok(j) if j.feasible() => "feasible",
+                _ => "infeasible",
+            }
+        )];
+        match &self.jump {
+            Err(e) => out.push(format!("  no admissible scaling: {e}")),
+            Ok(j) => {
+                out.push(format!(
+                    "  flight {:.3} s at apex speed {:.3} m/s ({:.3} m in the air)",
+                    j.flight_time, j.u_apex, j.d_flight
+                ));
+                for (((_, s), p), lim) in j.sides.iter().zip([up, down]).zip(&self.limits) {
+                    out.extend(scaled_stance_lines::<String>(p, Ok(s), lim));
+                }
+            }
+        }
+        out
     }
 
     /// First problem, `liftoff: force`, or the solver's reason.

@@ -10,6 +10,7 @@ pub mod landmarks;
 pub mod leadin;
 pub mod model;
 pub mod names;
+pub mod plausibility;
 pub mod units;
 
 pub use model::Skeleton;

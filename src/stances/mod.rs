@@ -9,6 +9,7 @@
 //! spec stance-model §1–§5, §7.2, §8.1–§8.2, §11.
 
 pub mod build;
+pub mod ids;
 pub mod limits;
 pub mod params;
 pub mod segment;

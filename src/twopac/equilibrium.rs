@@ -55,11 +55,20 @@ pub const MAX_COM_STATES: usize = 1_000_000;
 /// Force closure is declared when `max t s.t. G V β = 0, β ≥ t, t ≤ 1` exceeds this.
 pub const FORCE_CLOSURE_T: f64 = 0.5;
 
-/// The verdict's kind (§8.2 `status`).
+/// How the verdict was reached (§8.2 `status`); whether the state is in equilibrium is
+/// [`Verdict::in_equilibrium`], never the status alone.
+///
+/// | status | in equilibrium | margin |
+/// |---|---|---|
+/// | `solved` | when `margin > 0` | the LP's, N (≤ 0: how far outside) |
+/// | `force_closure` | always | unbounded (null) |
+/// | `infeasible` | never | null: no force distribution makes the wrench |
+/// | `solver_failed` | never | null |
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Status {
-    /// The margin exists; `in_equilibrium = margin > 0`.
-    Ok,
+    /// The margin LP was solved: `in_equilibrium = margin > 0`; a margin `≤ 0` is a COM
+    /// state outside the region (named `ok` before issue 38, which read as "in equilibrium").
+    Solved,
     /// Internal forces can grow without bound: every COM is in equilibrium, margin unbounded.
     ForceClosure,
     /// `G V β = w` has no solution with `β ≥ 0` at any margin.
@@ -70,10 +79,10 @@ pub enum Status {
 }
 
 impl Status {
-    /// The lower-case name used in output tables (`ok`, `force_closure`, …).
+    /// The lower-case name used in output tables (`solved`, `force_closure`, …).
     pub fn as_str(self) -> &'static str {
         match self {
-            Status::Ok => "ok",
+            Status::Solved => "solved",
             Status::ForceClosure => "force_closure",
             Status::Infeasible => "infeasible",
             Status::SolverFailed => "solver_failed",
@@ -86,11 +95,11 @@ impl Status {
 pub struct Verdict {
     /// What kind of answer this is.
     pub status: Status,
-    /// In equilibrium (strictly inside for `Ok`; always for `ForceClosure`).
+    /// In equilibrium (strictly inside for `Solved`; always for `ForceClosure`).
     pub in_equilibrium: bool,
-    /// Robustness margin `b0* · 4μ/(1 + μ²)`, N; `None` unless `status == Ok`.
+    /// Robustness margin `b0* · 4μ/(1 + μ²)`, N; `None` unless `status == Solved`.
     pub margin_n: Option<f64>,
-    /// The raw LP optimum `b0*`, N (smallest ray coefficient); `None` unless `Ok`.
+    /// The raw LP optimum `b0*`, N (smallest ray coefficient); `None` unless `Solved`.
     pub b0_n: Option<f64>,
 }
 
@@ -285,7 +294,7 @@ impl EqualityForm {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {
                 let margin = b0 * self.b0_to_newton;
                 Verdict {
-                    status: Status::Ok,
+                    status: Status::Solved,
                     in_equilibrium: margin > 0.0,
                     margin_n: Some(margin),
                     b0_n: Some(b0),
@@ -309,7 +318,7 @@ impl EqualityForm {
         let v = self.verdict(com, acc);
         match v.status {
             Status::ForceClosure => 0.0,
-            Status::Ok => (-v.b0_n.unwrap_or(f64::NAN)).max(0.0),
+            Status::Solved => (-v.b0_n.unwrap_or(f64::NAN)).max(0.0),
             Status::Infeasible | Status::SolverFailed => f64::INFINITY,
         }
     }

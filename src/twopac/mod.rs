@@ -14,6 +14,7 @@
 //! curve (eq 7–9):          c(t) = Σ_k B_k^n(t) P_k,  n = 6 or 7     — bezier.rs
 //! sliding window (§6):     windows of 2 or 3 phases, switch at u    — trajectory.rs
 //! validation (§7):         s* = min s : G V β = w(c, c̈), β + s ≥ 0  — validate.rs
+//! why a sample fails:      off support / too fast / no force       — diagnose.rs
 //! kinematics (§3):         K c ≤ k from the convex hull of COM samples — hull.rs
 //! ```
 //!
@@ -40,7 +41,7 @@
 //!     .unwrap();
 //! let form = EqualityForm::new(&[c], 54.0).unwrap();
 //! let v = form.verdict([0.0, 0.0, 1.0], [0.0; 3]);
-//! assert_eq!(v.status, Status::Ok);
+//! assert_eq!(v.status, Status::Solved);
 //! assert!((v.margin_n.unwrap() - 38.05).abs() < 0.01);
 //! ```
 
@@ -49,6 +50,7 @@
 pub mod bezier;
 pub mod clip;
 pub mod contact;
+pub mod diagnose;
 pub mod equilibrium;
 pub mod hull;
 pub mod kinematic;

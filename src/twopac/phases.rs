@@ -66,6 +66,23 @@ pub const CONTACTS_SCHEMA: &str = "stancelib.twopac.contacts/1";
 pub const NAMED_KINEMATICS: [&str; 4] = ["left_foot", "right_foot", "left_hand", "right_hand"];
 /// Horizontal length of the contact frame's `x` axis below which its yaw is taken from `y`.
 pub const VERTICAL_AXIS_TOL: f64 = 1e-6;
+/// Largest friction coefficient μ (`friction`) accepted: dry rubber on concrete is about 1,
+/// so 10 leaves room for an idealised sticking contact; μ = 1e308 overflowed the friction
+/// cone and called a feasible state infeasible.
+pub const MAX_FRICTION: f64 = 10.0;
+/// Largest |coordinate| of a contact position, a phase's `com` or an `equilibrium --points`
+/// COM, m (10 km: a scene, not an overflow; `com` 1e308 gave 2,889 NaN rows).
+pub const MAX_COORDINATE_M: f64 = 1e4;
+/// Largest side of a contact's `surface`, m.
+pub const MAX_SURFACE_M: f64 = 10.0;
+/// Shortest non-zero phase `duration_s`, s (5e-324 s gave NaN accelerations; a phase of
+/// 0 s is a contact change without time).
+pub const MIN_PHASE_DURATION_S: f64 = 1e-3;
+/// Largest |component| of a COM velocity given (`start.vel`), m/s.
+pub const MAX_VEL_MPS: f64 = 100.0;
+/// Largest |component| of a COM acceleration given (`start.acc`, the accelerations of
+/// `equilibrium --points`), m/s² (100 g).
+pub const MAX_ACC_MPS2: f64 = 1e3;
 
 /// A JSON input error: the JSON path, what is wrong and, when known, where in the text.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -275,14 +292,35 @@ fn check_schema(found: &str, want: &str) -> Result<(), JsonError> {
     }
 }
 
+/// Whether `c` is a number within ±`max` (NaN is not).
+pub fn within(c: f64, max: f64) -> bool {
+    c.abs() <= max
+}
+
+/// `v` at `path` when every component is finite and within `max` (unit `unit`).
+fn check_vector(
+    path: &str,
+    v: [f64; 3],
+    max: f64,
+    limit: &str,
+    unit: &str,
+) -> Result<[f64; 3], JsonError> {
+    match v.iter().find(|c| !within(**c, max)) {
+        None => Ok(v),
+        Some(c) => fail(
+            path,
+            format!("component {c} is beyond ±{max} {unit} ({limit})"),
+        ),
+    }
+}
+
+/// A body mass within the bounds every command applies
+/// ([`crate::ingest::masses::check_body_mass`], [1, 1000] kg): mass 1e100 called a feasible
+/// point infeasible.
 fn check_mass(m: f64) -> Result<f64, JsonError> {
-    if m.is_finite() && m > 0.0 {
-        Ok(m)
-    } else {
-        fail(
-            "mass_kg",
-            format!("must be a positive number of kg, found {m}"),
-        )
+    match crate::ingest::masses::check_body_mass(m) {
+        Ok(()) => Ok(m),
+        Err(why) => fail("mass_kg", why),
     }
 }
 
@@ -293,9 +331,29 @@ fn contact(v: &Value, path: &str) -> Result<Contact, JsonError> {
     if norm(c.normal) == 0.0 {
         return fail(&sub_path("normal"), "zero length");
     }
+    let n = norm(c.normal);
+    if !n.is_finite() {
+        return fail(
+            &sub_path("normal"),
+            "length overflows f64: give a unit-scale normal",
+        );
+    }
+    let position = check_vector(
+        &sub_path("position"),
+        c.position,
+        MAX_COORDINATE_M,
+        "MAX_COORDINATE_M",
+        "m",
+    )?;
     let mu = c.friction.unwrap_or(DEFAULT_MU);
-    if mu < 0.0 {
-        return fail(&sub_path("friction"), format!("must be ≥ 0, found {mu}"));
+    if !(0.0..=MAX_FRICTION).contains(&mu) {
+        return fail(
+            &sub_path("friction"),
+            format!("must be in [0, {MAX_FRICTION}] (MAX_FRICTION), found {mu}"),
+        );
+    }
+    if let Some(y) = c.yaw_rad.filter(|y| !y.is_finite()) {
+        return fail(&sub_path("yaw_rad"), format!("must be finite, found {y}"));
     }
     if c.effector.is_empty() {
         return fail(&sub_path("effector"), "empty name");
@@ -304,10 +362,10 @@ fn contact(v: &Value, path: &str) -> Result<Contact, JsonError> {
         None => ContactShape::Point,
         Some(s) => {
             for (k, v) in [("length_m", s.length_m), ("width_m", s.width_m)] {
-                if v < 0.0 {
+                if !(0.0..=MAX_SURFACE_M).contains(&v) {
                     return fail(
                         &format!("{path}.surface.{k}"),
-                        format!("must be ≥ 0, found {v}"),
+                        format!("must be in [0, {MAX_SURFACE_M}] m (MAX_SURFACE_M), found {v}"),
                     );
                 }
             }
@@ -319,7 +377,7 @@ fn contact(v: &Value, path: &str) -> Result<Contact, JsonError> {
     };
     Contact::new(
         c.effector,
-        c.position,
+        position,
         c.normal,
         mu,
         c.yaw_rad.unwrap_or(0.0),
@@ -450,11 +508,26 @@ pub fn parse_phases(text: &str) -> Result<PhasesFile, JsonError> {
     let raw: RawPhasesFile<Value, Value> = at(&v, "").map_err(loc)?;
     check_schema(&raw.schema, PHASES_SCHEMA)?;
     let mass_kg = check_mass(raw.mass_kg)?;
-    let start = raw.start.map_or(ComState::default(), |s| ComState {
-        pos: [0.0; 3],
-        vel: s.vel.unwrap_or([0.0; 3]),
-        acc: s.acc.unwrap_or([0.0; 3]),
-    });
+    let start = match raw.start {
+        None => ComState::default(),
+        Some(s) => ComState {
+            pos: [0.0; 3],
+            vel: check_vector(
+                "start.vel",
+                s.vel.unwrap_or([0.0; 3]),
+                MAX_VEL_MPS,
+                "MAX_VEL_MPS",
+                "m/s",
+            )?,
+            acc: check_vector(
+                "start.acc",
+                s.acc.unwrap_or([0.0; 3]),
+                MAX_ACC_MPS2,
+                "MAX_ACC_MPS2",
+                "m/s²",
+            )?,
+        },
+    };
     let mut effectors = BTreeMap::new();
     for (name, e) in &raw.effectors {
         let p = format!("effectors.{name}");
@@ -474,11 +547,23 @@ pub fn parse_phases(text: &str) -> Result<PhasesFile, JsonError> {
     for (j, p) in raw.phases.iter().enumerate() {
         let path = format!("phases[{j}]");
         let p: RawPhase<Value> = at(p, &path).map_err(loc)?;
-        if let Some(d) = p.duration_s.filter(|d| *d < 0.0) {
+        if let Some(d) = p
+            .duration_s
+            .filter(|d| !(*d == 0.0 || *d >= MIN_PHASE_DURATION_S))
+        {
             return fail(
                 &format!("{path}.duration_s"),
-                format!("must be ≥ 0, found {d}"),
+                format!("must be 0 or at least {MIN_PHASE_DURATION_S} s (MIN_PHASE_DURATION_S), found {d}"),
             );
+        }
+        if let Some(com) = p.com {
+            check_vector(
+                &format!("{path}.com"),
+                com,
+                MAX_COORDINATE_M,
+                "MAX_COORDINATE_M",
+                "m",
+            )?;
         }
         total_s += p.duration_s.unwrap_or(0.0);
         check_limit(

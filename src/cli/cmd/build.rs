@@ -11,7 +11,7 @@ use crate::pipeline::build::{build_library, BuildOptions, BuildPlan, BuildSummar
 use crate::pipeline::inputs::read_body;
 use crate::pipeline::merge::merge_into;
 use crate::pipeline::output::OutputRules;
-use crate::pipeline::spec::{resolve, resolve_fit};
+use crate::pipeline::spec::{resolve, resolve_fit, with_masses};
 
 /// Run `build`.
 ///
@@ -21,7 +21,7 @@ pub fn run(a: BuildArgs) -> anyhow::Result<Outcome> {
     let cli = a.body.overrides()?;
     let body = a.body.body.as_deref().map(read_body).transpose()?;
     let opts = BuildOptions {
-        ingest: resolve(body.as_ref(), None, &cli),
+        ingest: with_masses(resolve(body.as_ref(), None, &cli), cli.masses.as_deref())?,
         stances: resolve_fit(None, a.fit.force_model),
     };
     let rules = OutputRules {
@@ -70,11 +70,15 @@ pub fn run_merge(a: MergeArgs) -> anyhow::Result<Outcome> {
 /// `SomeFailed`: the merge decides).
 pub fn report_build(report: &BuildSummary, out: &Path, plan: &BuildPlan) -> Outcome {
     let reused = report.reused;
+    for line in &report.not_reused {
+        eprintln!("incremental: {line}");
+    }
     let outcome = super::frames::report(&report.records, out);
     crate::say!("{} stances rebuilt, {reused} clips reused", report.stances);
     let mut summary = super::frames::summary(&report.records, out, "build");
     summary["stances_rebuilt"] = report.stances.into();
     summary["clips_reused"] = reused.into();
+    summary["reuse_refused"] = report.not_reused.clone().into();
     // A library that cannot be read back here has said why already (the build's own
     // errors); the duplicates are then not reported.
     let duplicates = crate::library::info::duplicate_clips(out).unwrap_or_default();

@@ -4,7 +4,7 @@
 
 use super::super::args::EquilibriumArgs;
 use super::super::Outcome;
-use crate::pipeline::equilibrium::{run_equilibrium, EquilibriumJob};
+use crate::pipeline::equilibrium::{run_equilibrium, EquilibriumJob, EquilibriumReport};
 
 /// Run `equilibrium`.
 ///
@@ -19,21 +19,12 @@ pub fn run(a: EquilibriumArgs) -> anyhow::Result<Outcome> {
         png: a.png,
     };
     let r = run_equilibrium(&job)?;
-    let [ok, closure, infeasible, failed] = r.n_status;
-    crate::say!(
-        "equilibrium: {} point(s), {} contact(s) ({} points), m = {} kg: {} in equilibrium; \
-         status ok {ok}, force_closure {closure}, infeasible {infeasible}, solver_failed {failed}; {:.3} s",
-        r.n_points,
-        r.n_contacts,
-        r.n_contact_points,
-        r.mass_kg,
-        r.n_in_equilibrium,
-        r.elapsed_s
-    );
+    crate::say!("{}", summary(&r));
     crate::say!("  → {}", job.out.display());
     if let Some(png) = &job.png {
         crate::say!("  → {}", png.display());
     }
+    let failed = r.n_status[3];
     Ok(if failed == 0 {
         Outcome::Clean
     } else if failed == r.n_points {
@@ -41,4 +32,40 @@ pub fn run(a: EquilibriumArgs) -> anyhow::Result<Outcome> {
     } else {
         Outcome::SomeFailed
     })
+}
+
+/// The summary line: how many states are in equilibrium and why the others are not (the
+/// `status` column says how each verdict was reached, not whether it is in equilibrium),
+/// then the time of each stage, the picture included.
+pub fn summary(r: &EquilibriumReport) -> String {
+    let [_, closure, infeasible, failed] = r.n_status;
+    let mut not = vec![format!("{} outside the region (margin ≤ 0)", r.n_outside)];
+    if infeasible > 0 {
+        not.push(format!("{infeasible} with no force distribution at all"));
+    }
+    if failed > 0 {
+        not.push(format!("{failed} where the solver failed"));
+    }
+    let closure = if closure > 0 {
+        format!(" ({closure} by force closure)")
+    } else {
+        String::new()
+    };
+    let time = match &r.slice {
+        Some(s) => format!(
+            "verdicts {:.2} s, region slice {} cells ({} LPs) {:.2} s, total {:.2} s",
+            r.verdicts_s, s.cells, s.lps, s.elapsed_s, r.total_s
+        ),
+        None => format!("verdicts {:.2} s, total {:.2} s", r.verdicts_s, r.total_s),
+    };
+    format!(
+        "equilibrium: {} of {} COM state(s) in equilibrium{closure}; not: {}; \
+         {} contact(s) ({} points), m = {} kg; {time}",
+        r.n_in_equilibrium,
+        r.n_points,
+        not.join(", "),
+        r.n_contacts,
+        r.n_contact_points,
+        r.mass_kg,
+    )
 }

@@ -8,7 +8,7 @@ use crate::ingest::IngestOptions;
 use crate::library::{ClipStatus, Status};
 use crate::pipeline::batch::{discover, frames_into};
 use crate::pipeline::inputs::read_body;
-use crate::pipeline::spec::resolve;
+use crate::pipeline::spec::{resolve, with_masses};
 
 /// Run `frames`.
 ///
@@ -17,7 +17,7 @@ use crate::pipeline::spec::resolve;
 pub fn run(a: FramesArgs) -> anyhow::Result<Outcome> {
     let cli = a.body.overrides()?;
     let body = a.body.body.as_deref().map(read_body).transpose()?;
-    let opts = resolve(body.as_ref(), None, &cli);
+    let opts = with_masses(resolve(body.as_ref(), None, &cli), cli.masses.as_deref())?;
     let files = discover(&a.inputs)?;
     execute(&files, &a.out, &opts, a.body.threads)
 }

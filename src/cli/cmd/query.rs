@@ -7,7 +7,9 @@ use anyhow::Context;
 
 use super::super::args::{JumpArgs, RunQueryArgs};
 use super::super::Outcome;
-use crate::pipeline::queries::{jump_query, run_query, JumpQuery, RunQuery, RunReport};
+use crate::pipeline::queries::{
+    jump_query, run_query, JumpLine, JumpQuery, JumpTarget, RunQuery, RunReport,
+};
 
 /// Run `query run`.
 ///
@@ -25,6 +27,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
         gait_law: crate::pipeline::queries::gait_law_choice(Some(&a.gait_law))
             .context("--gait-law")?,
         keep_left_out: a.keep_left_out,
+        explain: a.explain.clone(),
     };
     print_run(&run_query(&q)?, &q.out);
     Ok(Outcome::Clean)
@@ -68,6 +71,12 @@ pub fn print_run(report: &RunReport, out: &Path) {
             verdict
         );
     }
+    if !report.explained.is_empty() {
+        crate::say!("");
+        for l in &report.explained {
+            crate::say!("{l}");
+        }
+    }
     let used = report.lines.iter().filter(|r| r.used).count();
     crate::say!(
         "query run: {} cycle(s) × {} speed(s); {} answer(s) shown from the cycles recorded \
@@ -84,20 +93,41 @@ pub fn print_run(report: &RunReport, out: &Path) {
 /// # Errors
 /// Bad options, an unreadable library, an unwritable output.
 pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
+    anyhow::ensure!(
+        a.distance_scale.is_none() || a.height_scale.is_some(),
+        "--distance-scale goes with --height-scale (with --height give --distance in m)"
+    );
+    let target = match (a.height, a.height_scale) {
+        (Some(h), _) => JumpTarget::Absolute {
+            height_m: h,
+            distance_m: a.distance.context("--height needs --distance D (m)")?,
+        },
+        (None, Some(s)) => JumpTarget::Scaled {
+            height: s,
+            distance: a.distance_scale.unwrap_or(1.0),
+        },
+        (None, None) => anyhow::bail!("give --height H or --height-scale S"),
+    };
     let q = JumpQuery {
         lib: a.lib,
-        height_m: a.height,
-        distance_m: a.distance,
+        target,
         limits: a.lim.options(),
         keep_left_out: a.keep_left_out,
+        explain: a.explain.is_some(),
         out: a.out,
     };
     let lines = jump_query(&q)?;
+    let explained = match &a.explain {
+        Some(id) => Some(explained_pair(&lines, id)?),
+        None => None,
+    };
+    let scaled = matches!(q.target, JumpTarget::Scaled { .. });
     crate::say!(
-        "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6}  verdict",
+        "{:>4} {:<34} {:<34}{} {:>7} {:>6} {:>6} {:>6} {:>6}  verdict",
         "rank",
         "liftoff",
         "landing",
+        if scaled { "  h_m    d_m  " } else { "" },
         "u_apex",
         "β_h1",
         "β_v1",
@@ -112,11 +142,17 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
             (Some(why), false) => format!("infeasible: {why}"),
             (None, false) => "infeasible".to_string(),
         };
+        let asked = if scaled {
+            format!(" {:>6.3} {:>6.3}", r.asked.0, r.asked.1)
+        } else {
+            String::new()
+        };
         crate::say!(
-            "{:>4} {:<34} {:<34} {:>7} {:>6} {:>6} {:>6} {:>6}  {}",
+            "{:>4} {:<34} {:<34}{} {:>7} {:>6} {:>6} {:>6} {:>6}  {}",
             i + 1,
             r.liftoff,
             r.landing,
+            asked,
             f(r.u_apex_mps),
             b(0, 0),
             b(0, 1),
@@ -124,6 +160,12 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
             b(1, 1),
             verdict
         );
+    }
+    if let Some(full) = explained {
+        crate::say!("");
+        for l in full {
+            crate::say!("{l}");
+        }
     }
     let n_ok = lines.iter().filter(|r| r.feasible).count();
     crate::say!(
@@ -133,4 +175,32 @@ pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
         q.out.display()
     );
     Ok(Outcome::Clean)
+}
+
+/// The pair `--explain` names: a rank of the table (1 = best), or the best-ranked pair with
+/// that liftoff or landing stance.
+///
+/// # Errors
+/// A rank beyond the pairs, or a stance id no pair holds (with the nearest ids).
+fn explained_pair<'a>(lines: &'a [JumpLine], id: &str) -> anyhow::Result<&'a [String]> {
+    if let Ok(rank) = id.parse::<usize>() {
+        return match rank.checked_sub(1).and_then(|i| lines.get(i)) {
+            Some(l) => Ok(&l.full),
+            None => anyhow::bail!("--explain {rank}: the ranks go from 1 to {}", lines.len()),
+        };
+    }
+    match lines.iter().find(|l| l.liftoff == id || l.landing == id) {
+        Some(l) => Ok(&l.full),
+        None => {
+            let held: std::collections::BTreeSet<&str> = lines
+                .iter()
+                .flat_map(|l| [l.liftoff.as_str(), l.landing.as_str()])
+                .collect();
+            anyhow::bail!(
+                "--explain: {}",
+                crate::stances::ids::unknown_stance_message(id, held.iter().copied())
+                    .replace("no stance", "no jump pair with stance")
+            )
+        }
+    }
 }

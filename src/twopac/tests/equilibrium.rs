@@ -58,7 +58,7 @@ fn r1_margin_is_17_1222_newtons() {
     // Spec §9 R1 (issue 5 acceptance): 17.1222 ± 1e-3 N.
     let form = EqualityForm::new(&[point_set(&R1_POINTS, [0.0, 0.0, 1.0], 0.5)], 55.8836).unwrap();
     let v = form.verdict(R1_COM, [0.0; 3]);
-    assert_eq!(v.status, Status::Ok);
+    assert_eq!(v.status, Status::Solved);
     let m = v.margin_n.unwrap();
     assert!((m - 17.1222).abs() < 1e-3, "margin {m}");
     assert!(v.in_equilibrium);
@@ -69,12 +69,12 @@ fn r2_margin_and_large_acceleration() {
     // Spec §9 R2: ≈ 38.05 N static, ≈ −77546 N with c̈ = (1000, 0, 0).
     let form = EqualityForm::new(&[point_set(&R2_POINTS, [0.0, 0.0, 1.0], 0.3)], 54.0).unwrap();
     let v = form.verdict([0.0, 0.0, 1.0], [0.0; 3]);
-    assert_eq!(v.status, Status::Ok);
+    assert_eq!(v.status, Status::Solved);
     let m = v.margin_n.unwrap();
     assert!((m - 38.05).abs() < 0.005, "margin {m}");
     assert!(v.in_equilibrium);
     let v = form.verdict([0.0, 0.0, 1.0], [1000.0, 0.0, 0.0]);
-    assert_eq!(v.status, Status::Ok);
+    assert_eq!(v.status, Status::Solved);
     let m = v.margin_n.unwrap();
     // "≈ −77546": the reference prints 5 significant digits.
     assert!((m + 77546.0).abs() < 1.0, "margin {m}");
@@ -110,7 +110,7 @@ fn single_point_contact_holds_the_com_only_on_its_vertical() {
     assert!(form.degenerate);
     assert_eq!(form.rank(), 3);
     let above = form.verdict([0.3, -0.2, 1.4], [0.0; 3]);
-    assert_eq!(above.status, Status::Ok);
+    assert_eq!(above.status, Status::Solved);
     assert!(above.in_equilibrium);
     for off in [[0.31, -0.2, 1.4], [0.3, -0.2 + 1e-4, 1.4], [0.0, 0.0, 1.0]] {
         let v = form.verdict(off, [0.0; 3]);
@@ -190,7 +190,7 @@ fn steep_slope_beyond_the_pyramid_has_no_static_equilibrium() {
         .unwrap();
         let form = EqualityForm::new(&[c], 70.0).unwrap();
         let v = form.verdict([0.0, 0.0, 0.9], [0.0; 3]);
-        assert_eq!(v.status, Status::Ok);
+        assert_eq!(v.status, Status::Solved);
         assert_eq!(v.in_equilibrium, balanced, "slope {deg}: {v:?}");
     }
 }

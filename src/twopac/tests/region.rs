@@ -26,7 +26,7 @@ fn cross_check(contacts: &[Contact], half: f64, n: usize, seed: u64) -> (usize, 
             continue;
         }
         let v = form.verdict(c, [0.0; 3]);
-        assert_eq!(v.status, Status::Ok);
+        assert_eq!(v.status, Status::Solved);
         let lp_inside = v.b0_n.unwrap() > 0.0;
         assert_eq!(
             viol < 0.0,
