@@ -1005,3 +1005,191 @@ fn demo_jump_at_1_4_m_converges_and_at_1_5_m_says_why_not() {
     assert!(err.contains("out of reach"), "{err}");
     assert!(off <= 0.04, "known miss: {off} m (measured 27.6 mm)");
 }
+
+/// The gait of a clip as `frames` re-detects it from the written motion, medians over its
+/// foot contacts whose both events lie inside the clip: `[mean speed m/s, contact time s,
+/// touchdown-to-touchdown period s, foot ahead of the COM at touchdown m (along the COM's
+/// travel), knee flexion at touchdown deg, knee flexion at mid-stance deg, swing knee
+/// flexion (98th percentile of both knees) deg, trunk lean deg, COM vertical range m]`.
+/// `g` is the clip's [`gauged`], whose `frames` folder is `frames_dir`.
+fn gait(g: &Gauged, frames_dir: &Path) -> [f64; 9] {
+    let f = read_parquet(&frames_dir.join("frames.parquet")).unwrap();
+    let c = read_parquet(&frames_dir.join("contacts.parquet")).unwrap();
+    let col = |df: &polars::prelude::DataFrame, n: &str| -> Vec<f64> {
+        df.column(n)
+            .unwrap()
+            .f64()
+            .unwrap()
+            .iter()
+            .map(|v| v.unwrap_or(f64::NAN))
+            .collect()
+    };
+    let t = col(&f, "time_clip_s");
+    let com: Vec<[f64; 3]> = (0..t.len())
+        .map(|i| {
+            [
+                col(&f, "com_x_m")[i],
+                col(&f, "com_y_m")[i],
+                col(&f, "com_z_m")[i],
+            ]
+        })
+        .collect();
+    let effector: Vec<String> = c
+        .column("effector")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .map(|v| v.unwrap().to_string())
+        .collect();
+    let (td, lo) = (col(&c, "td_clip_s"), col(&c, "lo_clip_s"));
+    let n = t.len();
+    let frame = |time: f64| (((time - t[0]) / g.dt).round() as usize).min(n - 1);
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let inside: Vec<usize> = (0..td.len())
+        .filter(|&k| {
+            // A contact open at the clip's edge has no event there (null).
+            effector[k].ends_with("_foot") && td[k] > t[0] + g.dt && lo[k] < t[n - 1] - g.dt
+        })
+        .collect();
+    assert!(
+        inside.len() >= 3,
+        "{}: too few contacts",
+        frames_dir.display()
+    );
+    let side = |k: usize| usize::from(effector[k].starts_with("right"));
+    let ahead = |k: usize| {
+        let i = frame(td[k]);
+        let (a, b) = (com[i.saturating_sub(1)], com[(i + 1).min(n - 1)]);
+        let h = [b[0] - a[0], b[1] - a[1]];
+        let len = h[0].hypot(h[1]);
+        let foot = col(&f, ["left_foot_x_m", "right_foot_x_m"][side(k)])[i];
+        let foot_y = col(&f, ["left_foot_y_m", "right_foot_y_m"][side(k)])[i];
+        ((foot - com[i][0]) * h[0] + (foot_y - com[i][1]) * h[1]) / len
+    };
+    let mut tds: Vec<f64> = inside.iter().map(|&k| td[k]).collect();
+    tds.sort_by(f64::total_cmp);
+    let mut knees: Vec<f64> = g.knees.iter().flatten().copied().collect();
+    knees.sort_by(f64::total_cmp);
+    let z = range(com.iter().map(|p| p[2]));
+    [
+        (com[n - 1][0] - com[0][0]).hypot(com[n - 1][1] - com[0][1]) / (t[n - 1] - t[0]),
+        median(inside.iter().map(|&k| lo[k] - td[k]).collect()),
+        median(tds.windows(2).map(|w| w[1] - w[0]).collect()),
+        median(inside.iter().map(|&k| ahead(k)).collect()),
+        median(
+            inside
+                .iter()
+                .map(|&k| g.knees[frame(td[k])][side(k)])
+                .collect(),
+        ),
+        median(
+            inside
+                .iter()
+                .map(|&k| g.knees[frame(0.5 * (td[k] + lo[k]))][side(k)])
+                .collect(),
+        ),
+        knees[(knees.len() as f64 * 0.98) as usize],
+        median(g.lean.clone()),
+        z[1] - z[0],
+    ]
+}
+
+// See: the brief — "what it predicts (a run at another speed …, the edited motion) must
+// match how the same person moves at that speed". One runner recorded at 2 and 3 m/s
+// (`hamner_multi_run_2ms`, `_3ms`): each recording edited to the speed the other measures,
+// re-read by `frames` from the written joints, against the other recording read the same
+// way. Timing within the issue's 10 %; the touchdown distance within 20 % (the
+// recordings' own strides spread 0.142–0.158 and 0.204–0.248 m); knees at touchdown and
+// mid-stance within 10° and the trunk within 5° (`edit::fidelity`'s tolerances: one
+// runner's spread between trials); the COM's vertical range within 15 %. Measured (2 → 3
+// / 3 → 2 m/s): contact +6.1 / −1.5 %, period −3.2 / +4.1 %, touchdown distance +2.8 /
+// +13.8 %, knee at touchdown −5.1 / +3.1°, mid-stance +0.1 / +3.9°, lean −1.1 / +0.2°, COM
+// range −10.9 / +6.5 %. Known miss: the swing knee keeps the source's flexion (the edit
+// time-warps the recorded swing), where the runner folds it 14° more at 3 m/s than at 2
+// (−15.5 / +15.9°): printed, not asserted.
+#[test]
+fn edited_run_moves_like_the_same_runner_recorded_at_the_target_speed() {
+    let Some(data) =
+        shared_or_skip("edited_run_moves_like_the_same_runner_recorded_at_the_target_speed")
+    else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let clip = |v: u32| data.join(format!("forceplate/hamner_multi_run_{v}ms/clip.bvh"));
+    let names = [
+        "speed m/s",
+        "contact s",
+        "period s",
+        "touchdown ahead m",
+        "knee at touchdown °",
+        "knee mid-stance °",
+        "swing knee °",
+        "trunk lean °",
+        "COM range m",
+    ];
+    // (relative bound, absolute bound in degrees) per figure; None: printed only.
+    let bounds: [Option<(f64, f64)>; 9] = [
+        Some((0.01, 0.0)),
+        Some((0.10, 0.0)),
+        Some((0.10, 0.0)),
+        Some((0.20, 0.0)),
+        Some((0.0, KNEE_TOL_DEG)),
+        Some((0.0, KNEE_TOL_DEG)),
+        None,
+        Some((0.0, LEAN_TOL_DEG)),
+        Some((0.15, 0.0)),
+    ];
+    for (from, to) in [(2u32, 3u32), (3, 2)] {
+        let sub = dir.path().join(format!("from{from}"));
+        let folder = |p: &Path| {
+            let stem = p.file_stem().unwrap().to_string_lossy();
+            sub.join(format!("joints_{stem}"))
+        };
+        // The target recording under its own name, so its `frames` folder is its own; the
+        // edit asks for the speed that recording measures (1.966 m/s for "2 m/s").
+        let target = sub.join(format!("recorded_{to}.bvh"));
+        std::fs::create_dir_all(&sub).unwrap();
+        std::fs::copy(clip(to), &target).unwrap();
+        let gr = gauged(&target, &sub);
+        let r = gait(&gr, &folder(&target));
+        let lib = library(&sub, &[clip(from)]);
+        let out = sub.join(format!("edit_{from}to{to}.bvh"));
+        let code = edit(&[
+            "edit",
+            "run",
+            "--lib",
+            &s(&lib),
+            "--speed",
+            &format!("{:.3}", r[0]),
+            "--out",
+            &s(&out),
+        ]);
+        assert_eq!(code, 0, "edit {from} → {:.3} m/s", r[0]);
+        let ge = gauged(&out, &sub);
+        let e = gait(&ge, &folder(&out));
+        for (k, name) in names.iter().enumerate() {
+            let (rel, diff) = (e[k] / r[k] - 1.0, e[k] - r[k]);
+            eprintln!(
+                "{from} → {to} m/s, {name}: edited {:.3}, recorded at {to} m/s {:.3} \
+                 ({:+.1} %, {diff:+.2}){}",
+                e[k],
+                r[k],
+                100.0 * rel,
+                if bounds[k].is_none() {
+                    "  KNOWN MISS"
+                } else {
+                    ""
+                }
+            );
+            match bounds[k] {
+                Some((b, 0.0)) => assert!(rel.abs() <= b, "{from} → {to}: {name} {rel:+.3}"),
+                Some((_, deg)) => assert!(diff.abs() <= deg, "{from} → {to}: {name} {diff:+.2}°"),
+                None => {}
+            }
+        }
+    }
+}
