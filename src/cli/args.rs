@@ -377,7 +377,8 @@ pub struct EditJumpArgs {
     /// `LIFTOFF_ID:LANDING_ID`, both of one clip; default: the best feasible pair of one
     /// clip (with `--height` and `--distance`), or the library's first recorded jump
     /// (without them). A landing that does not follow its liftoff in the clip is turned
-    /// onto the liftoff's heading.
+    /// onto the liftoff's heading. A clip name may hold ':': the pair is split at the ':'
+    /// where both halves are stance ids of the library (no quoting).
     #[arg(long)]
     pub pair: Option<String>,
 }

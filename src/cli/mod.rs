@@ -42,15 +42,19 @@ static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex
 /// one are dropped quietly and the command finishes its work, as ripgrep ends quietly on
 /// a broken pipe; the exit code is the command's own (0 when its work succeeded), and
 /// outputs it writes to files are still written. Any other write error (a full disk) is
-/// kept and makes [`run`] fail with it once the command is done.
+/// kept and makes [`run`] fail with it once the command is done. Control characters
+/// other than line breaks and tabs (an ESC from a clip name or a character id) are
+/// written escaped ([`crate::error::escape_but`]): nothing read from data reaches the
+/// terminal as a control sequence.
 pub fn print_line(args: std::fmt::Arguments<'_>) {
     use std::io::Write;
     if STDOUT_DONE.load(Ordering::Relaxed) {
         return;
     }
+    let line = crate::error::escape_but(&args.to_string(), &['\n', '\t']);
     let mut out = std::io::stdout().lock();
     if let Err(e) = out
-        .write_fmt(format_args!("{args}\n"))
+        .write_fmt(format_args!("{line}\n"))
         .and_then(|()| out.flush())
     {
         STDOUT_DONE.store(true, Ordering::Relaxed);

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::contacts::ContactOptions;
-use crate::error::{Error, Result};
+use crate::error::{echo, Error, Result};
 use crate::force_model::fit::{MAX_SAMPLES, MIN_SAMPLES};
 use crate::ingest::{IngestOptions, DEFAULT_MASS_KG};
 use crate::library::layout::Layout;
@@ -587,7 +587,7 @@ pub fn expand_inputs(pipeline_path: &Path, p: &PipelineFile) -> Result<Vec<PathB
             return Err(Error::config(
                 Some(pipeline_path.to_path_buf()),
                 None,
-                format!("inputs: '{g}' matches nothing"),
+                format!("inputs: '{}' matches nothing", echo(g)),
             ));
         }
         out.extend(found);
