@@ -189,7 +189,33 @@ fn limits_help(command: &str) -> Option<String> {
         crate::twopac::polytope::MAX_ROWS
     );
     let lines: Vec<String> = match command {
-        "frames" | "build" | "run" => vec![bvh, threads],
+        "frames" | "build" => vec![bvh, threads],
+        "run" => vec![
+            bvh,
+            threads,
+            format!(
+                "inputs: at most {} globs (MAX_INPUT_PATTERNS)",
+                crate::pipeline::spec::MAX_INPUT_PATTERNS
+            ),
+        ],
+        "edit-run" | "edit-jump" => {
+            let mut l = vec![
+                format!(
+                    "--fps {} to {} Hz (MIN_FPS, MAX_FPS)",
+                    crate::edit::MIN_FPS,
+                    crate::edit::MAX_FPS
+                ),
+                format!(
+                    "output frames × skeleton joints: at most {} (MAX_EDIT_FRAME_JOINTS)",
+                    crate::edit::MAX_EDIT_FRAME_JOINTS
+                ),
+            ];
+            if command == "edit-run" {
+                let cycles = format!("--cycles 1 to {} (MAX_CYCLES)", crate::edit::MAX_CYCLES);
+                l.insert(0, cycles);
+            }
+            l
+        }
         "run-query" => vec![
             range,
             format!(
@@ -204,9 +230,12 @@ fn limits_help(command: &str) -> Option<String> {
         ],
         "twopac" => vec![twopac],
         "equilibrium" => vec![format!(
-            "at most {} contacts (MAX_CONTACTS), {} COM states (MAX_COM_STATES)",
+            "at most {} contacts (MAX_CONTACTS), {} COM states (MAX_COM_STATES), {} contacts × \
+             (COM states + {} cells with --png) (MAX_CONTACT_STATES)",
             crate::twopac::equilibrium::MAX_CONTACTS,
-            crate::twopac::equilibrium::MAX_COM_STATES
+            crate::twopac::equilibrium::MAX_COM_STATES,
+            crate::twopac::equilibrium::MAX_CONTACT_STATES,
+            crate::plot::equilibrium::DEFAULT_SLICE_CELLS.pow(2)
         )],
         "synth" => vec![format!(
             "--rate {} to {} Hz, --duration at most {} s",
@@ -228,11 +257,11 @@ fn limits_help(command: &str) -> Option<String> {
 pub fn command() -> clap::Command {
     fn adjust(c: clap::Command, parent: &str) -> clap::Command {
         let name = c.get_name().to_string();
-        // `query run` and `run` share a name: key the query one by its parent.
-        let key = if parent == "query" && name == "run" {
-            "run-query".to_string()
-        } else {
-            name.clone()
+        // `query run`, `edit run` and `run` share a name: key the first two by their parent.
+        let key = match (parent, name.as_str()) {
+            ("query", "run") => "run-query".to_string(),
+            ("edit", _) => format!("edit-{name}"),
+            _ => name.clone(),
         };
         let mut c = c.allow_negative_numbers(true);
         if let Some(h) = limits_help(&key) {

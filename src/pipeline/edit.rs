@@ -15,7 +15,7 @@ use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
     choose_jump, choose_run, jump_stances, EditLimits, JumpTarget, RunTarget,
 };
-use crate::edit::{EditOptions, MAX_CYCLES, MAX_FPS, MIN_FPS};
+use crate::edit::{EditOptions, MAX_CYCLES, MAX_EDIT_FRAME_JOINTS, MAX_FPS, MIN_FPS};
 use crate::ingest::body::BodyModel;
 use crate::library::provenance::library_body;
 use crate::library::read::{read_clip_sources, read_stance_timing};
@@ -246,6 +246,36 @@ fn recorded_path(lib: &Path, recorded: &str) -> PathBuf {
     }
 }
 
+/// Checks the frames × joints of the planned output against [`MAX_EDIT_FRAME_JOINTS`]
+/// before any frame is posed.
+///
+/// # Errors
+/// Beyond the limit: the frames, rate and joints asked for, and the options that set them.
+fn check_frames(
+    path: &crate::edit::path::ComPath,
+    frame_time_s: f64,
+    joints: usize,
+) -> anyhow::Result<()> {
+    let frames = crate::edit::pose::frame_count_f64(path, frame_time_s);
+    let n = frames * joints as f64;
+    if n > MAX_EDIT_FRAME_JOINTS as f64 {
+        let field = format!(
+            "edit output ({} frames at {:.1} Hz × {joints} joints; lower --cycles or --fps)",
+            crate::error::count_text(frames),
+            1.0 / frame_time_s
+        );
+        return Err(crate::error::Error::limit(
+            field,
+            "frame-joints",
+            n,
+            MAX_EDIT_FRAME_JOINTS,
+            "MAX_EDIT_FRAME_JOINTS",
+        )
+        .into());
+    }
+    Ok(())
+}
+
 /// Builds the reference, places the plan and poses every frame.
 fn compute(
     t: &EditTarget,
@@ -265,6 +295,7 @@ fn compute(
         .with_context(|| format!("clip {clip}"))?
         .with_length_scale(length);
     let (path, sources) = place(&stances, &order, &reference, kind);
+    check_frames(&path, frame_time_s, bvh.hierarchy.joints.len())?;
     let edited = pose_motion(
         &reference,
         &path,
