@@ -148,6 +148,14 @@ pub enum ErrorKind {
         /// The name of the constant that defines the limit (`MAX_AXIS_VALUES`).
         limit: &'static str,
     },
+    /// A library was replaced (rebuilt) while a command read it, twice
+    /// ([`crate::library::generation`]): what was read may mix two builds, so nothing
+    /// was answered.
+    #[error("library {} changed while it was read (a build replaced it); retry", lib.display())]
+    Changed {
+        /// The library folder.
+        lib: PathBuf,
+    },
 }
 
 impl Error {

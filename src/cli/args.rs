@@ -338,7 +338,7 @@ pub enum EditCommand {
 }
 
 /// Options every edit shares.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EditCommon {
     /// Library folder (from `build` or `run`).
     #[arg(long)]
@@ -361,7 +361,7 @@ pub struct EditCommon {
 }
 
 /// `stancelib edit run`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EditRunArgs {
     /// Library, output and shared options.
     #[command(flatten)]
@@ -389,7 +389,7 @@ pub struct EditRunArgs {
 }
 
 /// `stancelib edit jump`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EditJumpArgs {
     /// Library, output and shared options.
     #[command(flatten)]
@@ -492,7 +492,7 @@ impl LimitArgs {
 }
 
 /// `stancelib query run`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct RunQueryArgs {
     /// Library folder (from `build` or `run`).
     #[arg(long)]
@@ -554,7 +554,7 @@ impl RunQueryArgs {
 }
 
 /// `stancelib query jump`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct JumpArgs {
     /// Library folder.
     #[arg(long)]
@@ -599,7 +599,7 @@ pub struct JumpArgs {
 }
 
 /// `stancelib map jumps`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct MapJumpsArgs {
     /// Library folder.
     #[arg(long)]
@@ -728,7 +728,7 @@ impl BodyArgs {
 }
 
 /// `stancelib frames`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct FramesArgs {
     /// BVH files or folders (searched recursively for *.bvh).
     #[arg(required = true)]
@@ -742,7 +742,7 @@ pub struct FramesArgs {
 }
 
 /// `stancelib build`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct BuildArgs {
     /// BVH files or folders (searched recursively for *.bvh).
     #[arg(required = true)]
@@ -779,7 +779,7 @@ fn parse_shard(s: &str) -> Result<Shard, String> {
 }
 
 /// `stancelib merge`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct MergeArgs {
     /// Shard libraries, one per shard of one build (any order).
     #[arg(required = true)]
@@ -796,7 +796,7 @@ pub struct MergeArgs {
 }
 
 /// `stancelib run`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct RunArgs {
     /// Pipeline file.
     pub pipeline: PathBuf,
@@ -816,7 +816,7 @@ pub struct RunArgs {
 }
 
 /// `stancelib synth`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct SynthArgs {
     /// `run` or `jump`.
     #[arg(long, value_enum, ignore_case = true, default_value = "run")]
@@ -842,7 +842,7 @@ pub struct SynthArgs {
 }
 
 /// `stancelib equilibrium` (spec two-pac §8.2).
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EquilibriumArgs {
     /// Contacts file (JSON, schema `stancelib.twopac.contacts/1`).
     #[arg(long)]
@@ -861,7 +861,7 @@ pub struct EquilibriumArgs {
 }
 
 /// `stancelib twopac` (spec two-pac §1.1, §8).
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct TwopacArgs {
     /// Phase sequence (JSON, schema `stancelib.twopac.phases/1`).
     #[arg(long, required_unless_present = "clip")]
@@ -884,7 +884,7 @@ pub struct TwopacArgs {
 }
 
 /// `stancelib forces`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct ForcesArgs {
     /// Library folder.
     #[arg(long)]
@@ -898,7 +898,7 @@ pub struct ForcesArgs {
 }
 
 /// `stancelib plot stance`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct PlotStanceArgs {
     /// Library folder.
     #[arg(long)]
@@ -920,21 +920,21 @@ pub struct PlotStanceArgs {
 }
 
 /// `stancelib info`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct InfoArgs {
     /// Library folder (from `build` or `run`).
     pub lib: PathBuf,
 }
 
 /// `stancelib list` (its help is the doc of [`Command::List`]).
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct ListArgs {
     /// Library folder (from `build` or `run`).
     pub lib: PathBuf,
 }
 
 /// `stancelib plot clip`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct PlotClipArgs {
     /// Library folder.
     #[arg(long)]

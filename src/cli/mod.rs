@@ -48,7 +48,7 @@ static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex
 /// terminal as a control sequence.
 pub fn print_line(args: std::fmt::Arguments<'_>) {
     use std::io::Write;
-    if STDOUT_DONE.load(Ordering::Relaxed) {
+    if STDOUT_DONE.load(Ordering::Relaxed) || !crate::library::generation::before_print() {
         return;
     }
     let line = crate::error::escape_but(&args.to_string(), &['\n', '\t']);
@@ -102,25 +102,34 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     }
 }
 
-/// Run one command.
+/// Run one command. The commands that read a library read one generation of it
+/// ([`read_consistently`]).
 fn dispatch(command: Command) -> anyhow::Result<Outcome> {
+    use crate::library::generation::read_consistently;
+    fn on<A: Clone>(
+        lib: &std::path::Path,
+        a: A,
+        run: fn(A) -> anyhow::Result<Outcome>,
+    ) -> anyhow::Result<Outcome> {
+        read_consistently(lib, || run(a.clone()))
+    }
     match command {
-        Command::Info(a) => cmd::info::run(a),
-        Command::List(a) => cmd::list::run(a),
+        Command::Info(a) => on(&a.lib.clone(), a, cmd::info::run),
+        Command::List(a) => on(&a.lib.clone(), a, cmd::list::run),
         Command::Frames(a) => cmd::frames::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Build(a) => cmd::build::run(a),
         Command::Merge(a) => cmd::build::run_merge(a),
         Command::Synth(a) => cmd::synth::run(a),
-        Command::Query(QueryCommand::Run(a)) => cmd::query::run(a),
-        Command::Query(QueryCommand::Jump(a)) => cmd::query::run_jump(a),
-        Command::Map(MapCommand::Jumps(a)) => cmd::map::run(a),
+        Command::Query(QueryCommand::Run(a)) => on(&a.lib.clone(), a, cmd::query::run),
+        Command::Query(QueryCommand::Jump(a)) => on(&a.lib.clone(), a, cmd::query::run_jump),
+        Command::Map(MapCommand::Jumps(a)) => on(&a.lib.clone(), a, cmd::map::run),
         Command::Equilibrium(a) => cmd::equilibrium::run(a),
         Command::Twopac(a) => cmd::twopac::run(a),
-        Command::Forces(a) => cmd::forces::run(a),
-        Command::Plot(PlotCommand::Stance(a)) => cmd::plot::run_stance(a),
-        Command::Edit(EditCommand::Run(a)) => cmd::edit::run(a),
-        Command::Edit(EditCommand::Jump(a)) => cmd::edit::run_jump(a),
-        Command::Plot(PlotCommand::Clip(a)) => cmd::plot::run_clip(a),
+        Command::Forces(a) => on(&a.lib.clone(), a, cmd::forces::run),
+        Command::Plot(PlotCommand::Stance(a)) => on(&a.lib.clone(), a, cmd::plot::run_stance),
+        Command::Edit(EditCommand::Run(a)) => on(&a.common.lib.clone(), a, cmd::edit::run),
+        Command::Edit(EditCommand::Jump(a)) => on(&a.common.lib.clone(), a, cmd::edit::run_jump),
+        Command::Plot(PlotCommand::Clip(a)) => on(&a.lib.clone(), a, cmd::plot::run_clip),
     }
 }

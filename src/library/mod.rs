@@ -9,6 +9,7 @@ pub mod atomic;
 pub mod clip_view;
 pub(crate) mod columns;
 pub mod forces;
+pub mod generation;
 pub mod info;
 pub mod integrity;
 pub mod kinematics;

@@ -339,6 +339,8 @@ fn finish(
         motion: e.edited.motion.clone(),
         warnings: Vec::new(),
     };
+    // The BVH writer is below the library's; the read's generation is checked here.
+    crate::library::generation::before_output()?;
     write_file(&t.out, &out)?;
     let (plan, png) = sidecars(&t.out);
     write_table(&plan, &mut df, &kv)?;
