@@ -148,6 +148,14 @@ pub enum ErrorKind {
         /// The name of the constant that defines the limit (`MAX_AXIS_VALUES`).
         limit: &'static str,
     },
+    /// A library was replaced (rebuilt) while a command read it, twice
+    /// ([`crate::library::generation`]): what was read may mix two builds, so nothing
+    /// was answered.
+    #[error("library {} changed while it was read (a build replaced it); retry", lib.display())]
+    Changed {
+        /// The library folder.
+        lib: PathBuf,
+    },
 }
 
 impl Error {
@@ -340,14 +348,33 @@ pub const MAX_ECHO_CHARS: usize = 80;
 /// assert_eq!(stancelib::error::echo(&"x".repeat(100)).chars().count(), 81);
 /// ```
 pub fn echo(raw: &str) -> String {
-    let mut out = String::new();
-    for (i, c) in raw.chars().enumerate() {
-        if i == MAX_ECHO_CHARS {
-            out.push('…');
-            break;
-        }
+    match raw.char_indices().nth(MAX_ECHO_CHARS) {
+        Some((cut, _)) => escape(&raw[..cut]) + "…",
+        None => escape(raw),
+    }
+}
+
+/// Text read from data (a clip name, a character id, a manifest value) made safe to print
+/// whole: every control character (ESC, newline, NUL, DEL, C1) and bidirectional-text
+/// control written as `\x1b` or `\u{202e}`, the rest as it is (see [`echo`] for input
+/// echoed in an error, which is also cut).
+///
+/// # Examples
+/// ```
+/// assert_eq!(stancelib::error::escape("a\nb\x1b[2J"), "a\\x0ab\\x1b[2J");
+/// ```
+pub fn escape(raw: &str) -> String {
+    escape_but(raw, &[])
+}
+
+/// [`escape`], except the characters of `keep` (the line breaks of a multi-line report).
+pub fn escape_but(raw: &str, keep: &[char]) -> String {
+    let mut out = String::with_capacity(raw.len());
+    for c in raw.chars() {
         let bidi = matches!(c, '\u{200b}'..='\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{feff}');
-        if c.is_control() && (c as u32) < 0x100 {
+        if keep.contains(&c) {
+            out.push(c);
+        } else if c.is_control() && (c as u32) < 0x100 {
             out.push_str(&format!("\\x{:02x}", c as u32));
         } else if c.is_control() || bidi {
             out.push_str(&format!("\\u{{{:x}}}", c as u32));

@@ -11,7 +11,8 @@ fn main() -> ExitCode {
         Ok(stancelib::cli::Outcome::AllFailed) => ExitCode::from(2),
         Ok(stancelib::cli::Outcome::Infeasible) => ExitCode::from(3),
         Err(e) => {
-            eprintln!("stancelib: error: {e:#}");
+            let msg = stancelib::error::escape_but(&format!("{e:#}"), &['\n', '\t']);
+            eprintln!("stancelib: error: {msg}");
             ExitCode::from(2)
         }
     }

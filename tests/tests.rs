@@ -94,6 +94,13 @@
 //! - `safety_reuse`: issue 40 items 1, 4, 7: incremental builds and merges check what they
 //!   reuse against the manifest's content hashes and rows per clip; `frames` never writes into a library.
 //! - `safety_side_inputs`: issue 40 items 2, 3, 8, 10: side inputs as BVH inputs, clip budget, closed stdout, atomic `synth`.
+//! - `safety_work`: issue 40 item 6: limits sized by work (equilibrium contacts × states,
+//!   edit frames × joints, pipeline globs), refused before the work.
+//! - `safety_swap`: issue 40 item 9: reads during rebuilds answer from one generation of
+//!   the library or say that it changed.
+//! - `safety_names`: issue 40 item 11: merge mismatches by key, echoed input cut, data
+//!   escaped on the terminal, "rebuild" for old layouts, injective file names, `--pair`
+//!   with `:` in clip names, the manifest read bounded.
 //!
 //! # Structure (issue 13)
 //! - `structure_edges`: enumerated options parsed (any case) and refused before work;
@@ -155,11 +162,14 @@ mod verdicts;
 mod safety_inputs;
 mod safety_limits;
 mod safety_messages;
+mod safety_names;
 mod safety_numbers;
 mod safety_options;
 mod safety_outputs;
 mod safety_reuse;
 mod safety_side_inputs;
+mod safety_swap;
+mod safety_work;
 // Structure (issue 13)
 mod structure_edges;
 mod structure_stages;

@@ -188,13 +188,34 @@ fn limits_help(command: &str) -> Option<String> {
         crate::twopac::validate::MAX_SAMPLES,
         crate::twopac::polytope::MAX_ROWS
     );
-    let fps = format!(
-        "--fps {} to {} Hz (MIN_FPS, MAX_FPS)",
-        crate::edit::MIN_FPS,
-        crate::edit::MAX_FPS
-    );
     let lines: Vec<String> = match command {
-        "frames" | "build" | "run" => vec![bvh, threads],
+        "frames" | "build" => vec![bvh, threads],
+        "run" => vec![
+            bvh,
+            threads,
+            format!(
+                "inputs: at most {} globs (MAX_INPUT_PATTERNS)",
+                crate::pipeline::spec::MAX_INPUT_PATTERNS
+            ),
+        ],
+        "edit-run" | "edit-jump" => {
+            let mut l = vec![
+                format!(
+                    "--fps {} to {} Hz (MIN_FPS, MAX_FPS)",
+                    crate::edit::MIN_FPS,
+                    crate::edit::MAX_FPS
+                ),
+                format!(
+                    "output frames × skeleton joints: at most {} (MAX_EDIT_FRAME_JOINTS)",
+                    crate::edit::MAX_EDIT_FRAME_JOINTS
+                ),
+            ];
+            if command == "edit-run" {
+                let cycles = format!("--cycles 1 to {} (MAX_CYCLES)", crate::edit::MAX_CYCLES);
+                l.insert(0, cycles);
+            }
+            l
+        }
         "run-query" => vec![
             range,
             format!(
@@ -209,15 +230,13 @@ fn limits_help(command: &str) -> Option<String> {
         ],
         "twopac" => vec![twopac],
         "equilibrium" => vec![format!(
-            "at most {} contacts (MAX_CONTACTS), {} COM states (MAX_COM_STATES)",
+            "at most {} contacts (MAX_CONTACTS), {} COM states (MAX_COM_STATES), {} contacts × \
+             (COM states + {} cells with --png) (MAX_CONTACT_STATES)",
             crate::twopac::equilibrium::MAX_CONTACTS,
-            crate::twopac::equilibrium::MAX_COM_STATES
+            crate::twopac::equilibrium::MAX_COM_STATES,
+            crate::twopac::equilibrium::MAX_CONTACT_STATES,
+            crate::plot::equilibrium::DEFAULT_SLICE_CELLS.pow(2)
         )],
-        "edit-run" => vec![
-            format!("--cycles 1 to {} (MAX_CYCLES)", crate::edit::MAX_CYCLES),
-            fps,
-        ],
-        "edit-jump" => vec![fps],
         "synth" => vec![format!(
             "--rate {} to {} Hz, --duration at most {} s",
             crate::synth::MIN_FRAME_RATE_HZ,
@@ -262,7 +281,7 @@ pub fn command() -> clap::Command {
         // `query run`, `edit run` and `run` share a name: key the first two by their parent.
         let key = match (parent, name.as_str()) {
             ("query", "run") => "run-query".to_string(),
-            ("edit", n) => format!("edit-{n}"),
+            ("edit", _) => format!("edit-{name}"),
             _ => name.clone(),
         };
         let mut c = c.allow_negative_numbers(true);
@@ -344,7 +363,7 @@ pub enum EditCommand {
 }
 
 /// Options every edit shares.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EditCommon {
     /// Library folder (from `build` or `run`).
     #[arg(long)]
@@ -373,7 +392,7 @@ pub struct EditCommon {
 }
 
 /// `stancelib edit run`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EditRunArgs {
     /// Library, output and shared options.
     #[command(flatten)]
@@ -401,7 +420,7 @@ pub struct EditRunArgs {
 }
 
 /// `stancelib edit jump`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EditJumpArgs {
     /// Library, output and shared options.
     #[command(flatten)]
@@ -418,7 +437,8 @@ pub struct EditJumpArgs {
     /// `LIFTOFF_ID:LANDING_ID`, both of one clip; default: the best feasible pair of one
     /// clip (with `--height` and `--distance`), or the library's first recorded jump
     /// (without them). A landing that does not follow its liftoff in the clip is turned
-    /// onto the liftoff's heading.
+    /// onto the liftoff's heading. A clip name may hold ':': the pair is split at the ':'
+    /// where both halves are stance ids of the library (no quoting).
     #[arg(long)]
     pub pair: Option<String>,
 }
@@ -503,7 +523,7 @@ impl LimitArgs {
 }
 
 /// `stancelib query run`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct RunQueryArgs {
     /// Library folder (from `build` or `run`).
     #[arg(long)]
@@ -565,7 +585,7 @@ impl RunQueryArgs {
 }
 
 /// `stancelib query jump`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct JumpArgs {
     /// Library folder.
     #[arg(long)]
@@ -610,7 +630,7 @@ pub struct JumpArgs {
 }
 
 /// `stancelib map jumps`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct MapJumpsArgs {
     /// Library folder.
     #[arg(long)]
@@ -739,7 +759,7 @@ impl BodyArgs {
 }
 
 /// `stancelib frames`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct FramesArgs {
     /// BVH files or folders (searched recursively for *.bvh).
     #[arg(required = true)]
@@ -753,7 +773,7 @@ pub struct FramesArgs {
 }
 
 /// `stancelib build`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct BuildArgs {
     /// BVH files or folders (searched recursively for *.bvh).
     #[arg(required = true)]
@@ -790,7 +810,7 @@ fn parse_shard(s: &str) -> Result<Shard, String> {
 }
 
 /// `stancelib merge`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct MergeArgs {
     /// Shard libraries, one per shard of one build (any order).
     #[arg(required = true)]
@@ -807,7 +827,7 @@ pub struct MergeArgs {
 }
 
 /// `stancelib run`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct RunArgs {
     /// Pipeline file.
     pub pipeline: PathBuf,
@@ -827,7 +847,7 @@ pub struct RunArgs {
 }
 
 /// `stancelib synth`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct SynthArgs {
     /// `run` or `jump`.
     #[arg(long, value_enum, ignore_case = true, default_value = "run")]
@@ -853,7 +873,7 @@ pub struct SynthArgs {
 }
 
 /// `stancelib equilibrium` (spec two-pac §8.2).
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct EquilibriumArgs {
     /// Contacts file (JSON, schema `stancelib.twopac.contacts/1`).
     #[arg(long)]
@@ -872,7 +892,7 @@ pub struct EquilibriumArgs {
 }
 
 /// `stancelib twopac` (spec two-pac §1.1, §8).
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct TwopacArgs {
     /// Phase sequence (JSON, schema `stancelib.twopac.phases/1`).
     #[arg(long, required_unless_present = "clip")]
@@ -895,7 +915,7 @@ pub struct TwopacArgs {
 }
 
 /// `stancelib forces`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct ForcesArgs {
     /// Library folder.
     #[arg(long)]
@@ -909,7 +929,7 @@ pub struct ForcesArgs {
 }
 
 /// `stancelib plot stance`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct PlotStanceArgs {
     /// Library folder.
     #[arg(long)]
@@ -931,21 +951,21 @@ pub struct PlotStanceArgs {
 }
 
 /// `stancelib info`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct InfoArgs {
     /// Library folder (from `build` or `run`).
     pub lib: PathBuf,
 }
 
 /// `stancelib list` (its help is the doc of [`Command::List`]).
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct ListArgs {
     /// Library folder (from `build` or `run`).
     pub lib: PathBuf,
 }
 
 /// `stancelib plot clip`.
-#[derive(Debug, Args)]
+#[derive(Debug, Args, Clone)]
 pub struct PlotClipArgs {
     /// Library folder.
     #[arg(long)]

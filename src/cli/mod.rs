@@ -42,15 +42,19 @@ static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex
 /// one are dropped quietly and the command finishes its work, as ripgrep ends quietly on
 /// a broken pipe; the exit code is the command's own (0 when its work succeeded), and
 /// outputs it writes to files are still written. Any other write error (a full disk) is
-/// kept and makes [`run`] fail with it once the command is done.
+/// kept and makes [`run`] fail with it once the command is done. Control characters
+/// other than line breaks and tabs (an ESC from a clip name or a character id) are
+/// written escaped ([`crate::error::escape_but`]): nothing read from data reaches the
+/// terminal as a control sequence.
 pub fn print_line(args: std::fmt::Arguments<'_>) {
     use std::io::Write;
-    if STDOUT_DONE.load(Ordering::Relaxed) {
+    if STDOUT_DONE.load(Ordering::Relaxed) || !crate::library::generation::before_print() {
         return;
     }
+    let line = crate::error::escape_but(&args.to_string(), &['\n', '\t']);
     let mut out = std::io::stdout().lock();
     if let Err(e) = out
-        .write_fmt(format_args!("{args}\n"))
+        .write_fmt(format_args!("{line}\n"))
         .and_then(|()| out.flush())
     {
         STDOUT_DONE.store(true, Ordering::Relaxed);
@@ -101,25 +105,34 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     }
 }
 
-/// Run one command.
+/// Run one command. The commands that read a library read one generation of it
+/// ([`read_consistently`]).
 fn dispatch(command: Command) -> anyhow::Result<Outcome> {
+    use crate::library::generation::read_consistently;
+    fn on<A: Clone>(
+        lib: &std::path::Path,
+        a: A,
+        run: fn(A) -> anyhow::Result<Outcome>,
+    ) -> anyhow::Result<Outcome> {
+        read_consistently(lib, || run(a.clone()))
+    }
     match command {
-        Command::Info(a) => cmd::info::run(a),
-        Command::List(a) => cmd::list::run(a),
+        Command::Info(a) => on(&a.lib.clone(), a, cmd::info::run),
+        Command::List(a) => on(&a.lib.clone(), a, cmd::list::run),
         Command::Frames(a) => cmd::frames::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Build(a) => cmd::build::run(a),
         Command::Merge(a) => cmd::build::run_merge(a),
         Command::Synth(a) => cmd::synth::run(a),
-        Command::Query(QueryCommand::Run(a)) => cmd::query::run(a),
-        Command::Query(QueryCommand::Jump(a)) => cmd::query::run_jump(a),
-        Command::Map(MapCommand::Jumps(a)) => cmd::map::run(a),
+        Command::Query(QueryCommand::Run(a)) => on(&a.lib.clone(), a, cmd::query::run),
+        Command::Query(QueryCommand::Jump(a)) => on(&a.lib.clone(), a, cmd::query::run_jump),
+        Command::Map(MapCommand::Jumps(a)) => on(&a.lib.clone(), a, cmd::map::run),
         Command::Equilibrium(a) => cmd::equilibrium::run(a),
         Command::Twopac(a) => cmd::twopac::run(a),
-        Command::Forces(a) => cmd::forces::run(a),
-        Command::Plot(PlotCommand::Stance(a)) => cmd::plot::run_stance(a),
-        Command::Edit(EditCommand::Run(a)) => cmd::edit::run(a),
-        Command::Edit(EditCommand::Jump(a)) => cmd::edit::run_jump(a),
-        Command::Plot(PlotCommand::Clip(a)) => cmd::plot::run_clip(a),
+        Command::Forces(a) => on(&a.lib.clone(), a, cmd::forces::run),
+        Command::Plot(PlotCommand::Stance(a)) => on(&a.lib.clone(), a, cmd::plot::run_stance),
+        Command::Edit(EditCommand::Run(a)) => on(&a.common.lib.clone(), a, cmd::edit::run),
+        Command::Edit(EditCommand::Jump(a)) => on(&a.common.lib.clone(), a, cmd::edit::run_jump),
+        Command::Plot(PlotCommand::Clip(a)) => on(&a.lib.clone(), a, cmd::plot::run_clip),
     }
 }

@@ -1336,6 +1336,17 @@ fn write_angles(r: &Reference, ws: &mut PoseWorkspace) {
     prev.copy_from_slice(&ws.pose.row);
 }
 
+/// The frames [`pose_motion`] writes for `path` at `frame_time_s`: the lead-in, then
+/// `t_start..=t_end` (as a float: no overflow for any path or rate).
+pub fn frame_count_f64(path: &ComPath, frame_time_s: f64) -> f64 {
+    let dt = frame_time_s;
+    (path.lead_in_s / dt + 1e-9).floor() + ((path.t_end - path.t_start) / dt + 1e-9).floor() + 1.0
+}
+
+fn frame_count(path: &ComPath, frame_time_s: f64) -> usize {
+    frame_count_f64(path, frame_time_s) as usize
+}
+
 /// Poses every output frame `t = t_start + (i − n_lead)·Δt` of the plan (`frame_time_s` =
 /// Δt, s: the source clip's own value unless `--fps`, so that the written `Frame Time` is
 /// the source's; `n_lead = ⌊lead_in_s / Δt⌋` frames of lead-in: the recording before the first touchdown, [`Phase::Rest`]).
@@ -1354,7 +1365,7 @@ pub fn pose_motion(
 ) -> EditedMotion {
     let dt = frame_time_s;
     let n_lead = (path.lead_in_s / dt + 1e-9).floor() as usize;
-    let n = n_lead + ((path.t_end - path.t_start) / dt + 1e-9).floor() as usize + 1;
+    let n = frame_count(path, dt);
     let nc = r.body.skeleton.n_channels;
     let mut ws = PoseWorkspace::new(r);
     let time = |i: usize| path.t_start + (i as f64 - n_lead as f64) * dt;

@@ -412,8 +412,18 @@ pub fn recorded_pair(
 
 /// The (liftoff, landing) stance indices of `LIFTOFF_ID:LANDING_ID`.
 ///
+/// # Model
+/// ```text
+/// p = LIFTOFF_ID ":" LANDING_ID,  each id = clip ":" label ":" frame
+/// ```
+/// A clip name may hold `:` itself (`take:01`), so `p` is split at the `:` where both
+/// halves are stance ids of the library; no quoting is needed. When no split gives two
+/// held ids, the split at the middle `:` names the unknown id (and its nearest ids); when
+/// several do (possible only with clip names of that very shape), the pair is ambiguous
+/// and each candidate is named.
+///
 /// # Errors
-/// Not two stance ids, an unknown id, or a stance of the wrong kind.
+/// Not two stance ids, an unknown id, an ambiguous split, or a stance of the wrong kind.
 pub fn given_pair(lib: &StanceLibrary, p: &str) -> Result<(usize, usize)> {
     let bad = |msg: String| Error::invalid("--pair", msg);
     let index = |id: &str| {
@@ -425,14 +435,44 @@ pub fn given_pair(lib: &StanceLibrary, p: &str) -> Result<(usize, usize)> {
                 bad(crate::stances::ids::unknown_stance_message(id, held))
             })
     };
-    // Stance ids hold ':' themselves (<clip>:<label>:<frame>): split at the middle ':'.
-    let parts: Vec<&str> = p.split(':').collect();
-    if parts.len() != 6 {
-        return Err(bad(format!(
-            "expected LIFTOFF_ID:LANDING_ID (each <clip>:<label>:<frame>), found {p}"
-        )));
-    }
-    let (i, j) = (index(&parts[..3].join(":"))?, index(&parts[3..].join(":"))?);
+    let held = |id: &str| lib.stances.iter().position(|s| s.stance_id == id);
+    let splits: Vec<(usize, usize)> = p
+        .match_indices(':')
+        .filter_map(|(k, _)| Some((held(&p[..k])?, held(&p[k + 1..])?)))
+        .collect();
+    let (i, j) = match splits[..] {
+        [one] => one,
+        [] => {
+            // Stance ids hold ':' themselves (<clip>:<label>:<frame>): with clip names
+            // of as many ':', the pair splits at its middle ':'.
+            let colons: Vec<usize> = p.match_indices(':').map(|(k, _)| k).collect();
+            if colons.len() < 5 || colons.len().is_multiple_of(2) {
+                return Err(bad(format!(
+                    "expected LIFTOFF_ID:LANDING_ID (each <clip>:<label>:<frame>), found {}",
+                    crate::error::echo(p)
+                )));
+            }
+            let k = colons[colons.len() / 2];
+            (index(&p[..k])?, index(&p[k + 1..])?)
+        }
+        _ => {
+            let named: Vec<String> = splits
+                .iter()
+                .map(|&(a, b)| {
+                    format!(
+                        "{} and {}",
+                        lib.stances[a].stance_id, lib.stances[b].stance_id
+                    )
+                })
+                .collect();
+            return Err(bad(format!(
+                "{} splits into stance ids of this library in {} ways ({}): ambiguous",
+                crate::error::echo(p),
+                splits.len(),
+                named.join("; ")
+            )));
+        }
+    };
     if !is_liftoff(&lib.stances[i]) {
         return Err(bad(format!(
             "{} is not a liftoff stance (rest or clip edge, then flight)",

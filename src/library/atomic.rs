@@ -40,6 +40,7 @@ pub fn write_file_atomic<E: From<Error>>(
 ) -> std::result::Result<(), E> {
     let tmp = temporary_beside(path)?;
     let result = write(&tmp).and_then(|()| {
+        super::generation::before_output()?;
         std::fs::rename(&tmp, path)
             .map_err(|e| E::from(Error::io(path, "cannot rename into place", e)))
     });

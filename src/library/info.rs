@@ -10,10 +10,8 @@ use serde::Serialize;
 
 use super::provenance::manifest_sha256;
 use super::read::{same_content, Table};
-use super::schema::{
-    clips, errors, stances as S, CLIPS_FILE, ERRORS_FILE, MANIFEST_FILE, STANCES_FILE,
-};
-use crate::error::{echo, Error, Result};
+use super::schema::{clips, errors, stances as S, CLIPS_FILE, ERRORS_FILE, STANCES_FILE};
+use crate::error::{escape, Error, Result};
 
 /// Stances beyond a person's bounds listed by the text summary (`--json` lists all).
 pub const BEYOND_BOUNDS_SHOWN: usize = 10;
@@ -100,10 +98,8 @@ fn column_counts(t: &Table, name: &str) -> Result<Counts> {
 /// A missing or malformed `manifest.json`, `clips.parquet`, `stances.parquet` or
 /// `errors.parquet` (the error names the file and column).
 pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
-    let mpath = lib.join(MANIFEST_FILE);
-    let text = std::fs::read_to_string(&mpath).map_err(|e| Error::io(&mpath, "cannot read", e))?;
-    let m: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| Error::invalid(mpath.display().to_string(), e.to_string()))?;
+    super::provenance::check_layout(lib)?;
+    let m = super::manifest::read_manifest(lib)?;
     let s = |k: &str| m.get(k).and_then(|v| v.as_str()).map(str::to_string);
     let clips = Table::open_columns(
         &lib.join(CLIPS_FILE),
@@ -226,7 +222,10 @@ fn beyond_bounds(clips_t: &Table, stances: &Table) -> Result<Vec<(String, String
 
 fn write_counts(f: &mut fmt::Formatter<'_>, title: &str, c: &Counts) -> fmt::Result {
     let total: usize = c.values().sum();
-    let parts: Vec<String> = c.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    let parts: Vec<String> = c
+        .iter()
+        .map(|(k, n)| format!("{} {n}", escape(k)))
+        .collect();
     let list = if parts.is_empty() {
         "none".to_string()
     } else {
@@ -237,8 +236,10 @@ fn write_counts(f: &mut fmt::Formatter<'_>, title: &str, c: &Counts) -> fmt::Res
 
 impl fmt::Display for LibraryInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let or = |v: &Option<String>| v.clone().unwrap_or_else(|| "(not recorded)".into());
-        writeln!(f, "library {}", self.library.display())?;
+        // Every value read from the library is escaped: a character id (a body file's
+        // `id`) with an ESC or a newline once reached the terminal as it was.
+        let or = |v: &Option<String>| v.as_deref().map_or("(not recorded)".into(), escape);
+        writeln!(f, "library {}", escape(&self.library.display().to_string()))?;
         writeln!(
             f,
             "  tool {}, schema {}, layout {}, built {}",
@@ -248,7 +249,8 @@ impl fmt::Display for LibraryInfo {
             or(&self.created_utc)
         )?;
         if let Some(cmd) = &self.command_line {
-            writeln!(f, "  command: {}", cmd.join(" "))?;
+            let words: Vec<String> = cmd.iter().map(|w| escape(w)).collect();
+            writeln!(f, "  command: {}", words.join(" "))?;
         }
         writeln!(f, "  manifest sha256 {}", self.manifest_sha256)?;
         write_counts(f, "clips", &self.clips_by_status)?;
@@ -278,8 +280,9 @@ impl fmt::Display for LibraryInfo {
                 let from = match l.get("source").and_then(|v| v.as_str()).unwrap_or("?") {
                     "character" => "its own stances",
                     "size" => "the floor of a person's capacity (3.5 body weights)",
-                    other => other,
+                    other => &escape(other),
                 };
+                let id = escape(id);
                 let n = l.get("n_stances").and_then(|v| v.as_u64()).unwrap_or(0);
                 writeln!(
                     f,
@@ -299,7 +302,7 @@ impl fmt::Display for LibraryInfo {
                 self.beyond_bounds.len()
             )?;
             for (id, why) in self.beyond_bounds.iter().take(BEYOND_BOUNDS_SHOWN) {
-                writeln!(f, "  {id}: {why}")?;
+                writeln!(f, "  {}: {}", escape(id), escape(why))?;
             }
             if self.beyond_bounds.len() > BEYOND_BOUNDS_SHOWN {
                 writeln!(
@@ -316,7 +319,7 @@ impl fmt::Display for LibraryInfo {
                 self.duplicates.len()
             )?;
             for (clip, of) in self.duplicates.iter().take(BEYOND_BOUNDS_SHOWN) {
-                writeln!(f, "  {} = {}", echo(clip), echo(of))?;
+                writeln!(f, "  {} = {}", escape(clip), escape(of))?;
             }
             if self.duplicates.len() > BEYOND_BOUNDS_SHOWN {
                 writeln!(
@@ -326,6 +329,6 @@ impl fmt::Display for LibraryInfo {
                 )?;
             }
         }
-        write!(f, "options: {}", self.options)
+        write!(f, "options: {}", escape(&self.options.to_string()))
     }
 }

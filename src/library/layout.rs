@@ -80,10 +80,7 @@ const CLIP_ORDERED: [&str; 2] = [CLIPS_FILE, STANCES_FILE];
 /// The manifest names a layout this tool does not know (the key is named).
 pub fn layout_of(lib: &Path) -> Result<Layout> {
     let path = lib.join(MANIFEST_FILE);
-    let Some(m) = std::fs::read_to_string(&path)
-        .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-    else {
+    let Ok(m) = super::manifest::read_manifest(lib) else {
         return Ok(Layout::File);
     };
     match m.get(LAYOUT_MANIFEST_KEY) {

@@ -9,10 +9,12 @@ pub mod atomic;
 pub mod clip_view;
 pub(crate) mod columns;
 pub mod forces;
+pub mod generation;
 pub mod info;
 pub mod integrity;
 pub mod kinematics;
 pub mod layout;
+pub mod manifest;
 pub mod plates;
 pub mod provenance;
 #[doc(hidden)]

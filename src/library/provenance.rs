@@ -73,23 +73,25 @@ pub fn command_line() -> Vec<String> {
 /// # Errors
 /// The manifest cannot be read.
 pub fn manifest_sha256(lib: &Path) -> Result<String> {
-    let path = lib.join(MANIFEST_FILE);
-    let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, "cannot read", e))?;
+    let bytes = super::manifest::read_manifest_bytes(lib)?;
     Ok(Sha256::digest(&bytes)
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect())
 }
 
-/// The table layout a library's manifest names (`schema`: `stancelib.library/<version>`),
-/// `None` when the folder has no readable stancelib manifest.
+/// The table layout a library's manifest names (`schema`: `stancelib.library/<version>`;
+/// in the manifests written before that key, `schema_version`), `None` when the folder
+/// has no readable stancelib manifest.
 pub fn library_layout(lib: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(lib.join(MANIFEST_FILE)).ok()?;
-    let m: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let schema = m.get("schema")?.as_str()?;
-    schema
-        .strip_prefix(MANIFEST_SCHEMA_PREFIX)
-        .map(str::to_string)
+    let m = super::manifest::read_manifest(lib).ok()?;
+    match m.get("schema") {
+        Some(schema) => schema
+            .as_str()?
+            .strip_prefix(MANIFEST_SCHEMA_PREFIX)
+            .map(str::to_string),
+        None => m.get("schema_version")?.as_str().map(str::to_string),
+    }
 }
 
 /// Refuses a library written with another table layout than this tool's
@@ -98,8 +100,15 @@ pub fn library_layout(lib: &Path) -> Option<String> {
 /// A folder without a stancelib manifest passes (its tables are checked as they are read).
 ///
 /// # Errors
-/// The manifest names another layout (the message says how to rebuild).
+/// The manifest names another layout (the message says how to rebuild), or it exists
+/// but cannot be taken in (larger than
+/// [`MAX_MANIFEST_BYTES`](super::manifest::MAX_MANIFEST_BYTES), not a regular file).
 pub fn check_layout(lib: &Path) -> Result<()> {
+    if let Err(e) = super::manifest::read_manifest_bytes(lib) {
+        if matches!(e.kind, crate::error::ErrorKind::Input { .. }) {
+            return Err(e);
+        }
+    }
     match library_layout(lib) {
         Some(v) if v != SCHEMA_VERSION => Err(Error::config(
             Some(lib.join(MANIFEST_FILE)),
@@ -124,9 +133,7 @@ pub fn check_layout(lib: &Path) -> Result<()> {
 pub fn library_body(lib: &Path) -> Result<(Sex, BTreeMap<String, String>)> {
     check_layout(lib)?;
     let path = lib.join(MANIFEST_FILE);
-    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, "cannot read", e))?;
-    let m: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| Error::config(Some(path.clone()), None, e.to_string()))?;
+    let m = super::manifest::read_manifest(lib)?;
     let ingest = &m["options"]["ingest"];
     let sex = match ingest["sex"].as_str() {
         None | Some("Male") => Sex::Male,

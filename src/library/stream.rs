@@ -700,7 +700,7 @@ impl TableWriter {
             .finish(meta)
             .map(|_| ())
             .map_err(|e| io(&self.tmp, "cannot write parquet", e));
-        if let Err(e) = ended {
+        if let Err(e) = ended.and_then(|()| super::generation::before_output()) {
             let _ = std::fs::remove_file(&self.tmp);
             return Err(e);
         }

@@ -50,8 +50,8 @@ use crate::library::layout::Layout;
 use crate::library::provenance::library_layout;
 use crate::library::read::read_parquet;
 use crate::library::schema::{
-    clips, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, MANIFEST_FILE,
-    SCHEMA_VERSION, STANCES_FILE,
+    clips, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, SCHEMA_VERSION,
+    STANCES_FILE,
 };
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{errors_table, first_non_finite, stances_table, ErrorRow};
@@ -323,10 +323,7 @@ const REFUSED_CLIPS_NAMED: usize = 10;
 /// path and content are unchanged and its rows in every table are as many as recorded.
 /// Anything else is rebuilt, with a line in `refused` saying why.
 fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str, joints: bool) -> Reuse {
-    let Some(manifest) = std::fs::read_to_string(out.join(MANIFEST_FILE))
-        .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-    else {
+    let Ok(manifest) = crate::library::manifest::read_manifest(out) else {
         return Reuse::default();
     };
     let all = |why: String| Reuse {

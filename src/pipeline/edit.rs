@@ -17,7 +17,8 @@ use crate::edit::select::{
     choose_jump, choose_run, jump_stances, ChosenRun, EditLimits, JumpTarget, RunTarget,
 };
 use crate::edit::{
-    EditOptions, DEFAULT_JUMP_SWING_HOLD_S, MAX_CYCLES, MAX_FPS, MIN_FPS, RUN_KNEE_SLACK_DEG,
+    EditOptions, DEFAULT_JUMP_SWING_HOLD_S, MAX_CYCLES, MAX_EDIT_FRAME_JOINTS, MAX_FPS, MIN_FPS,
+    RUN_KNEE_SLACK_DEG,
 };
 use crate::ingest::body::BodyModel;
 use crate::library::provenance::library_body;
@@ -312,6 +313,36 @@ fn recorded_path(lib: &Path, recorded: &str) -> PathBuf {
     }
 }
 
+/// Checks the frames × joints of the planned output against [`MAX_EDIT_FRAME_JOINTS`]
+/// before any frame is posed.
+///
+/// # Errors
+/// Beyond the limit: the frames, rate and joints asked for, and the options that set them.
+fn check_frames(
+    path: &crate::edit::path::ComPath,
+    frame_time_s: f64,
+    joints: usize,
+) -> anyhow::Result<()> {
+    let frames = crate::edit::pose::frame_count_f64(path, frame_time_s);
+    let n = frames * joints as f64;
+    if n > MAX_EDIT_FRAME_JOINTS as f64 {
+        let field = format!(
+            "edit output ({} frames at {:.1} Hz × {joints} joints; lower --cycles or --fps)",
+            crate::error::count_text(frames),
+            1.0 / frame_time_s
+        );
+        return Err(crate::error::Error::limit(
+            field,
+            "frame-joints",
+            n,
+            MAX_EDIT_FRAME_JOINTS,
+            "MAX_EDIT_FRAME_JOINTS",
+        )
+        .into());
+    }
+    Ok(())
+}
+
 /// Builds the reference, places the plan and poses every frame.
 fn compute(
     t: &EditTarget,
@@ -331,6 +362,7 @@ fn compute(
         .with_context(|| format!("clip {clip}"))?
         .with_length_scale(length);
     let (path, sources) = place(&stances, &order, &reference, kind);
+    check_frames(&path, frame_time_s, bvh.hierarchy.joints.len())?;
     let mut opts = EditOptions::default();
     if kind == PlanKind::Run {
         // The knee stays within the source's range over the cycle (`RUN_KNEE_SLACK_DEG`).
@@ -423,6 +455,8 @@ fn finish(
         motion: e.edited.motion.clone(),
         warnings: Vec::new(),
     };
+    // The BVH writer is below the library's; the read's generation is checked here.
+    crate::library::generation::before_output()?;
     write_file(&t.out, &out)?;
     let (plan, png) = sidecars(&t.out);
     write_table(&plan, &mut df, &kv)?;

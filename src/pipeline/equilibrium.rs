@@ -26,7 +26,9 @@ use crate::library::schema::com_state::{ACCELERATION, POSITION};
 use crate::library::write::write_atomic;
 use crate::plot::write_png;
 use crate::twopac::contact::{contact_points, min_mu, ContactPoint};
-use crate::twopac::equilibrium::{EqualityForm, Status, Verdict, MAX_COM_STATES};
+use crate::twopac::equilibrium::{
+    EqualityForm, Status, Verdict, MAX_COM_STATES, MAX_CONTACT_STATES,
+};
 use crate::twopac::phases::{parse_contacts, within, MAX_ACC_MPS2, MAX_COORDINATE_M};
 use crate::twopac::region::{static_region, RegionOptions, RegionStatus, StaticRegion};
 
@@ -85,19 +87,39 @@ type ComStates = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 
 /// The COM positions and accelerations of `P.parquet` (`ax_mps2`, `ay_mps2`, `az_mps2` default 0),
 /// opened as a side input ([`SideInput::Points`]); the row count is checked from the
-/// footer before any row is decoded.
-fn read_points(path: &Path) -> anyhow::Result<ComStates> {
+/// footer before any row is decoded, against [`MAX_COM_STATES`] and, times the
+/// `n_contacts` of the contact set (and with `slice_cells` more states for `--png`),
+/// against [`MAX_CONTACT_STATES`].
+fn read_points(path: &Path, n_contacts: usize, slice_cells: usize) -> anyhow::Result<ComStates> {
     let file = open_side_input(path, SideInput::Points)?.into_file();
     let mut table = OpenedParquet::new(path, file);
     let rows = table.rows()?;
-    if rows > MAX_COM_STATES {
-        let e = Error::limit(
+    let work = n_contacts as f64 * (rows + slice_cells) as f64;
+    let too_many = if rows > MAX_COM_STATES {
+        Some(Error::limit(
             "--points",
             "rows",
             rows as f64,
             MAX_COM_STATES,
             "MAX_COM_STATES",
-        );
+        ))
+    } else if work > MAX_CONTACT_STATES as f64 {
+        let png = if slice_cells > 0 {
+            format!(" + {slice_cells} cells of the --png slice")
+        } else {
+            String::new()
+        };
+        Some(Error::limit(
+            format!("--points ({rows} rows{png}) × --contacts ({n_contacts} contacts)"),
+            "contact-states",
+            work,
+            MAX_CONTACT_STATES,
+            "MAX_CONTACT_STATES",
+        ))
+    } else {
+        None
+    };
+    if let Some(e) = too_many {
         return Err(anyhow::Error::from(e).context(path.display().to_string()));
     }
     let t = table.read()?;
@@ -143,7 +165,12 @@ pub fn run_equilibrium(job: &EquilibriumJob) -> anyhow::Result<EquilibriumReport
     let start = Instant::now();
     let text = read_side_text(&job.contacts, SideInput::Contacts)?;
     let file = parse_contacts(&text).with_context(|| job.contacts.display().to_string())?;
-    let (com, acc) = read_points(&job.points)?;
+    let slice_cells = if job.png.is_some() {
+        crate::plot::equilibrium::DEFAULT_SLICE_CELLS.pow(2)
+    } else {
+        0
+    };
+    let (com, acc) = read_points(&job.points, file.contacts.len(), slice_cells)?;
     let form = EqualityForm::new(&file.contacts, file.mass_kg)
         .with_context(|| job.contacts.display().to_string())?;
     let t0 = Instant::now();

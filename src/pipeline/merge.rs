@@ -84,10 +84,7 @@ fn open_shard(dir: &Path) -> Result<ShardLib> {
             format!("no stancelib {MANIFEST_FILE}: the build of this shard did not finish"),
         ));
     }
-    let path = dir.join(MANIFEST_FILE);
-    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, "cannot read", e))?;
-    let manifest: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| Error::config(Some(path.clone()), None, e.to_string()))?;
+    let manifest = crate::library::manifest::read_manifest(dir)?;
     let Some(index) = manifest
         .pointer("/shard/index")
         .and_then(serde_json::Value::as_u64)
@@ -162,6 +159,52 @@ const SHARED_FIELDS: [&str; 6] = [
     "/shard/inputs_sha256",
 ];
 
+/// The first place where two manifest values differ: its key path (`options.ingest.mass_kg`,
+/// array items as `[i]`) and the two values as JSON, each cut to
+/// [`crate::error::MAX_ECHO_CHARS`] and escaped; `None` when they are equal. A key one
+/// side lacks shows as `none`. (Printed whole, two option sets of a thousand characters
+/// differed after the point where the message cut them.)
+///
+/// # Examples
+/// ```text
+/// {"ingest": {"mass_kg": 70, "sex": "Male"}} vs {"ingest": {"mass_kg": 80, "sex": "Male"}}
+///   → ("options.ingest.mass_kg", "70", "80")
+/// ```
+pub fn first_difference(
+    pointer: &str,
+    a: Option<&serde_json::Value>,
+    b: Option<&serde_json::Value>,
+) -> Option<(String, String, String)> {
+    use serde_json::Value;
+    fn walk(
+        path: String,
+        a: Option<&Value>,
+        b: Option<&Value>,
+    ) -> Option<(String, String, String)> {
+        match (a, b) {
+            (Some(Value::Object(x)), Some(Value::Object(y))) => {
+                let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+                keys.into_iter()
+                    .find_map(|k| walk(format!("{path}.{k}"), x.get(k), y.get(k)))
+            }
+            (Some(Value::Array(x)), Some(Value::Array(y))) if x.len() == y.len() => x
+                .iter()
+                .zip(y)
+                .enumerate()
+                .find_map(|(i, (p, q))| walk(format!("{path}[{i}]"), Some(p), Some(q))),
+            _ if a == b => None,
+            _ => {
+                let show = |v: Option<&Value>| {
+                    crate::error::echo(&v.map_or("none".to_string(), Value::to_string))
+                };
+                Some((crate::error::echo(&path), show(a), show(b)))
+            }
+        }
+    }
+    let root = pointer.trim_start_matches('/').replace('/', ".");
+    walk(root, a, b)
+}
+
 /// Check the shards belong to one build and cover it; sorted by index.
 fn check_shards(mut libs: Vec<ShardLib>) -> Result<Vec<ShardLib>> {
     let Some(first) = libs.first() else {
@@ -170,19 +213,12 @@ fn check_shards(mut libs: Vec<ShardLib>) -> Result<Vec<ShardLib>> {
     for lib in &libs[1..] {
         for field in SHARED_FIELDS {
             let (a, b) = (first.manifest.pointer(field), lib.manifest.pointer(field));
-            if a != b {
-                let show = |v: Option<&serde_json::Value>| {
-                    let s = v.map_or("none".to_string(), |v| v.to_string());
-                    s.chars().take(120).collect::<String>()
-                };
+            if let Some((key, a, b)) = first_difference(field, a, b) {
                 return Err(bad(
                     &lib.dir,
                     format!(
-                        "{} is {} here but {} in {}: shards of different builds \
+                        "{key} is {b} here but {a} in {}: shards of different builds \
                          (options, inputs or tool versions) are never merged",
-                        field.trim_start_matches('/'),
-                        show(b),
-                        show(a),
                         first.dir.display()
                     ),
                 ));

@@ -24,9 +24,7 @@ use crate::error::{Error, Result};
 use crate::library::schema::{MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX};
 use crate::library::scratch::{remove_stale, scratch_name, Scratch};
 
-/// Largest `manifest.json` read to decide whether a folder is a library, bytes (a
-/// manifest lists one hash per input: about 100 bytes per clip).
-pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
+pub use crate::library::manifest::MAX_MANIFEST_BYTES;
 
 /// Whether a JSON value has the expected type.
 type JsonTypeCheck = fn(&serde_json::Value) -> bool;
@@ -109,14 +107,7 @@ fn refused(out: &Path, why: impl std::fmt::Display) -> Error {
 /// [`MAX_MANIFEST_BYTES`]) has `schema` = `stancelib.library/…`, or every key of the
 /// manifests written before that key.
 pub fn is_library(dir: &Path) -> bool {
-    let path = dir.join(MANIFEST_FILE);
-    let small_file =
-        std::fs::metadata(&path).is_ok_and(|m| m.is_file() && m.len() <= MAX_MANIFEST_BYTES);
-    small_file
-        && std::fs::read_to_string(&path)
-            .ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-            .is_some_and(|m| manifest_says_library(&m))
+    crate::library::manifest::read_manifest(dir).is_ok_and(|m| manifest_says_library(&m))
 }
 
 /// Refuse a folder of tables `out` (`frames --out`) that holds a stancelib library

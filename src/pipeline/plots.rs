@@ -78,6 +78,7 @@ pub fn plot_stance(job: &StancePlotJob) -> anyhow::Result<StancePlotReport> {
 
 /// The data of a stance plot, with warnings.
 fn stance_plot(job: &StancePlotJob) -> anyhow::Result<(StancePlot, Vec<String>)> {
+    crate::library::provenance::check_layout(&job.lib)?;
     let lib = |name: &str| job.lib.join(name);
     let stances = read_force_stances(&lib(STANCES_FILE))
         .with_context(|| format!("library {}", job.lib.display()))?;

@@ -526,6 +526,8 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
     let map = jump_map(&pool, heights, speeds, &limits)
         .context("--heights × --speeds on this library")?;
     let elapsed = t0.elapsed().as_secs_f64();
+    // Every output's name is known (and fits a file name) before the first is written.
+    let per_character = character_figures(&q.out, &map, &pool);
     std::fs::create_dir_all(&q.out)
         .with_context(|| format!("cannot create {}", q.out.display()))?;
     let iou = map.agreement.iou();
@@ -554,7 +556,7 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         &q.out.join("jump_map.json"),
         &(serde_json::to_string_pretty(&summary)? + "\n"),
     )?;
-    map_figures(&q.out, &map, &pool)?;
+    map_figures(&q.out, &map, &pool, &per_character)?;
     let pair_answers = pair_answers(&map, &pool, &limits);
     if q.diagnostics {
         write_png(&q.out.join(JUMP_MAP_AGREEMENT_PNG), |p| {
@@ -630,8 +632,33 @@ fn pair_answers(
 /// The `--diagnostics` picture of `map jumps` in its output folder.
 pub const JUMP_MAP_AGREEMENT_PNG: &str = "jump_map_agreement.png";
 
-/// `jump_map.png`, and one `jump_map_<character>.png` each when the pool has several.
-fn map_figures(out: &Path, map: &JumpMap, pool: &[Prepared]) -> anyhow::Result<()> {
+/// The per-character pictures of a map: `(character_id, jump_map_<file_safe(id)>.png)`
+/// when the pool has several characters, none otherwise.
+fn character_figures(out: &Path, map: &JumpMap, pool: &[Prepared]) -> Vec<(String, PathBuf)> {
+    let characters: BTreeSet<&str> = map
+        .pairs
+        .iter()
+        .map(|p| pool[p.liftoff].stance.character_id.as_str())
+        .collect();
+    if characters.len() < 2 {
+        return Vec::new();
+    }
+    characters
+        .into_iter()
+        .map(|id| {
+            let file = out.join(format!("jump_map_{}.png", file_safe(id)));
+            (id.to_string(), file)
+        })
+        .collect()
+}
+
+/// `jump_map.png`, and the pictures of `per_character` ([`character_figures`]).
+fn map_figures(
+    out: &Path,
+    map: &JumpMap,
+    pool: &[Prepared],
+    per_character: &[(String, PathBuf)],
+) -> anyhow::Result<()> {
     let recorded = recorded_jumps(map, pool);
     let marks = |ids: Option<&str>| -> Vec<(f64, f64)> {
         recorded
@@ -643,26 +670,18 @@ fn map_figures(out: &Path, map: &JumpMap, pool: &[Prepared]) -> anyhow::Result<(
     write_png(&out.join("jump_map.png"), |p| {
         jump_map_png(p, map, "all characters", &marks(None))
     })?;
-    let characters: BTreeSet<&str> = map
-        .pairs
-        .iter()
-        .map(|p| pool[p.liftoff].stance.character_id.as_str())
-        .collect();
-    if characters.len() > 1 {
-        for id in &characters {
-            let mut one = map.clone();
-            one.pairs
-                .retain(|p| pool[p.liftoff].stance.character_id == *id);
-            one.agreement = one.pairs.iter().fold(Default::default(), |mut acc, p| {
-                acc.approx += p.agreement.approx;
-                acc.exact += p.agreement.exact;
-                acc.both += p.agreement.both;
-                acc.either += p.agreement.either;
-                acc
-            });
-            let file = out.join(format!("jump_map_{}.png", file_safe(id)));
-            write_png(&file, |p| jump_map_png(p, &one, id, &marks(Some(*id))))?;
-        }
+    for (id, file) in per_character {
+        let mut one = map.clone();
+        one.pairs
+            .retain(|p| pool[p.liftoff].stance.character_id == *id);
+        one.agreement = one.pairs.iter().fold(Default::default(), |mut acc, p| {
+            acc.approx += p.agreement.approx;
+            acc.exact += p.agreement.exact;
+            acc.both += p.agreement.both;
+            acc.either += p.agreement.either;
+            acc
+        });
+        write_png(file, |p| jump_map_png(p, &one, id, &marks(Some(id))))?;
     }
     Ok(())
 }
@@ -689,17 +708,55 @@ pub fn recorded_jumps(map: &JumpMap, pool: &[Prepared]) -> Vec<(String, (f64, f6
         .collect()
 }
 
-/// `id` with every character but ASCII letters, digits, `-` and `_` replaced by `_`.
-fn file_safe(id: &str) -> String {
-    id.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
+/// Longest part of a file name made from an id ([`file_safe`]), bytes: with its prefix
+/// and extension far below the 255 bytes of a file name on common file systems.
+pub const MAX_ID_FILE_BYTES: usize = 64;
+
+/// The part of a file name that stands for `id` (a character id): one name per id, never
+/// the same for two, never longer than [`MAX_ID_FILE_BYTES`].
+///
+/// # Model
+/// ```text
+/// ASCII letters, digits, '-', '_', '.'   as they are
+/// any other byte of the UTF-8 text       %XX (upper-case hex; '%' itself is %25)
+/// longer than MAX_ID_FILE_BYTES, or       the first bytes of that, then '~' and 16 hex
+/// the name of another output of the map   digits of the id's SHA-256
+/// ```
+/// The escaped text alone is injective, and it never holds `~` (`%7E`), so a cut name
+/// cannot equal a whole one. (Before, `a/b` and `a.b` both gave `a_b`, and a 300-character
+/// id a file name the system refused after four outputs were written.)
+///
+/// # Examples
+/// ```
+/// use stancelib::pipeline::queries::file_safe;
+/// assert_eq!(file_safe("sk-9f71a3e6fbd4"), "sk-9f71a3e6fbd4");
+/// assert_ne!(file_safe("a/b"), file_safe("a.b"));
+/// assert!(file_safe(&"x".repeat(300)).len() <= 64);
+/// ```
+pub fn file_safe(id: &str) -> String {
+    let mut out = String::with_capacity(id.len());
+    for b in id.bytes() {
+        if b.is_ascii_alphanumeric() || b"-_.".contains(&b) {
+            out.push(b as char);
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    let reserved = out == "agreement" || out == "pairs";
+    if out.len() <= MAX_ID_FILE_BYTES && !reserved {
+        return out;
+    }
+    use sha2::{Digest, Sha256};
+    let hash: String = Sha256::digest(id.as_bytes())[..8]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let mut cut = out.len().min(MAX_ID_FILE_BYTES - 1 - hash.len());
+    // Never keep half of a %XX.
+    if let Some(p) = out[..cut].rfind('%').filter(|&p| p + 3 > cut) {
+        cut = p;
+    }
+    format!("{}~{hash}", &out[..cut])
 }
 
 /// The `[queries]` stages of a pipeline file on the library `lib` just built, as typed

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::contacts::ContactOptions;
-use crate::error::{Error, Result};
+use crate::error::{echo, Error, Result};
 use crate::force_model::fit::{MAX_SAMPLES, MIN_SAMPLES};
 use crate::ingest::{IngestOptions, DEFAULT_MASS_KG};
 use crate::library::layout::Layout;
@@ -271,6 +271,16 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
         |key: &str, msg: String| Error::config(Some(path.to_path_buf()), key_line(text, key), msg);
     if p.inputs.is_empty() {
         return Err(bad("inputs", "inputs must list at least one glob".into()));
+    }
+    if p.inputs.len() > MAX_INPUT_PATTERNS {
+        let e = Error::limit(
+            "inputs",
+            "globs",
+            p.inputs.len() as f64,
+            MAX_INPUT_PATTERNS,
+            "MAX_INPUT_PATTERNS",
+        );
+        return Err(bad("inputs", e.to_string()));
     }
     check_common(path, text, p.mass_kg, p.unit.as_ref(), p.up_axis.as_deref())?;
     if let Some(a) = p.constraints.as_ref().and_then(|c| c.active_set) {
@@ -566,20 +576,48 @@ pub fn with_masses(mut o: IngestOptions, path: Option<&Path>) -> Result<IngestOp
     Ok(o)
 }
 
-/// Expand a pipeline's input globs (relative to the pipeline file's folder).
+/// Most globs of a pipeline's `inputs` (count). Each is expanded by listing folders, so
+/// the work grows with the globs times the files they list; a pipeline lists a few (those
+/// in `pipelines/` one or two). A list of 10⁶ repeats of one glob once held 723 MB of
+/// paths and was still expanding after 60 s. Repeated globs are expanded once, and a file
+/// matched by several globs is held once.
+pub const MAX_INPUT_PATTERNS: usize = 10_000;
+
+/// Expand a pipeline's input globs (relative to the pipeline file's folder): each
+/// distinct glob once, each file once, in the order first found.
 ///
 /// # Errors
-/// An invalid glob pattern, or a glob that matches nothing.
+/// An invalid glob pattern, a glob that matches nothing, or more than
+/// [`MAX_INPUT_PATTERNS`] globs.
 pub fn expand_inputs(pipeline_path: &Path, p: &PipelineFile) -> Result<Vec<PathBuf>> {
+    if p.inputs.len() > MAX_INPUT_PATTERNS {
+        let e = Error::limit(
+            "inputs",
+            "globs",
+            p.inputs.len() as f64,
+            MAX_INPUT_PATTERNS,
+            "MAX_INPUT_PATTERNS",
+        );
+        return Err(Error::config(
+            Some(pipeline_path.to_path_buf()),
+            None,
+            e.to_string(),
+        ));
+    }
     let mut out = Vec::new();
+    let mut seen_globs = std::collections::HashSet::new();
+    let mut seen_files = std::collections::HashSet::new();
     for g in &p.inputs {
+        if !seen_globs.insert(g.as_str()) {
+            continue;
+        }
         let pat = relative_to(pipeline_path, g);
         let pat_s = pat.to_string_lossy();
         let matches = glob::glob(&pat_s).map_err(|e| {
             Error::config(
                 Some(pipeline_path.to_path_buf()),
                 None,
-                format!("inputs: bad glob '{g}': {e}"),
+                format!("inputs: bad glob '{}': {e}", echo(g)),
             )
         })?;
         let found: Vec<PathBuf> = matches.filter_map(|m| m.ok()).collect();
@@ -587,10 +625,10 @@ pub fn expand_inputs(pipeline_path: &Path, p: &PipelineFile) -> Result<Vec<PathB
             return Err(Error::config(
                 Some(pipeline_path.to_path_buf()),
                 None,
-                format!("inputs: '{g}' matches nothing"),
+                format!("inputs: '{}' matches nothing", echo(g)),
             ));
         }
-        out.extend(found);
+        out.extend(found.into_iter().filter(|f| seen_files.insert(f.clone())));
     }
     Ok(out)
 }

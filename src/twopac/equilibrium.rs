@@ -52,6 +52,14 @@ pub const MAX_CONTACTS: usize = 64;
 pub const MAX_CONTACT_POINTS: usize = 4 * MAX_CONTACTS;
 /// Most COM states of one `equilibrium --points` table (rows), one LP each.
 pub const MAX_COM_STATES: usize = 1_000_000;
+/// Most contact-states of one `equilibrium` job: contacts × (COM states + the cells of
+/// the `--png` slice, [`crate::plot::equilibrium::DEFAULT_SLICE_CELLS`]², each of which
+/// may need its LP). One state's margin LP takes about 0.1–0.17 ms per contact on two
+/// cores (measured with 4, 16 and 64 contacts × 2,000 states: 0.83 s, 4.6 s, 21 s, the
+/// test profile, whose solver is built as in release), so the limit is about 3 minutes
+/// there. 64 contacts × 20,000 states once ran for more than 300 s, and 10⁶ states
+/// (within [`MAX_COM_STATES`]) for about 8 hours.
+pub const MAX_CONTACT_STATES: usize = 1_000_000;
 /// Force closure is declared when `max t s.t. G V β = 0, β ≥ t, t ≤ 1` exceeds this.
 pub const FORCE_CLOSURE_T: f64 = 0.5;
 

@@ -15,6 +15,7 @@ use crate::pipeline::queries::{query_kv, write_table};
 /// An unreadable library, an unknown `--stance` id (nothing is written), an unwritable
 /// output.
 pub fn run(a: ForcesArgs) -> anyhow::Result<Outcome> {
+    crate::library::provenance::check_layout(&a.lib)?;
     let table = a.lib.join(STANCES_FILE);
     let stances =
         read_force_stances(&table).with_context(|| format!("library {}", a.lib.display()))?;
