@@ -131,7 +131,7 @@ pub fn collect(
                         let other = &contact[1 - e];
                         ratio
                             .as_deref()
-                            .filter(|_| walking::supported(other, a.checked_sub(n_support), a))
+                            .filter(|_| walking::supported(other, a.saturating_sub(n_support), a))
                             .and_then(|r| {
                                 walking::touchdown(r, time_s, a, b, prev_end, kappa.touchdown)
                             })
@@ -144,7 +144,7 @@ pub fn collect(
                         let other = &contact[1 - e];
                         ratio
                             .as_deref()
-                            .filter(|_| walking::supported(other, Some(b), b + n_support))
+                            .filter(|_| walking::supported(other, b, b + n_support))
                             .and_then(|r| {
                                 walking::liftoff(r, time_s, a, b, next_start, kappa.liftoff)
                             })

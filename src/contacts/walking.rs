@@ -11,7 +11,8 @@
 //! liftoff: the frame k nearest the run's last frame b (at most REACH back, 0.05 s
 //!   forward) with R(k) ≤ κ_LO < R(k+1);  t_LO = t[k] + dt·(κ_LO − R(k))/(R(k+1) − R(k))
 //! applies to a touchdown (liftoff) of a foot when the other foot is in contact over the
-//!   MIN_SUPPORT before (after) the run's edge frame: a step into (out of) double support
+//!   MIN_SUPPORT before (after) the run's edge frame, or up to the clip's edge: a step
+//!   into (out of) double support
 //! κ_TD = 0.65, κ_LO = 0.75, V_min = 0.5 m/s, REACH = 0.15 s, MIN_SUPPORT = 0.1 s
 //! ```
 //! The planted foot is still and the body moves at `v_COM,h`; a swinging foot moves at
@@ -78,10 +79,7 @@ pub fn speed_ratio(points: &[PointTrack], com_speed_h: &[f64]) -> Vec<f64> {
         .iter()
         .enumerate()
         .map(|(k, vc)| {
-            let v = points
-                .iter()
-                .map(|p| p.v[k])
-                .fold(f64::INFINITY, f64::min);
+            let v = points.iter().map(|p| p.v[k]).fold(f64::INFINITY, f64::min);
             v / vc.abs().max(WALK_MIN_BODY_SPEED_MPS)
         })
         .collect()
@@ -92,13 +90,12 @@ fn frames_for(t: &[f64], s: f64) -> usize {
     ((s / dt).round() as usize).max(1)
 }
 
-/// The other foot supports the body on every frame of `from..=to` (inclusive, clamped to
-/// the clip): the gate of the walking rule. `None` bounds (outside the clip) fail.
-pub fn supported(other: &[bool], from: Option<usize>, to: usize) -> bool {
-    match from {
-        Some(from) if to < other.len() && from <= to => other[from..=to].iter().all(|&c| c),
-        _ => false,
-    }
+/// The other foot supports the body on every frame of `from..=to` (inclusive; `to` is
+/// clamped to the clip's last frame, so a clip that ends in support still counts): the
+/// gate of the walking rule.
+pub fn supported(other: &[bool], from: usize, to: usize) -> bool {
+    let to = to.min(other.len().saturating_sub(1));
+    from <= to && to < other.len() && other[from..=to].iter().all(|&c| c)
 }
 
 /// Frames of [`WALK_MIN_SUPPORT_S`] at frame times `t`.
@@ -110,8 +107,12 @@ pub fn min_support_frames(t: &[f64]) -> usize {
 /// ([`speed_ratio`]) nearest `a`, not before frame `lo` (after the foot's previous run);
 /// `None` when `r` does not cross within reach.
 pub fn touchdown(r: &[f64], t: &[f64], a: usize, b: usize, lo: usize, kappa: f64) -> Option<f64> {
-    let lo = lo.max(1).max(a.saturating_sub(frames_for(t, EVENT_MAX_SHIFT_S)));
-    let hi = b.min(a + frames_for(t, WALK_EVENT_REACH_S)).min(r.len() - 1);
+    let lo = lo
+        .max(1)
+        .max(a.saturating_sub(frames_for(t, EVENT_MAX_SHIFT_S)));
+    let hi = b
+        .min(a + frames_for(t, WALK_EVENT_REACH_S))
+        .min(r.len() - 1);
     let mut k = a.min(hi);
     while k > lo && r[k - 1] <= kappa {
         k -= 1;
@@ -195,9 +196,10 @@ mod tests {
     #[test]
     fn the_gate_needs_support_over_the_whole_interval() {
         let other = [true, true, true, false, true];
-        assert!(supported(&other, Some(0), 2));
-        assert!(!supported(&other, Some(1), 3));
-        assert!(!supported(&other, None, 2));
-        assert!(!supported(&other, Some(3), 5));
+        assert!(supported(&other, 0, 2));
+        assert!(!supported(&other, 1, 3));
+        assert!(supported(&other, 4, 9)); // clamped to the clip's end
+        assert!(!supported(&other, 3, 9));
+        assert!(!supported(&[], 0, 0));
     }
 }
