@@ -13,6 +13,7 @@ pub mod info;
 pub mod integrity;
 pub mod kinematics;
 pub mod layout;
+pub mod per_contact;
 pub mod plates;
 pub mod provenance;
 #[doc(hidden)]
