@@ -29,7 +29,7 @@
 //! total. Two departures, each measured against the plates of three walks (per foot, BW
 //! RMSE): the vertical and lateral shares are a linear share of the *current* total
 //! (measured: 0.02–0.06 BW vertical, against 0.03–0.07 for Ren's `F(t_hs)·shape(s)` and
-//! 0.12–0.20 for a Gaussian decay), which keeps both feet's vertical force non-negative;
+//! 0.15–0.20 for a Gaussian decay), which keeps both feet's vertical force non-negative;
 //! the fore-aft share has a propulsive hump: the trailing foot keeps pushing harder for
 //! the first half of double support (1.3–1.5 F_fa(t_hs) at s ≈ 0.4 on the plates) while
 //! the leading foot brakes. `A` was chosen by leaving one walk out (2.0–3.5; 2.5 on all
