@@ -308,9 +308,9 @@ pub fn per_contact_csv(r: &ContactRows) -> String {
     s
 }
 
-/// OpenSim axes (Y up) of a Z-up world vector: `(x, z, −y)`.
+/// OpenSim axes (Y up) of a Z-up world vector: `(x, z, −y)` (a zero stays `0`, not `-0`).
 pub fn opensim_axes(v: V3) -> V3 {
-    [v[0], v[2], -v[1]]
+    [v[0] + 0.0, v[2] + 0.0, 0.0 - v[1]]
 }
 
 /// The rows as an OpenSim `.mot` file named `name` (see the module docs).
@@ -412,6 +412,7 @@ mod tests {
         // Force (1, 2, 3) Z up → (1, 3, −2) Y up; COP (0.5, −0.25, 0) → (0.5, 0, 0.25).
         assert_eq!(&row[..7], &[0.03, 1.0, 3.0, -2.0, 0.5, 0.0, 0.25]);
         assert!(row[7..].iter().all(|v| *v == 0.0));
+        assert!(!m.contains("-0.000000"), "{m}");
     }
 
     #[test]
