@@ -531,11 +531,13 @@ fn docs_tables_are_the_written_schemas() {
     let documented = documented_columns(&docs_page("tables.md"));
     let demo = Demo::build();
     // Outputs the demo job does not write: `joints.parquet` (needs `--joints`), a jump
-    // query, the forces and an edit's plan, written beside the demo library.
+    // query, the forces (per stance and per contact) and an edit's plan, written beside
+    // the demo library.
     for c in [
         "stancelib frames fixtures/bvh/run_120hz_m_yup.bvh --joints --out joints",
         "stancelib query jump --lib out/demo --height 1.2 --distance 0 --out q/jump.parquet",
         "stancelib forces --lib out/demo --out q/forces.parquet",
+        "stancelib forces --lib out/demo --per-contact --clip run_120hz_m_yup --out q/per_contact.parquet",
         "stancelib edit jump --lib out/demo --out q/edit.bvh",
     ] {
         let (code, out, err) = demo.sh(c);
@@ -569,6 +571,7 @@ fn docs_tables_are_the_written_schemas() {
         ),
         ("jump.parquet", q.join("jump.parquet")),
         ("forces.parquet", q.join("forces.parquet")),
+        ("per_contact.parquet", q.join("per_contact.parquet")),
         ("plan.parquet", q.join("edit.plan.parquet")),
     ];
     for (file, path) in &files {

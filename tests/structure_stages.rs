@@ -72,12 +72,14 @@ fn contact_stage_entry_points_reproduce_the_ingest_contacts() {
     let mut timeline = contacts::detect(&tracks, &c);
     let vz: Vec<f64> = frames.com_v.iter().map(|v| v[2]).collect();
     let az: Vec<f64> = frames.com_a.iter().map(|a| a[2]).collect();
+    let vh: Vec<f64> = frames.com_v.iter().map(|v| v[0].hypot(v[1])).collect();
     let motion = ClipMotion {
         frame: &frames.frame,
         time_s: &frames.time_s,
         dt: summary.frame_time_s,
         com: &frames.com,
         com_vz: &vz,
+        com_speed_h: &vh,
         com_az: &az,
         facing: &frames.facing,
     };

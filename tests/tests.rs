@@ -28,6 +28,9 @@
 //! - `force_truth`: Stage A force models of the fixtures against the true applied force;
 //!   the force model's Parquet round trip.
 //! - `forceplate_stances`: stance force models against the force plates (per stance, per foot).
+//! - `per_contact`: issue 39 item 3 — walking contact timing against the plates (ratios
+//!   chosen leaving one walk out), `forces --per-contact` per foot against each foot's
+//!   plate on the walks, its Parquet/CSV/`.mot` outputs and refusals.
 //!
 //! # Library: tables, readers, scale
 //! - `golden`: issue 13 — the demo job's outputs equal `fixtures/golden/demo/` (library
@@ -132,6 +135,7 @@ mod real_data;
 // Stances and force models
 mod force_truth;
 mod forceplate_stances;
+mod per_contact;
 mod stances;
 mod stances_truth;
 // Library

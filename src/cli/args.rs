@@ -921,11 +921,56 @@ pub struct ForcesArgs {
     #[arg(long)]
     pub lib: PathBuf,
     /// A stance id (`<clip>:<label>:<first frame>`); repeat for several (default: all).
+    /// With `--per-contact`: one stance, whose frames are written.
     #[arg(long = "stance")]
     pub stances: Vec<String>,
-    /// Output Parquet file.
+    /// Per contact instead of the stance models: each foot's (and hand's) share of the
+    /// clip's total force m(a + g) and its centre of pressure, frame by frame (needs one
+    /// `--clip` or one `--stance`).
+    #[arg(long = "per-contact")]
+    pub per_contact: bool,
+    /// With `--per-contact`: every frame of this clip (a name `stancelib list` prints).
+    #[arg(long, conflicts_with = "stances")]
+    pub clip: Option<String>,
+    /// Output format: `parquet`, `csv` or `mot` (OpenSim ground reactions, Y up); `csv` and
+    /// `mot` need `--per-contact` (default: from the `--out` extension, else parquet).
+    #[arg(long, value_enum)]
+    pub format: Option<ForcesFormat>,
+    /// Output file.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// `stancelib forces --format`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ForcesFormat {
+    /// A Parquet table.
+    Parquet,
+    /// CSV text with a header.
+    Csv,
+    /// OpenSim `.mot` ground-reaction storage.
+    Mot,
+}
+
+impl ForcesFormat {
+    /// The format a file extension names (`parquet`, `csv`, `mot`).
+    pub fn from_extension(path: &std::path::Path) -> Option<ForcesFormat> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "parquet" => Some(ForcesFormat::Parquet),
+            "csv" => Some(ForcesFormat::Csv),
+            "mot" => Some(ForcesFormat::Mot),
+            _ => None,
+        }
+    }
+
+    /// Its name, as `--format` takes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ForcesFormat::Parquet => "parquet",
+            ForcesFormat::Csv => "csv",
+            ForcesFormat::Mot => "mot",
+        }
+    }
 }
 
 /// `stancelib plot stance`.

@@ -5,7 +5,9 @@
 //! ```text
 //! run a..b:  t_TD = t[a] − dt/2 (null at the first kept frame), t_LO = t[b] + dt/2 (null at the last)
 //!            td_time, lo_time: feet, sub-frame times (contacts::timing), or the touchdown
-//!            of a landing found from the foot's motion (contacts::landing); hands, t_TD and t_LO
+//!            of a landing found from the foot's motion (contacts::landing), or, for a step
+//!            into or out of the other foot's support, the walking rule (contacts::walking);
+//!            hands, t_TD and t_LO
 //! origin    = mean of the effector's contact points over the run
 //! yaw       = atan2 of the mean horizontal ankle→toe (wrist→MET3) direction; facing from the
 //!             hips when that is vertical
@@ -16,6 +18,7 @@
 //! ```
 
 use super::timeline::{ContactTimeline, ContactTracks};
+use super::walking::{self, WalkRatios};
 use super::{runs, timing, ClipMotion, EFFECTORS};
 use crate::math::stats::median;
 use crate::math::v3::V3;
@@ -67,8 +70,11 @@ pub fn collect(
     let (points, ground_z, dt) = (&tracks.points, &tracks.ground_z, tracks.dt);
     let (facing, frame, time_s) = (motion.facing, motion.frame, motion.time_s);
     let n = frame.len();
+    let n_support = walking::min_support_frames(time_s);
+    let kappa = WalkRatios::default();
     let mut out = Vec::new();
     for e in 0..4 {
+        let ratio = (e < 2).then(|| walking::speed_ratio(&tracks.tracks[e], motion.com_speed_h));
         for (a, b) in runs(&contact[e]) {
             let pts = &points[e];
             let count = ((b - a + 1) * pts.len().max(1)) as f64;
@@ -122,12 +128,28 @@ pub fn collect(
                 td_time_s: (a > 0).then(|| match (timeline.landing_s[e][a], e < 2) {
                     (Some(t), _) => t,
                     (None, true) if !own.is_empty() => {
-                        timing::touchdown(own, time_s, a, b, prev_end)
+                        let other = &contact[1 - e];
+                        ratio
+                            .as_deref()
+                            .filter(|_| walking::supported(other, a.saturating_sub(n_support), a))
+                            .and_then(|r| {
+                                walking::touchdown(r, time_s, a, b, prev_end, kappa.touchdown)
+                            })
+                            .unwrap_or_else(|| timing::touchdown(own, time_s, a, b, prev_end))
                     }
                     _ => time_s[a] - dt / 2.0,
                 }),
                 lo_time_s: (b + 1 < n).then(|| match e < 2 && !own.is_empty() {
-                    true => timing::liftoff(own, time_s, a, b, next_start),
+                    true => {
+                        let other = &contact[1 - e];
+                        ratio
+                            .as_deref()
+                            .filter(|_| walking::supported(other, b, b + n_support))
+                            .and_then(|r| {
+                                walking::liftoff(r, time_s, a, b, next_start, kappa.liftoff)
+                            })
+                            .unwrap_or_else(|| timing::liftoff(own, time_s, a, b, next_start))
+                    }
                     false => time_s[b] + dt / 2.0,
                 }),
                 speed_led,

@@ -264,6 +264,7 @@ mod tests {
             dt,
             com: &com,
             com_vz: &zero,
+            com_speed_h: &zero,
             com_az: &com_az,
             facing: &facing,
         };

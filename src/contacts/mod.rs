@@ -4,7 +4,8 @@
 //! # Model
 //! ```text
 //! EffectorPoints ─ tracks ─▶ ContactTracks ─ detect ─▶ ContactTimeline
-//!     ─ runs_and_flights ─▶ contact runs (contact_runs::collect, sub-frame events: timing)
+//!     ─ runs_and_flights ─▶ contact runs (contact_runs::collect, sub-frame events: timing;
+//!                           steps into and out of double support: walking)
 //!                           landings of estimated toe tips from the foot's motion (landing)
 //!                           physics cross-check (support::cross_check, speed-led rule)
 //!                           hidden flights of jogs (hidden_flight)
@@ -28,6 +29,7 @@ pub mod options;
 pub mod support;
 pub mod timeline;
 pub mod timing;
+pub mod walking;
 
 pub use contact_runs::ContactRun;
 pub use flight::{flights, Flight};
@@ -50,6 +52,9 @@ pub struct ClipMotion<'a> {
     pub com: &'a [V3],
     /// SG vertical COM velocity, m/s.
     pub com_vz: &'a [f64],
+    /// SG horizontal COM speed `|(v_x, v_y)|`, m/s (the walking rule's reference,
+    /// [`walking`]).
+    pub com_speed_h: &'a [f64],
     /// SG vertical COM acceleration, m/s² (the hidden-flight rule's force).
     pub com_az: &'a [f64],
     /// Horizontal facing direction from the hips (unit, or zero).

@@ -353,6 +353,7 @@ mod tests {
             dt,
             com: &com,
             com_vz: &vz,
+            com_speed_h: &vz,
             com_az: &com_az,
             facing: &facing,
         };

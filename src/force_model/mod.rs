@@ -46,6 +46,7 @@ pub mod export;
 pub mod fit;
 pub mod leg_line;
 pub mod model;
+pub mod per_contact;
 pub mod ratio;
 
 pub use fit::{fit_axis, fit_stage_a, j_cap, k_max, FitWorkspace, StanceForce};

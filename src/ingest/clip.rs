@@ -70,12 +70,14 @@ pub(super) fn run(
     let mut timeline = contacts::detect(&tracks, c);
     let vz: Vec<f64> = com_v.iter().map(|v| v[2]).collect();
     let az: Vec<f64> = com_a.iter().map(|a| a[2]).collect();
+    let vh: Vec<f64> = com_v.iter().map(|v| v[0].hypot(v[1])).collect();
     let motion = ClipMotion {
         frame: &frame,
         time_s: &time_s,
         dt,
         com: &com_pos,
         com_vz: &vz,
+        com_speed_h: &vh,
         com_az: &az,
         facing: &fwd,
     };

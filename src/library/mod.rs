@@ -15,6 +15,7 @@ pub mod integrity;
 pub mod kinematics;
 pub mod layout;
 pub mod manifest;
+pub mod per_contact;
 pub mod plates;
 pub mod provenance;
 #[doc(hidden)]
