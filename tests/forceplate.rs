@@ -15,7 +15,8 @@ const CLIPS: [&str; 2] = ["hamner_s02_run_4ms", "opencap_s4_DJ1_dropjump"];
 /// g used by the data (meta.json `g_mps2`) and by the flight fits, m/s².
 const G: f64 = 9.81;
 
-fn pearson(a: &[f64], b: &[f64]) -> f64 {
+/// Pearson's correlation coefficient of two equally long series.
+pub fn pearson(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len() as f64;
     let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
     let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();

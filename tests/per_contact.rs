@@ -24,6 +24,7 @@ use stancelib::ingest::IngestOptions;
 use stancelib::library::read::Table;
 use stancelib::math::savgol::{window_for_rate, SavGol};
 
+use crate::forceplate::pearson;
 use crate::util::{self, outln};
 
 /// The walks: (folder, synthetic: its forces are the model's own, an exact oracle).
@@ -264,15 +265,6 @@ fn walking_events_match_the_plates_leaving_one_walk_out() {
     }
     print!("{out}");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-}
-
-fn pearson(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt()
 }
 
 fn rmse(a: &[f64], b: &[f64]) -> f64 {

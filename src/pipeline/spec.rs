@@ -272,14 +272,7 @@ pub fn parse_pipeline(path: &Path, text: &str) -> Result<PipelineFile> {
     if p.inputs.is_empty() {
         return Err(bad("inputs", "inputs must list at least one glob".into()));
     }
-    if p.inputs.len() > MAX_INPUT_PATTERNS {
-        let e = Error::limit(
-            "inputs",
-            "globs",
-            p.inputs.len() as f64,
-            MAX_INPUT_PATTERNS,
-            "MAX_INPUT_PATTERNS",
-        );
+    if let Some(e) = too_many_inputs(&p) {
         return Err(bad("inputs", e.to_string()));
     }
     check_common(path, text, p.mass_kg, p.unit.as_ref(), p.up_axis.as_deref())?;
@@ -583,6 +576,19 @@ pub fn with_masses(mut o: IngestOptions, path: Option<&Path>) -> Result<IngestOp
 /// matched by several globs is held once.
 pub const MAX_INPUT_PATTERNS: usize = 10_000;
 
+/// The limit error when the pipeline lists more than [`MAX_INPUT_PATTERNS`] globs.
+fn too_many_inputs(p: &PipelineFile) -> Option<Error> {
+    (p.inputs.len() > MAX_INPUT_PATTERNS).then(|| {
+        Error::limit(
+            "inputs",
+            "globs",
+            p.inputs.len() as f64,
+            MAX_INPUT_PATTERNS,
+            "MAX_INPUT_PATTERNS",
+        )
+    })
+}
+
 /// Expand a pipeline's input globs (relative to the pipeline file's folder): each
 /// distinct glob once, each file once, in the order first found.
 ///
@@ -590,14 +596,7 @@ pub const MAX_INPUT_PATTERNS: usize = 10_000;
 /// An invalid glob pattern, a glob that matches nothing, or more than
 /// [`MAX_INPUT_PATTERNS`] globs.
 pub fn expand_inputs(pipeline_path: &Path, p: &PipelineFile) -> Result<Vec<PathBuf>> {
-    if p.inputs.len() > MAX_INPUT_PATTERNS {
-        let e = Error::limit(
-            "inputs",
-            "globs",
-            p.inputs.len() as f64,
-            MAX_INPUT_PATTERNS,
-            "MAX_INPUT_PATTERNS",
-        );
+    if let Some(e) = too_many_inputs(p) {
         return Err(Error::config(
             Some(pipeline_path.to_path_buf()),
             None,
