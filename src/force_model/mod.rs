@@ -36,7 +36,7 @@
 //! let eye = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 //! let mut ws = FitWorkspace::new(64);
 //! let fm = fit_stage_a(&mut ws, &acc, t_td, dt, eye, m, 30, &FitOptions::default()).unwrap();
-//! assert_eq!(fm.axes[2].harmonics, vec![1]);
+//! assert_eq!(fm.axes[2].harmonics, vec![1.0]);
 //! assert!((fm.j()[2] - 700.0 * dt / m).abs() < 1e-9); // J_v = c0 Δt / m
 //! assert!(fm.support_ok() && fm.unilateral_ok(&fm.grid()));
 //! ```
