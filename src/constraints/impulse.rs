@@ -194,7 +194,7 @@ pub fn moment_integral(model: &ForceModel, ctx: &StanceContext, a: usize, b: usi
 /// For integer harmonics the `cos·cos` terms cancel between `∫ r_a f_b` and `∫ r_b f_a`
 /// (the oscillating part of `r_a` is `−κ/Ω²` times that of `f_a`, and only equal
 /// frequencies pair); half-range cosines of different frequencies do not cancel, which
-/// [`integral_r_f`] includes.
+/// `integral_r_f` includes.
 pub fn h0_closed_form(model: &ForceModel, ctx: &StanceContext) -> [f64; 3] {
     let [h, p, v] = [0, 1, 2].map(|axis| AxisForm::new(model, ctx, axis));
     let dt = model.dt_s;

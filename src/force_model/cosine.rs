@@ -72,7 +72,7 @@ pub fn half_cosine(k: usize, tau: f64) -> f64 {
 pub fn double_integral(k: usize) -> f64 {
     match k {
         0 => 0.5,
-        _ if k % 2 == 0 => 0.0,
+        _ if k.is_multiple_of(2) => 0.0,
         _ => 2.0 / (PI * k as f64).powi(2),
     }
 }
