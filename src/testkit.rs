@@ -47,13 +47,19 @@ pub(crate) struct Harmonics {
     pub(crate) terms: u32,
     /// Highest harmonic number.
     pub(crate) max_j: u32,
+    /// Every harmonic `j − ½` instead of `j` (the half-range cosines of
+    /// `force_model::cosine`), from the same random draws.
+    pub(crate) halves: bool,
 }
 
 /// A random axis: DC `c0` (N) plus cosines of amplitude up to `amp` (N), phases in
 /// `[−π, π)`.
 pub(crate) fn random_axis(rng: &mut Rng, c0: f64, amp: f64, h: Harmonics) -> AxisModel {
     let n = rng.int(1, h.terms) as usize;
-    let harmonics: Vec<u32> = (0..n).map(|_| rng.int(1, h.max_j)).collect();
+    let half = if h.halves { 0.5 } else { 0.0 };
+    let harmonics: Vec<f64> = (0..n)
+        .map(|_| f64::from(rng.int(1, h.max_j)) - half)
+        .collect();
     AxisModel {
         c0,
         amps: (0..n).map(|_| rng.uniform(0.0, amp)).collect(),
@@ -73,7 +79,7 @@ pub(crate) fn bell_model(rng: &mut Rng, ringing: f64, h: Harmonics) -> ForceMode
     let weight = mass_kg * GRAVITY;
     let bell = rng.uniform(1.0, 3.0) * weight;
     let mut v = random_axis(rng, bell, ringing * weight, h);
-    v.harmonics.push(1);
+    v.harmonics.push(1.0);
     v.amps.push(bell);
     v.phases.push(PI);
     let h_dc = rng.uniform(-0.3, 0.3) * weight;

@@ -20,14 +20,16 @@
 //! f_b(τ) = d_b + Σ_l c_l cos(Ω_l τ + φ_l)                                          (N)
 //! ```
 //!
-//! For `Ω = 2πj`, `j ≥ 1` integer, every product integrates exactly:
+//! For `Ω = 2πj` (`j` whole or half cycles per stance) every product integrates in closed
+//! form, with `C_n(j, φ) = ∫₀¹ τⁿ cos(Ωτ+φ) dτ` ([`basis::harmonic_power_moments`]) and the
+//! product-to-sum identity ([`basis::product_integral`]):
 //!
 //! ```text
-//! ∫₀¹ cos(Ωτ+φ) dτ = 0,   ∫₀¹ τ cos(Ωτ+φ) dτ = sin φ/Ω,   ∫₀¹ τ² cos(Ωτ+φ) dτ = sin φ/Ω + 2 cos φ/Ω²
-//! ∫₀¹ cos(Ω_kτ+φ_k) cos(Ω_lτ+φ_l) dτ = ½ cos(φ_k − φ_l) if j_k = j_l, else 0
-//! ∫₀¹ r_a f_b dτ = d_b (p0_a + p1_a/2 + p2_a/3) + Σ_l c_l (p1_a sin φ_l/Ω_l + p2_a (sin φ_l/Ω_l + 2 cos φ_l/Ω_l²))
-//!                 + Σ_{k,l: j_k = j_l} ρ_k c_l ½ cos(φ_k − φ_l)
+//! ∫₀¹ r_a f_b dτ = d_b (p0_a + p1_a/2 + p2_a/3) + Σ_l c_l (p0_a C_0,l + p1_a C_1,l + p2_a C_2,l)
+//!                 + d_b Σ_k ρ_k C_0,k + Σ_{k,l} ρ_k c_l ∫₀¹ cos(Ω_kτ+φ_k) cos(Ω_lτ+φ_l) dτ
 //! ```
+//! For integer `j`: `C_0 = 0`, `C_1 = sin φ/Ω`, `C_2 = sin φ/Ω + 2 cos φ/Ω²`, and the
+//! cosine products vanish unless `j_k = j_l` (then `½ cos(φ_k − φ_l)`): the paper's case.
 //!
 //! `H` is affine in `u = (cp_h, cp_p)`: `H(u) = A u + b` with
 //! `A = [[0, I_v], [−I_v, 0], [I_p, −I_h]]` (rows h, p, v) and `b = (0, 0, −z_TD) × I − H_0`.
@@ -45,12 +47,12 @@ use super::tables::dc_term;
 use super::StanceContext;
 use crate::force_model::{basis, ForceModel, GRAVITY};
 pub(crate) use crate::math::v3::cross;
-use std::f64::consts::TAU;
-
-/// One cosine term of an axis: `Ω`, amplitude (N), `cos φ`, `sin φ`.
+/// One cosine term of an axis: `Ω`, amplitude (N), `cos φ`, `sin φ`, and its moments
+/// `C_0, C_1, C_2` (`C_n = ∫₀¹ τⁿ cos(Ωτ+φ) dτ`).
 #[derive(Debug, Clone, Copy)]
 struct Term {
-    j: u32,
+    j: f64,
+    c: [f64; 3],
     phi: f64,
     omega: f64,
     amp: f64,
@@ -84,10 +86,12 @@ impl AxisForm {
         let terms: Vec<Term> = super::tables::harmonic_terms(model, axis)
             .map(|(j, amp, phi)| {
                 let (sin_phi, cos_phi) = phi.sin_cos();
+                let m = basis::harmonic_power_moments(j, phi, 2);
                 Term {
                     j,
+                    c: [m[0], m[1], m[2]],
                     phi,
-                    omega: TAU * f64::from(j),
+                    omega: basis::omega_of(j),
                     amp,
                     cos_phi,
                     sin_phi,
@@ -127,15 +131,23 @@ fn integral_r_f(ra: &AxisForm, fb: &AxisForm) -> f64 {
     let [p0, p1, p2] = ra.p;
     let mut sum = fb.d * (p0 + p1 / 2.0 + p2 / 3.0);
     for l in &fb.terms {
-        let m1 = l.sin_phi / l.omega;
-        let m2 = m1 + 2.0 * l.cos_phi / (l.omega * l.omega);
-        sum += l.amp * (p1 * m1 + p2 * m2);
+        sum += l.amp * (p0 * l.c[0] + p1 * l.c[1] + p2 * l.c[2]);
     }
     for k in &ra.terms {
         let rho = -ra.kappa * k.amp / (k.omega * k.omega);
-        for l in fb.terms.iter().filter(|l| l.j == k.j) {
-            let cos_diff = k.cos_phi * l.cos_phi + k.sin_phi * l.sin_phi;
-            sum += 0.5 * rho * l.amp * cos_diff;
+        sum += rho * fb.d * k.c[0];
+        for l in &fb.terms {
+            let both_whole = k.j.fract() == 0.0 && l.j.fract() == 0.0;
+            let product = if both_whole {
+                // The paper's integer harmonics: orthogonal unless equal.
+                if l.j != k.j {
+                    continue;
+                }
+                0.5 * (k.cos_phi * l.cos_phi + k.sin_phi * l.sin_phi)
+            } else {
+                basis::product_integral(k.j, k.phi, l.j, l.phi)
+            };
+            sum += rho * l.amp * product;
         }
     }
     if !(ra.f_poly.is_empty() && fb.f_poly.is_empty()) {
@@ -179,8 +191,10 @@ pub fn moment_integral(model: &ForceModel, ctx: &StanceContext, a: usize, b: usi
 
 /// `H_0 = Δt ∫₀¹ r(τ) × f(τ) dτ` with β = 1, closed form, N·m·s.
 ///
-/// The `cos·cos` terms cancel between `∫ r_a f_b` and `∫ r_b f_a` (the oscillating part of
-/// `r_a` is `−κ/Ω²` times that of `f_a`), so only the polynomial × cosine terms remain.
+/// For integer harmonics the `cos·cos` terms cancel between `∫ r_a f_b` and `∫ r_b f_a`
+/// (the oscillating part of `r_a` is `−κ/Ω²` times that of `f_a`, and only equal
+/// frequencies pair); half-range cosines of different frequencies do not cancel, which
+/// `integral_r_f` includes.
 pub fn h0_closed_form(model: &ForceModel, ctx: &StanceContext) -> [f64; 3] {
     let [h, p, v] = [0, 1, 2].map(|axis| AxisForm::new(model, ctx, axis));
     let dt = model.dt_s;

@@ -5,7 +5,7 @@
 //! Per stance axis `a ∈ {h, p, v}`, on the grid `τ_k = k/(N_s − 1)` of §4.3:
 //!
 //! ```text
-//! f_a(τ) = d_a + Σ_i c_i cos(Ω_i τ + φ_i) + P_a(τ),   Ω_i = 2π j_i,  j_i ≥ 1    (N)
+//! f_a(τ) = d_a + Σ_i c_i cos(Ω_i τ + φ_i) + P_a(τ),   Ω_i = 2π j_i,  j_i ≥ ½    (N)
 //! d_a    = c0_a + Σ_{i: j_i = 0} c_i cos φ_i                                   (N)
 //! S_a(τ) = κ F2_a(τ)                                                          (m)
 //!        = κ [q0 + q1 τ + q2 τ² − Σ_i (c_i/Ω_i²) cos(Ω_i τ + φ_i)]
@@ -13,13 +13,15 @@
 //! κ = Δt²/m (s²/kg),  q0 = Σ c_i cos φ_i/Ω_i²,  q1 = −Σ c_i sin φ_i/Ω_i,  q2 = d_a/2
 //! ```
 //!
-//! `f_a` and `S_a` share the one cosine per harmonic and grid point. On the uniform grid
-//! the angle is `Ω_i τ_k + φ_i = 2π (j_i k mod (N_s − 1))/(N_s − 1) + φ_i`, so
+//! `f_a` and `S_a` share the one cosine per harmonic and grid point. Harmonics are whole
+//! or half cycles per stance (`2j_i` an integer), so on the uniform grid the angle is
+//! `Ω_i τ_k + φ_i = 2π (2j_i k mod P)/P + φ_i` with `P = 2(N_s − 1)`, and
 //!
 //! ```text
-//! cos(Ω_i τ_k + φ_i) = cos φ_i · C[m] − sin φ_i · S[m],   m = j_i k mod (N_s − 1)
-//! C[m] = cos(2π m/(N_s − 1)),  S[m] = sin(2π m/(N_s − 1))
+//! cos(Ω_i τ_k + φ_i) = cos φ_i · C[m] − sin φ_i · S[m],   m = 2j_i k mod P
+//! C[m] = cos(2π m/P),  S[m] = sin(2π m/P)
 //! ```
+//! (A harmonic that is not a multiple of ½, which no fit writes, is evaluated directly.)
 //!
 //! with the unit-circle table `C`, `S` built once per grid size and kept across stances: no
 //! trigonometric call per grid point or per stance beyond `sin_cos φ_i` (error ≈ 1 ulp).
@@ -47,7 +49,7 @@ pub struct SampledTables {
     pub max_f_v: f64,
     /// `f_v(τ_k) ≥ −0.05 · max f_v` at every grid point (§4.3); false if any is NaN.
     pub unilateral_ok: bool,
-    /// `(cos, sin)` of `2π m/(N_s − 1)`, `m = 0 … N_s − 2`, for the last grid size.
+    /// `(cos, sin)` of `2π m/P`, `P = 2(N_s − 1)`, `m = 0 … P − 1`, for the last grid size.
     unit_circle: Vec<(f64, f64)>,
 }
 
@@ -77,15 +79,17 @@ impl SampledTables {
     /// when the grid size is unchanged).
     pub fn rebuild(&mut self, model: &ForceModel) {
         let n = model.grid_len();
-        let period = n.saturating_sub(1);
-        let last = period as f64;
+        let last = n.saturating_sub(1) as f64;
+        // Half steps: m/P = (m/2)/(N_s − 1); doubling is exact in binary, so the whole
+        // steps' values equal those of a table over N_s − 1.
+        let period = 2 * n.saturating_sub(1);
         self.tau.clear();
         self.tau.extend((0..n).map(|k| k as f64 / last));
         if self.unit_circle.len() != period {
             self.unit_circle.clear();
             self.unit_circle.extend(
                 (0..period)
-                    .map(|m| (TAU * m as f64 / last).sin_cos())
+                    .map(|m| (TAU * m as f64 / (2.0 * last)).sin_cos())
                     .map(|(s, c)| (c, s)),
             );
         }
@@ -97,7 +101,7 @@ impl SampledTables {
             let d = dc_term(model, axis);
             let (mut q0, mut q1) = (0.0, 0.0);
             for (j, c, phi) in harmonic_terms(model, axis) {
-                let omega = TAU * f64::from(j);
+                let omega = basis::omega_of(j);
                 let (sin_phi, cos_phi) = phi.sin_cos();
                 q0 += c * cos_phi / (omega * omega);
                 q1 -= c * sin_phi / omega;
@@ -108,7 +112,7 @@ impl SampledTables {
                 s.push(kappa * (q0 + t * (q1 + t * q2)));
             }
             for (j, c, phi) in harmonic_terms(model, axis) {
-                let omega = TAU * f64::from(j);
+                let omega = basis::omega_of(j);
                 let c_s = -kappa * c / (omega * omega);
                 let (sin_phi, cos_phi) = phi.sin_cos();
                 if period == 0 {
@@ -118,7 +122,17 @@ impl SampledTables {
                     }
                     continue;
                 }
-                let step = usize::try_from(j).map_or(0, |j| j % period);
+                let twice = 2.0 * j;
+                if twice.fract() != 0.0 || !twice.is_finite() || twice < 0.0 {
+                    for ((fk, sk), &t) in f.iter_mut().zip(s.iter_mut()).zip(&self.tau) {
+                        let cos_angle = (omega * t + phi).cos();
+                        *fk += c * cos_angle;
+                        *sk += c_s * cos_angle;
+                    }
+                    continue;
+                }
+                // 2j < 2⁵³ here (finite and whole), so the cast is exact.
+                let step = (twice as u64 % period as u64) as usize;
                 let mut m = 0usize;
                 for (fk, sk) in f.iter_mut().zip(s.iter_mut()) {
                     let (cos_m, sin_m) = self.unit_circle.get(m).copied().unwrap_or((1.0, 0.0));
@@ -193,17 +207,17 @@ pub(crate) fn dc_term(model: &ForceModel, axis: usize) -> f64 {
         + ax.harmonics
             .iter()
             .zip(ax.amps.iter().zip(&ax.phases))
-            .filter(|(&j, _)| j == 0)
+            .filter(|(&j, _)| j == 0.0)
             .map(|(_, (&c, &phi))| c * phi.cos())
             .sum::<f64>()
 }
 
-/// The `(j, c, φ)` terms of axis `axis` with `j ≥ 1` (lists of unequal length are cut to the
-/// shortest).
+/// The `(j, c, φ)` terms of axis `axis` with `j ≠ 0` (cycles per stance; lists of unequal
+/// length are cut to the shortest).
 pub(crate) fn harmonic_terms(
     model: &ForceModel,
     axis: usize,
-) -> impl Iterator<Item = (u32, f64, f64)> + '_ {
+) -> impl Iterator<Item = (f64, f64, f64)> + '_ {
     model
         .axes
         .get(axis)
@@ -214,5 +228,5 @@ pub(crate) fn harmonic_terms(
                 .zip(ax.amps.iter().zip(&ax.phases))
                 .map(|(&j, (&c, &phi))| (j, c, phi))
         })
-        .filter(|&(j, _, _)| j > 0)
+        .filter(|&(j, _, _)| j != 0.0)
 }

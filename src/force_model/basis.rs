@@ -87,27 +87,59 @@ pub fn m1(omega: f64, phi: f64) -> f64 {
     i1(omega, phi) - d(omega, phi)
 }
 
-/// `Ω = 2πj` for an integer harmonic `j` (rad per unit τ).
-pub fn omega_of(j: u32) -> f64 {
-    TAU * f64::from(j)
+/// `Ω = 2πj` for a harmonic of `j` cycles per stance (rad per unit τ). The Fourier model's
+/// harmonics are integers (the paper's DFT terms) or halves (the half-range cosines
+/// `cos(πkτ) = cos(2π(k/2)τ)` of [`super::cosine`]).
+pub fn omega_of(j: f64) -> f64 {
+    TAU * j
 }
 
-/// `I1` for the integer harmonic `j`: exactly 0 for `j ≥ 1`, `cos φ` for `j = 0`.
-pub fn i1_harmonic(j: u32, phi: f64) -> f64 {
-    if j == 0 {
-        phi.cos()
+/// `cos(Ω + φ)`, `sin(Ω + φ)` at the stance's end, `Ω = 2πj`: exactly `(cos φ, sin φ)` for an
+/// integer `j` and `(−cos φ, −sin φ)` for a half-integer one (no `sin(2πj)` roundoff).
+fn end_value(j: f64, phi: f64) -> (f64, f64) {
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    if j.fract() == 0.0 {
+        (cos_phi, sin_phi)
+    } else if (2.0 * j).fract() == 0.0 {
+        (-cos_phi, -sin_phi)
     } else {
-        0.0
+        let (s, c) = (omega_of(j) + phi).sin_cos();
+        (c, s)
     }
 }
 
-/// `M1` for the integer harmonic `j`: `sin φ/(2πj)` for `j ≥ 1`, `cos φ / 2` for `j = 0`.
-pub fn m1_harmonic(j: u32, phi: f64) -> f64 {
-    if j == 0 {
+/// `I1` for a harmonic of `j` cycles: exactly 0 for an integer `j ≥ 1`, `cos φ` for `j = 0`,
+/// `−2 sin φ/Ω` for a half-integer `j` (`sin(Ω+φ) = −sin φ`), the general form otherwise.
+pub fn i1_harmonic(j: f64, phi: f64) -> f64 {
+    if j == 0.0 {
+        return phi.cos();
+    }
+    let (_, sin_end) = end_value(j, phi);
+    (sin_end - phi.sin()) / omega_of(j)
+}
+
+/// `M1` for a harmonic of `j` cycles: `sin φ/(2πj)` for an integer `j ≥ 1`, `cos φ / 2` for
+/// `j = 0`, and `C_1` of [`harmonic_power_moments`] otherwise.
+pub fn m1_harmonic(j: f64, phi: f64) -> f64 {
+    if j == 0.0 {
         0.5 * phi.cos()
-    } else {
+    } else if j.fract() == 0.0 {
         phi.sin() / omega_of(j)
+    } else {
+        harmonic_power_moments(j, phi, 1)[1]
     }
+}
+
+/// `∫₀¹ cos(2πj₁τ + φ₁) cos(2πj₂τ + φ₂) dτ = ½ [I1(j₁ + j₂, φ₁ + φ₂) + I1(|j₁ − j₂|, ±(φ₁ − φ₂))]`
+/// for harmonics of `j₁, j₂ ≥ 0` cycles (the product-to-sum identity; `cos` is even, so the
+/// difference term takes the phase of the larger frequency's term minus the other's).
+pub fn product_integral(j1: f64, phi1: f64, j2: f64, phi2: f64) -> f64 {
+    let (dj, dphi) = if j1 >= j2 {
+        (j1 - j2, phi1 - phi2)
+    } else {
+        (j2 - j1, phi2 - phi1)
+    };
+    0.5 * (i1_harmonic(j1 + j2, phi1 + phi2) + i1_harmonic(dj, dphi))
 }
 
 /// `P(τ) = Σ_k p_k τ^k` by Horner's rule (N for force coefficients).
@@ -163,24 +195,27 @@ pub fn poly_mul(a: &[f64], b: &[f64]) -> Vec<f64> {
     out
 }
 
-/// `C_n = ∫₀¹ τⁿ cos(2πjτ + φ) dτ` for `n = 0 … n_max` and an integer harmonic `j ≥ 1`.
+/// `C_n = ∫₀¹ τⁿ cos(2πjτ + φ) dτ` for `n = 0 … n_max` and a harmonic of `j > 0` cycles.
 ///
 /// ```text
-/// C_0 = S_0 = 0,   C_n = (sin φ − n S_(n−1))/Ω,   S_n = (n C_(n−1) − cos φ)/Ω,   Ω = 2πj
+/// C_0 = (sin(Ω+φ) − sin φ)/Ω,   S_0 = (cos φ − cos(Ω+φ))/Ω,   Ω = 2πj
+/// C_n = (sin(Ω+φ) − n S_(n−1))/Ω,   S_n = (n C_(n−1) − cos(Ω+φ))/Ω        (n ≥ 1)
 /// ```
-/// (`S_n = ∫₀¹ τⁿ sin(Ωτ + φ) dτ`, integration by parts with `sin(Ω+φ) = sin φ`,
-/// `cos(Ω+φ) = cos φ`.) The upward recursion multiplies errors by `n/Ω` per step, below 1
-/// for `n < 2π`; over `n ≤ 24` the product stays below 10 (the tests bound it).
-pub fn harmonic_power_moments(j: u32, phi: f64, n_max: usize) -> Vec<f64> {
+/// (`S_n = ∫₀¹ τⁿ sin(Ωτ + φ) dτ`, integration by parts; for an integer `j`,
+/// `sin(Ω+φ) = sin φ`, `cos(Ω+φ) = cos φ` and `C_0 = S_0 = 0`; for a half-integer, their
+/// negatives.) The upward recursion multiplies errors by `n/Ω` per step, below 1 for
+/// `n < Ω`; over `n ≤ 24` and `j ≥ ½` the product stays below 10⁴ (the tests bound it).
+pub fn harmonic_power_moments(j: f64, phi: f64, n_max: usize) -> Vec<f64> {
     let omega = omega_of(j);
     let (sin_phi, cos_phi) = phi.sin_cos();
+    let (cos_end, sin_end) = end_value(j, phi);
     let mut out = Vec::with_capacity(n_max + 1);
-    let (mut c, mut s) = (0.0, 0.0);
+    let (mut c, mut s) = ((sin_end - sin_phi) / omega, (cos_phi - cos_end) / omega);
     out.push(c);
     for n in 1..=n_max {
         let nf = n as f64;
-        let c_n = (sin_phi - nf * s) / omega;
-        let s_n = (nf * c - cos_phi) / omega;
+        let c_n = (sin_end - nf * s) / omega;
+        let s_n = (nf * c - cos_end) / omega;
         (c, s) = (c_n, s_n);
         out.push(c);
     }
@@ -293,10 +328,19 @@ mod tests {
 
     #[test]
     fn harmonic_power_moments_match_simpson() {
-        // Up to τ²⁰ against Simpson (error ≤ h⁴/180·max|f⁗| ≈ 3e-16·(Ω+20)⁴ ≤ 1e-10).
-        for j in [1u32, 2, 5] {
-            for &ph in &[0.0, 0.8, -2.4] {
-                let c = harmonic_power_moments(j, ph, 20);
+        // Up to τ²⁰ for integer harmonics, τ⁸ for half-integer ones (the recursion's error
+        // growth ∏ n/Ω stays below 10 there), against Simpson (error ≤ h⁴/180·max|f⁗|
+        // ≈ 3e-16·(Ω+20)⁴ ≤ 1e-10).
+        for (j, n_max) in [
+            (1.0, 20),
+            (2.0, 20),
+            (5.0, 20),
+            (0.5, 8),
+            (1.5, 8),
+            (3.5, 8),
+        ] {
+            for &ph in &[0.0, 0.8, -2.4, std::f64::consts::PI] {
+                let c = harmonic_power_moments(j, ph, n_max);
                 let om = omega_of(j);
                 for (n, &cn) in c.iter().enumerate() {
                     let q = simpson(
@@ -308,6 +352,29 @@ mod tests {
                     assert!((cn - q).abs() < 1e-10, "j={j} φ={ph} n={n}: {cn} vs {q}");
                 }
                 assert!((c[1] - m1_harmonic(j, ph)).abs() < 1e-15);
+                assert!((c[0] - i1_harmonic(j, ph)).abs() < 1e-15);
+            }
+        }
+    }
+
+    #[test]
+    fn product_integrals_match_simpson() {
+        // Integer and half-integer harmonics, equal and unequal, with phases; Simpson's
+        // error ≤ h⁴/180·(Ω₁+Ω₂)⁴ ≈ 1e-12 here.
+        let js = [0.0, 0.5, 1.0, 1.5, 2.0, 3.5];
+        for &j1 in &js {
+            for &j2 in &js {
+                for &(p1, p2) in &[(0.0, 0.0), (0.3, -1.2), (std::f64::consts::PI, 0.0)] {
+                    let (o1, o2) = (omega_of(j1), omega_of(j2));
+                    let q = simpson(
+                        |u| (o1 * u + p1).cos() * (o2 * u + p2).cos(),
+                        0.0,
+                        1.0,
+                        N_SIMPSON,
+                    );
+                    let got = product_integral(j1, p1, j2, p2);
+                    assert!((got - q).abs() < 1e-11, "j {j1}, {j2}: {got} vs {q}");
+                }
             }
         }
     }
@@ -315,7 +382,7 @@ mod tests {
     #[test]
     fn integer_harmonics_have_the_special_values() {
         // Ω = 2πj: I1 = 0, M1 = sin φ/Ω, D = −sin φ/Ω (a few ulps of sin(2πj) roundoff).
-        for j in 1..=31u32 {
+        for j in (1..=31).map(f64::from) {
             let om = omega_of(j);
             for &ph in &[0.3, -1.1, 3.0] {
                 assert!(i1(om, ph).abs() < 1e-14);
@@ -324,7 +391,16 @@ mod tests {
                 assert_eq!(i1_harmonic(j, ph), 0.0);
             }
         }
-        assert!((m1_harmonic(0, 0.5) - m1(0.0, 0.5)).abs() < 1e-15);
-        assert!((i1_harmonic(0, 0.5) - i1(0.0, 0.5)).abs() < 1e-15);
+        assert!((m1_harmonic(0.0, 0.5) - m1(0.0, 0.5)).abs() < 1e-15);
+        assert!((i1_harmonic(0.0, 0.5) - i1(0.0, 0.5)).abs() < 1e-15);
+        // Half-integer j (Ω = π(2j)): I1 = −2 sin φ/Ω, and the general forms agree.
+        for j in [0.5, 1.5, 2.5] {
+            let om = omega_of(j);
+            for &ph in &[0.3, -1.1, 3.0] {
+                assert!((i1_harmonic(j, ph) + 2.0 * ph.sin() / om).abs() < 1e-15);
+                assert!((i1_harmonic(j, ph) - i1(om, ph)).abs() < 1e-14);
+                assert!((m1_harmonic(j, ph) - m1(om, ph)).abs() < 1e-14);
+            }
+        }
     }
 }

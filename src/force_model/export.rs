@@ -152,7 +152,7 @@ mod tests {
             axes: [
                 AxisModel {
                     c0: 20.0,
-                    harmonics: vec![1],
+                    harmonics: vec![1.0],
                     amps: vec![150.0],
                     phases: vec![1.2],
                     ..Default::default()
@@ -160,7 +160,7 @@ mod tests {
                 AxisModel::constant(-5.0),
                 AxisModel {
                     c0: 900.0,
-                    harmonics: vec![1, 20],
+                    harmonics: vec![1.0, 20.0],
                     amps: vec![700.0, 3.0],
                     phases: vec![std::f64::consts::PI, 0.0],
                     ..Default::default()

@@ -175,16 +175,16 @@ fn dft_select(ws: &mut FitWorkspace, k_max: u32, opts: &FitOptions) -> AxisModel
             break;
         }
         kept += amps[k] * amps[k];
-        model.harmonics.push(k as u32);
+        model.harmonics.push(k as f64);
         model.amps.push(amps[k]);
         model.phases.push(spectrum[k].im.atan2(spectrum[k].re));
     }
     // Parseval: (1/N) Σ_j r_j² = (1/N²) Σ_k |R_k|², R = the bins the model leaves out
     // (the pairs k, N−k of the dropped k < N/2, and the Nyquist bin for even N).
     let paired = &spectrum[1..=(*n - 1) / 2];
-    let mut ss: f64 = (1..)
+    let mut ss: f64 = (1u32..)
         .zip(paired)
-        .filter(|(k, _)| !model.harmonics.contains(k))
+        .filter(|(k, _)| !model.harmonics.contains(&f64::from(*k)))
         .map(|(_, x)| 2.0 * x.norm_sqr())
         .sum();
     if *n % 2 == 0 {

@@ -36,12 +36,13 @@
 //! let eye = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 //! let mut ws = FitWorkspace::new(64);
 //! let fm = fit_stage_a(&mut ws, &acc, t_td, dt, eye, m, 30, &FitOptions::default()).unwrap();
-//! assert_eq!(fm.axes[2].harmonics, vec![1]);
+//! assert_eq!(fm.axes[2].harmonics, vec![1.0]);
 //! assert!((fm.j()[2] - 700.0 * dt / m).abs() < 1e-9); // J_v = c0 Δt / m
 //! assert!(fm.support_ok() && fm.unilateral_ok(&fm.grid()));
 //! ```
 
 pub mod basis;
+pub mod cosine;
 pub mod export;
 pub mod fit;
 pub mod leg_line;
@@ -49,6 +50,7 @@ pub mod model;
 pub mod per_contact;
 pub mod ratio;
 
+pub use cosine::{fit_cosine_with, CosineFit};
 pub use fit::{fit_axis, fit_stage_a, j_cap, k_max, FitWorkspace, StanceForce};
 pub use leg_line::LegLine;
 pub use model::{AxisModel, ForceModel};
@@ -71,7 +73,9 @@ pub enum ForceModelKind {
     /// The friction-ratio model of [`ratio`] (default).
     #[default]
     Ratio,
-    /// The paper's Fourier model, Stage A of spec §4.1 ([`fit`]).
+    /// The paper's Fourier model (a constant plus cosine terms per axis) fitted with the
+    /// ratio model's physics: half-range cosines for `f_v` and the ratios ([`cosine`]).
+    /// The periodic DFT of spec §4.1 ([`fit_stage_a`]) stays a library function.
     Fourier,
 }
 
@@ -103,9 +107,12 @@ pub struct FitOptions {
     pub ratio: RatioOptions,
     /// Samples `N` per stance (≥ 2), at `τ_j = j/N`; default [`DEFAULT_SAMPLES`].
     pub samples: usize,
-    /// At most `K_max` harmonics per axis; default [`DEFAULT_MAX_HARMONICS`].
+    /// At most `K_max` harmonics per axis of the periodic DFT ([`fit_stage_a`]); default
+    /// [`DEFAULT_MAX_HARMONICS`]. The `fourier` model of a build takes its sizes from
+    /// [`RatioOptions`] ([`cosine`]).
     pub max_harmonics: usize,
-    /// Energy fraction `η ∈ [0, 1]` of the candidates to keep; default [`DEFAULT_ENERGY`].
+    /// Energy fraction `η ∈ [0, 1]` of the DFT's candidates to keep ([`fit_stage_a`]);
+    /// default [`DEFAULT_ENERGY`].
     pub energy: f64,
 }
 
@@ -128,71 +135,71 @@ pub struct StanceFit {
     pub model: ForceModel,
     /// Which model was fitted.
     pub kind: ForceModelKind,
-    /// `q_h`, `q_p` of the ratio model (power basis); empty for the Fourier model.
+    /// `q_h`, `q_p` of the ratio model (power basis); empty for the Fourier model, whose
+    /// ratios are in its force terms ([`CosineFit::ratio`]).
     pub ratio: [Vec<f64>; 2],
-    /// Vertical edge targets met (see [`RatioFit::vertical_targets_met`]); 0 for Fourier.
+    /// Vertical edge targets met (see [`RatioFit::vertical_targets_met`]).
     pub targets_met: usize,
 }
 
 /// Fits the model `opts.model` to one stance's kinematic force (`n_st` stance frames).
 ///
-/// `targets` (ratio model only; the paper's Fourier model ignores them) make the force
-/// integrate to the stance's edge states.
-///
-/// The Fourier model samples `τ_j = j/N` ([`fit_stage_a`]); the ratio model samples
-/// `τ_j = j/(N−1)`, both edges included ([`ratio::fit_ratio`]).
+/// `targets` make the force integrate to the stance's edge states. The workspace (the
+/// DFT's, [`fit_stage_a`]) is not used by either model; it stays for callers' threads. Both models sample
+/// `τ_j = j/(N−1)`, both edges included, use the leg line where there is one and differ in
+/// the basis: Bernstein and power polynomials ([`ratio::fit_ratio_with`]) or half-range
+/// cosines ([`cosine::fit_cosine_with`]).
 ///
 /// # Errors
 /// Bad options or stance values (config), a non-finite sampled force, a failed QP.
 pub fn fit_stance(
-    ws: &mut FitWorkspace,
+    _ws: &mut FitWorkspace,
     force: &StanceForce,
     n_st: usize,
     targets: Option<&EdgeTargets>,
     opts: &FitOptions,
 ) -> crate::Result<StanceFit> {
+    force.check(&format!("{} model", opts.model.name()))?;
+    let n = opts.samples.clamp(fit::MIN_SAMPLES, fit::MAX_SAMPLES);
+    let tau = ratio::sample_grid(n);
+    let mut samples: [Vec<f64>; 3] = Default::default();
+    if !force.sample(tau.iter().copied(), &mut samples) {
+        return Err(crate::Error::numeric(format!(
+            "{} model: sampled force is not finite near t = {} s",
+            opts.model.name(),
+            force.t_td
+        )));
+    }
+    let leg = force
+        .leg
+        .as_ref()
+        .filter(|_| opts.ratio.leg_line_weight > 0.0);
+    let slopes = leg.and_then(|l| {
+        l.slopes(
+            (force.t_td, force.dt),
+            &force.r_s,
+            &tau,
+            opts.ratio.roll_fraction,
+        )
+    });
     match opts.model {
         ForceModelKind::Fourier => {
-            let model = fit_stage_a(
-                ws,
-                force.acc,
-                force.t_td,
-                force.dt,
-                force.r_s,
-                force.mass_kg,
+            let fit = fit_cosine_with(
+                &samples,
                 n_st,
-                opts,
+                (force.mass_kg, force.dt),
+                targets,
+                slopes.as_ref(),
+                &opts.ratio,
             )?;
             Ok(StanceFit {
-                model,
+                model: fit.model,
                 kind: ForceModelKind::Fourier,
                 ratio: Default::default(),
-                targets_met: 0,
+                targets_met: fit.vertical_targets_met,
             })
         }
         ForceModelKind::Ratio => {
-            force.check("ratio model")?;
-            let n = opts.samples.clamp(fit::MIN_SAMPLES, fit::MAX_SAMPLES);
-            let mut samples: [Vec<f64>; 3] = Default::default();
-            if !force.sample(ratio::sample_grid(n).into_iter(), &mut samples) {
-                return Err(crate::Error::numeric(format!(
-                    "ratio model: sampled force is not finite near t = {} s",
-                    force.t_td
-                )));
-            }
-            let tau = ratio::sample_grid(n);
-            let leg = force
-                .leg
-                .as_ref()
-                .filter(|_| opts.ratio.leg_line_weight > 0.0);
-            let slopes = leg.and_then(|l| {
-                l.slopes(
-                    (force.t_td, force.dt),
-                    &force.r_s,
-                    &tau,
-                    opts.ratio.roll_fraction,
-                )
-            });
             let fit = fit_ratio_with(
                 &samples,
                 n_st,

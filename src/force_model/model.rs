@@ -43,8 +43,10 @@ pub const GRID_MAX_SAMPLES: usize = (1 << 24) + 1;
 pub struct AxisModel {
     /// DC term `c0` (N).
     pub c0: f64,
-    /// Integer harmonics `j_i ≥ 1` (`Ω_i = 2π j_i` rad per unit τ).
-    pub harmonics: Vec<u32>,
+    /// Harmonics `j_i > 0` in cycles per stance (`Ω_i = 2π j_i` rad per unit τ): integers
+    /// for the paper's DFT terms ([`super::fit`]), halves for the half-range cosines
+    /// `cos(πkτ)` of [`super::cosine`].
+    pub harmonics: Vec<f64>,
     /// Amplitudes `c_i ≥ 0` (N).
     pub amps: Vec<f64>,
     /// Phases `φ_i` (rad).
@@ -101,7 +103,7 @@ impl AxisModel {
     }
 
     /// `(j, c, φ)` of each term.
-    pub fn terms(&self) -> impl Iterator<Item = (u32, f64, f64)> + '_ {
+    pub fn terms(&self) -> impl Iterator<Item = (f64, f64, f64)> + '_ {
         self.harmonics
             .iter()
             .zip(&self.amps)
@@ -109,9 +111,9 @@ impl AxisModel {
             .map(|((&j, &c), &p)| (j, c, p))
     }
 
-    /// The largest harmonic index (0 when there is none).
-    pub fn j_max(&self) -> u32 {
-        self.terms().map(|(j, _, _)| j).max().unwrap_or(0)
+    /// The largest harmonic, cycles per stance (0 when there is none).
+    pub fn j_max(&self) -> f64 {
+        self.terms().map(|(j, _, _)| j).fold(0.0, f64::max)
     }
 
     /// `f(τ)` (N).
@@ -144,8 +146,9 @@ impl AxisModel {
             + basis::poly_f2(&self.poly, tau)
     }
 
-    /// `∫₀¹ f dτ`: exactly `c0` for the Fourier model with every harmonic ≥ 1 (their `I1` is
-    /// 0, spec §5), plus `Σ_k p_k/(k+1)` for the polynomial part.
+    /// `∫₀¹ f dτ`: exactly `c0` for the Fourier model with integer harmonics ≥ 1 (their `I1`
+    /// is 0, spec §5), `− Σ 2 c_i sin φ_i/Ω_i` over half-integer ones, plus `Σ_k p_k/(k+1)`
+    /// for the polynomial part.
     pub fn integral(&self) -> f64 {
         self.c0
             + self
@@ -155,7 +158,8 @@ impl AxisModel {
             + basis::poly_moment(&self.poly, 0)
     }
 
-    /// `∫₀¹ τ f dτ = c0/2 + Σ c_i sin φ_i / Ω_i + Σ_k p_k/(k+2)` (N per unit τ).
+    /// `∫₀¹ τ f dτ = c0/2 + Σ c_i M1_i + Σ_k p_k/(k+2)` (N per unit τ), `M1_i = sin φ_i/Ω_i`
+    /// for an integer harmonic ([`basis::m1_harmonic`]).
     pub fn first_moment(&self) -> f64 {
         self.c0 / 2.0
             + self
@@ -212,15 +216,19 @@ impl ForceModel {
         }
     }
 
-    /// The largest harmonic over the three axes (0 if none).
-    pub fn j_max(&self) -> u32 {
-        self.axes.iter().map(AxisModel::j_max).max().unwrap_or(0)
+    /// The largest harmonic over the three axes, cycles per stance (0 if none).
+    pub fn j_max(&self) -> f64 {
+        self.axes.iter().map(AxisModel::j_max).fold(0.0, f64::max)
     }
 
-    /// `N_s = max(201, 16·j_max + 1)`, capped at [`GRID_MAX_SAMPLES`].
+    /// `N_s = max(201, ⌈16·j_max⌉ + 1)`, capped at [`GRID_MAX_SAMPLES`] (a NaN or infinite
+    /// harmonic gives the cap).
     pub fn grid_len(&self) -> usize {
-        let j = usize::try_from(self.j_max()).unwrap_or(usize::MAX);
-        j.saturating_mul(GRID_SAMPLES_PER_HARMONIC)
+        let per = self.j_max() * GRID_SAMPLES_PER_HARMONIC as f64;
+        if !per.is_finite() || per >= GRID_MAX_SAMPLES as f64 {
+            return GRID_MAX_SAMPLES;
+        }
+        (per.ceil() as usize)
             .saturating_add(1)
             .clamp(GRID_MIN_SAMPLES, GRID_MAX_SAMPLES)
     }
@@ -271,7 +279,16 @@ mod tests {
     /// A random axis: DC in [−450, 1050) N plus 1–6 cosines of harmonics 1–8, up to 800 N.
     fn random_axis(rng: &mut Rng) -> AxisModel {
         let c0 = 1500.0 * (rng.next_f64() - 0.3);
-        crate::testkit::random_axis(rng, c0, 800.0, Harmonics { terms: 6, max_j: 8 })
+        crate::testkit::random_axis(
+            rng,
+            c0,
+            800.0,
+            Harmonics {
+                terms: 6,
+                max_j: 8,
+                halves: false,
+            },
+        )
     }
 
     #[test]
@@ -370,7 +387,7 @@ mod tests {
                 assert!((p[a] - (fm.dt_s * j[a] - k[a])).abs() < 1e-12 * (1.0 + p[a].abs()));
                 let sines: f64 = ax
                     .terms()
-                    .map(|(jj, c, ph)| c * ph.sin() / (TAU * jj as f64))
+                    .map(|(jj, c, ph)| c * ph.sin() / (TAU * jj))
                     .sum();
                 let p_dft = fm.dt_s * fm.dt_s / fm.mass_kg * (ax.c0 / 2.0 - sines);
                 assert!((p[a] - p_dft).abs() < 1e-12 * (1.0 + p[a].abs()));
@@ -383,13 +400,13 @@ mod tests {
 
     #[test]
     fn grid_sizes() {
-        let with_j = |j: u32| ForceModel {
+        let with_j = |j: f64| ForceModel {
             mass_kg: 70.0,
             dt_s: 0.2,
             axes: [
                 AxisModel::constant(0.0),
                 AxisModel {
-                    harmonics: vec![j.min(2), j],
+                    harmonics: vec![j.min(2.0), j],
                     amps: vec![1.0; 2],
                     phases: vec![0.0; 2],
                     ..Default::default()
@@ -399,10 +416,17 @@ mod tests {
         };
         let none = ForceModel {
             axes: Default::default(),
-            ..with_j(1)
+            ..with_j(1.0)
         };
-        assert_eq!((none.j_max(), none.grid_len()), (0, 201));
-        for (j, n) in [(1, 201), (12, 201), (13, 209), (31, 497), (100, 1601)] {
+        assert_eq!((none.j_max(), none.grid_len()), (0.0, 201));
+        for (j, n) in [
+            (1.0, 201),
+            (12.0, 201),
+            (13.0, 209),
+            (12.5, 201),
+            (31.5, 505),
+            (100.0, 1601),
+        ] {
             let fm = with_j(j);
             assert_eq!((fm.j_max(), fm.grid_len()), (j, n), "j_max = {j}");
             let g = fm.grid();
@@ -410,7 +434,7 @@ mod tests {
             assert_eq!((g[0], g[n - 1]), (0.0, 1.0));
             assert!((g[1] - 1.0 / (n - 1) as f64).abs() < 1e-17);
         }
-        assert_eq!(with_j(u32::MAX).grid_len(), GRID_MAX_SAMPLES);
+        assert_eq!(with_j(f64::from(u32::MAX)).grid_len(), GRID_MAX_SAMPLES);
     }
 
     #[test]
@@ -424,7 +448,7 @@ mod tests {
                 AxisModel::constant(0.0),
                 AxisModel {
                     c0: 500.0,
-                    harmonics: vec![1],
+                    harmonics: vec![1.0],
                     amps: vec![a],
                     phases: vec![0.0],
                     poly: Vec::new(),

@@ -308,7 +308,13 @@ pub fn bernstein_to_power(b: &[f64]) -> Vec<f64> {
 
 /// `min ½ xᵀQx + cᵀx` s.t. the first `meq` rows of `a x = b`, the rest `a x ≤ b` (quadprog,
 /// Goldfarb–Idnani); `q` gets a relative ridge so that it is strictly positive definite.
-fn qp(q: &DMatrix<f64>, c: &[f64], a: &[f64], b: &[f64], meq: usize) -> Option<Vec<f64>> {
+pub(super) fn qp(
+    q: &DMatrix<f64>,
+    c: &[f64],
+    a: &[f64],
+    b: &[f64],
+    meq: usize,
+) -> Option<Vec<f64>> {
     let n = q.ncols();
     let ridge = NNLS_RIDGE_REL * (0..n).map(|i| q[(i, i)]).sum::<f64>() / n as f64;
     let mut qm: Vec<f64> = (0..n * n)
@@ -382,7 +388,7 @@ fn vertical_fit(
 /// tolerance in the row's unit), so that missing the target by `σ` costs one sample's
 /// typical misfit (module docs). `None` where `w` is not finite and positive (a residual
 /// of 0: nothing to weigh the target against).
-fn with_soft_row(
+pub(super) fn with_soft_row(
     x: &DMatrix<f64>,
     s: &[f64],
     c0: &[f64],
@@ -403,14 +409,15 @@ fn with_soft_row(
     Some((rows, rhs))
 }
 
-/// Weighted least squares `argmin_r Σ_j (f_v(τ_j) q(τ_j) − s_j)² / (f_v(τ_j) + ε)`, `q` of
-/// degree `deg` ([`RATIO_WEIGHT_FLOOR`]), optionally with `∫₀¹ f_v q dτ = target`
-/// (`fv_moments[k] = ∫₀¹ τ^k f_v dτ`).
-fn ratio_fit(
+/// Weighted least squares `argmin_r Σ_j (f_v(τ_j) q(τ_j) − s_j)² / (f_v(τ_j) + ε)`,
+/// `q(τ) = Σ_{k ≤ deg} r_k φ_k(τ)` ([`RATIO_WEIGHT_FLOOR`]; `φ_k = τ^k` here, `cos(πkτ)` in
+/// [`super::cosine`]), optionally with `∫₀¹ f_v q dτ = target` (`impulse.0[k] = ∫₀¹ φ_k f_v
+/// dτ`) and the soft travel row (`travel.0[k] = ∫₀¹∫₀ˢ φ_k f_v`, target, tolerance).
+pub(super) fn ratio_fit(
     fv: &[f64],
     tau: &[f64],
     s: &[f64],
-    deg: usize,
+    (deg, phi): (usize, &dyn Fn(usize, f64) -> f64),
     impulse: Option<(&[f64], f64)>,
     travel: Option<(&[f64], f64, f64)>,
 ) -> Vec<f64> {
@@ -419,9 +426,7 @@ fn ratio_fit(
         .iter()
         .map(|&v| 1.0 / (v.max(0.0) + eps).sqrt())
         .collect();
-    let x = DMatrix::from_fn(tau.len(), deg + 1, |j, k| {
-        w[j] * fv[j] * tau[j].powi(k as i32)
-    });
+    let x = DMatrix::from_fn(tau.len(), deg + 1, |j, k| w[j] * fv[j] * phi(k, tau[j]));
     let weighted: Vec<f64> = s.iter().zip(&w).map(|(v, w)| v * w).collect();
     let s = weighted.as_slice();
     if let Some((m, target)) = impulse {
@@ -454,7 +459,7 @@ fn ratio_fit(
 }
 
 /// RMS of `samples − model(τ)` over the fit grid (N).
-fn rms(axis: &AxisModel, tau: &[f64], samples: &[f64]) -> f64 {
+pub(super) fn rms(axis: &AxisModel, tau: &[f64], samples: &[f64]) -> f64 {
     let ss: f64 = tau
         .iter()
         .zip(samples)
@@ -481,7 +486,7 @@ pub fn fit_ratio(
 
 /// The ratio data `s'_a = (1 − λ) s_a + λ f_v g_a` of the leg line ([`super::leg_line`]),
 /// a = h, p; the kinematic samples where there is no leg line or `λ = 0`.
-fn ratio_data(
+pub(super) fn ratio_data(
     samples: &[Vec<f64>; 3],
     fv: &[f64],
     leg: Option<&[Vec<f64>; 2]>,
@@ -555,8 +560,23 @@ pub fn fit_ratio_with(
     let imp = |a: usize| targets.map(|t| (moments.as_slice(), t.impulse[a]));
     let travel = |a: usize| targets.map(|t| (double.as_slice(), t.travel_double[a], sigma));
     let data = ratio_data(samples, &fv, leg, opts.leg_line_weight);
-    let q_h = ratio_fit(&fv, &tau, &data[0], opts.ratio_degree_h, imp(0), travel(0));
-    let q_p = ratio_fit(&fv, &tau, &data[1], opts.ratio_degree_p, imp(1), travel(1));
+    let power = |k: usize, t: f64| t.powi(k as i32);
+    let q_h = ratio_fit(
+        &fv,
+        &tau,
+        &data[0],
+        (opts.ratio_degree_h, &power),
+        imp(0),
+        travel(0),
+    );
+    let q_p = ratio_fit(
+        &fv,
+        &tau,
+        &data[1],
+        (opts.ratio_degree_p, &power),
+        imp(1),
+        travel(1),
+    );
     let axis = |poly: Vec<f64>, s: &[f64]| {
         let mut a = AxisModel {
             poly,

@@ -556,7 +556,8 @@ pub mod stances {
     pub const MASS: &str = "mass_kg";
     /// Fourier DC term per stance axis, N. (`_h`, `_p`, `_v`)
     pub const C0: [&str; 3] = ["c0_h_n", "c0_p_n", "c0_v_n"];
-    /// Fourier harmonics per stance axis (integers). (`_h`, `_p`, `_v`)
+    /// Fourier harmonics per stance axis, cycles per stance (whole, or half for the
+    /// half-range cosines). (`_h`, `_p`, `_v`)
     pub const HARMONIC: [&str; 3] = ["harmonic_h", "harmonic_p", "harmonic_v"];
     /// Fourier amplitudes per stance axis, N. (`_h`, `_p`, `_v`)
     pub const AMP: [&str; 3] = ["amp_h_n", "amp_p_n", "amp_v_n"];

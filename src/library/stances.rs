@@ -221,17 +221,11 @@ fn model_columns(rows: &[Stance]) -> PolarsResult<Vec<Column>> {
         cols.push(col(S::C0[a], f(&|r| r.model.axes[a].c0)));
     }
     for a in 0..3 {
-        let h: Vec<Vec<i32>> = rows
+        let h: Vec<Vec<f64>> = rows
             .iter()
-            .map(|r| {
-                r.model.axes[a]
-                    .harmonics
-                    .iter()
-                    .map(|&j| j as i32)
-                    .collect()
-            })
+            .map(|r| r.model.axes[a].harmonics.clone())
             .collect();
-        cols.push(list_col(S::HARMONIC[a], h, DataType::Int32)?);
+        cols.push(list_col(S::HARMONIC[a], h, DataType::Float64)?);
     }
     let axis_list =
         |names: [&str; 3], g: &dyn Fn(&AxisModel) -> Vec<f64>| -> PolarsResult<Vec<Column>> {
@@ -391,12 +385,26 @@ fn fixed<const N: usize>(v: &[f64]) -> [f64; N] {
 /// `poly_*`.
 type AxisColumns = (
     Vec<f64>,
-    Vec<Vec<i32>>,
+    Vec<Vec<f64>>,
     Vec<Vec<f64>>,
     Vec<Vec<f64>>,
     Vec<f64>,
     Vec<Vec<f64>>,
 );
+
+/// A `harmonic_*` column: `list<double>` (cycles per stance, whole or half), or the
+/// `list<int32>` of libraries written before the half-range cosine model (whole cycles).
+fn harmonic_lists(t: &Table, name: &str) -> Result<Vec<Vec<f64>>> {
+    t.f64_lists(name, None).or_else(|e| {
+        t.i32_lists(name)
+            .map(|v| {
+                v.into_iter()
+                    .map(|r| r.into_iter().map(f64::from).collect())
+                    .collect()
+            })
+            .map_err(|_| e)
+    })
+}
 
 /// The force model of row `i` from one axis's columns.
 fn axis_model(t: &Table, axis: usize, i: usize, cols: &AxisColumns) -> Result<AxisModel> {
@@ -409,21 +417,20 @@ fn axis_model(t: &Table, axis: usize, i: usize, cols: &AxisColumns) -> Result<Ax
             "harmonic, amp and phase lists differ in length",
         ));
     }
-    let harmonics = h[i]
+    if !h[i]
         .iter()
-        .map(|&j| u32::try_from(j).ok().filter(|&j| j >= 1))
-        .collect::<Option<Vec<u32>>>()
-        .ok_or_else(|| {
-            Error::column(
-                &t.path,
-                S::HARMONIC[axis],
-                Some(i),
-                "harmonics must be integers ≥ 1",
-            )
-        })?;
+        .all(|&j| j >= 0.5 && j.is_finite() && (2.0 * j).fract() == 0.0)
+    {
+        return Err(Error::column(
+            &t.path,
+            S::HARMONIC[axis],
+            Some(i),
+            "harmonics must be whole or half cycles ≥ ½",
+        ));
+    }
     Ok(AxisModel {
         c0: c0[i],
-        harmonics,
+        harmonics: h[i].clone(),
         amps: a[i].clone(),
         phases: p[i].clone(),
         poly: poly[i].clone(),
@@ -497,7 +504,7 @@ impl StanceColumns {
                 .map(|i| {
                     Ok((
                         f(S::C0[i])?,
-                        t.i32_lists(S::HARMONIC[i])?,
+                        harmonic_lists(t, S::HARMONIC[i])?,
                         t.f64_lists(S::AMP[i], None)?,
                         t.f64_lists(S::PHASE[i], None)?,
                         f(S::FIT_RMS[i])?,

@@ -80,7 +80,6 @@ use crate::constraints::{
     Coefficients, SampledTables, StanceContext, RELATIVE_MARGIN,
 };
 use crate::force_model::{basis, ForceModel, GRAVITY};
-use std::f64::consts::TAU;
 
 /// Absolute friction coefficient `μ` of `query run` (§7.5): the crate's one default μ.
 pub use crate::math::constants::DEFAULT_MU;
@@ -497,7 +496,8 @@ pub fn exact_at_contact_point(
     (exact(tables, model, &at, beta, lim), u)
 }
 
-/// `(∫₀¹ τ f_b dτ, ∫₀¹ τ² f_b dτ)` for integer harmonics and the polynomial part, N.
+/// `(∫₀¹ τ f_b dτ, ∫₀¹ τ² f_b dτ)` for whole- and half-cycle harmonics and the polynomial
+/// part, N.
 fn tau_moments(model: &ForceModel, axis: usize) -> (f64, f64) {
     let d = dc_term(model, axis);
     let (mut t1, mut t2) = (d / 2.0, d / 3.0);
@@ -506,11 +506,18 @@ fn tau_moments(model: &ForceModel, axis: usize) -> (f64, f64) {
         t2 += basis::poly_moment(&ax.poly, 2);
     }
     for (j, c, phi) in harmonic_terms(model, axis) {
-        let omega = TAU * f64::from(j);
-        let (sin_phi, cos_phi) = phi.sin_cos();
-        let m1 = sin_phi / omega;
-        t1 += c * m1;
-        t2 += c * (m1 + 2.0 * cos_phi / (omega * omega));
+        if j.fract() == 0.0 {
+            // Integer harmonics (spec §5): ∫τ cos = sin φ/Ω, ∫τ² cos = sin φ/Ω + 2 cos φ/Ω².
+            let omega = basis::omega_of(j);
+            let (sin_phi, cos_phi) = phi.sin_cos();
+            let m1 = sin_phi / omega;
+            t1 += c * m1;
+            t2 += c * (m1 + 2.0 * cos_phi / (omega * omega));
+        } else {
+            let m = basis::harmonic_power_moments(j, phi, 2);
+            t1 += c * m[1];
+            t2 += c * m[2];
+        }
     }
     (t1, t2)
 }

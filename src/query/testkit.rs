@@ -9,7 +9,11 @@ use crate::testkit::Harmonics;
 pub(crate) use crate::testkit::Rng;
 
 /// The harmonic content of the query tests' random axes: 1–3 cosines of harmonics 1–4.
-const HARMONICS: Harmonics = Harmonics { terms: 3, max_j: 4 };
+const HARMONICS: Harmonics = Harmonics {
+    terms: 3,
+    max_j: 4,
+    halves: false,
+};
 
 /// A DC term plus 1–3 cosines of harmonics 1–4 (`testkit::random_axis`).
 pub fn random_axis(rng: &mut Rng, c0: f64, amp: f64) -> AxisModel {

@@ -9,8 +9,7 @@ use crate::contacts::flight::FlightFit;
 use crate::contacts::timing::EVENT_MAX_SHIFT_S;
 use crate::contacts::EFFECTORS;
 use crate::force_model::{
-    fit_stance, EdgeTargets, FitOptions, FitWorkspace, ForceModelKind, LegLine, StanceFit,
-    StanceForce, GRAVITY,
+    fit_stance, EdgeTargets, FitOptions, FitWorkspace, LegLine, StanceFit, StanceForce, GRAVITY,
 };
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};
 use crate::math::polyfit::{fit as poly_fit, fit_fixed_curvature};
@@ -594,7 +593,7 @@ impl<'a> ClipData<'a> {
             targets_met,
         } = fit;
         let mut sw = Vec::new();
-        if targeted && force_model == ForceModelKind::Ratio && targets_met < 2 {
+        if targeted && targets_met < 2 {
             sw.push(format!(
                 "the force model meets {targets_met} of 2 vertical edge targets of the adjacent flight(s)"
             ));

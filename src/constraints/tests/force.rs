@@ -1,6 +1,6 @@
 //! Eq 9–12 coefficients against brute force, and conservativeness of eq 10 and eq 12.
 
-use super::{force_at, random_model, Rng};
+use super::{force_at, random_model, random_model_with, Rng};
 use crate::constraints::{
     force_coefficients, force_filter_accepts, friction_filter_accepts, precompute, SampledTables,
     StanceContext, ACTIVE_FRACTION,
@@ -9,20 +9,22 @@ use crate::force_model::{AxisModel, ForceModel};
 
 #[test]
 fn tables_match_the_models_evaluators() {
-    let mut rng = Rng::new(1);
-    for _ in 0..50 {
-        let model = random_model(&mut rng);
-        let tables = SampledTables::new(&model);
-        assert_eq!(tables.tau, model.grid());
-        for axis in 0..3 {
-            let f_scale = tables.f[axis].iter().fold(1.0f64, |m, v| m.max(v.abs()));
-            let s_scale = tables.s[axis].iter().fold(1e-6f64, |m, v| m.max(v.abs()));
-            for (k, &t) in tables.tau.iter().enumerate() {
-                // Unit-circle table vs direct cos of 2πjτ + φ: a few ulps of the scale.
-                let ef = (tables.f[axis][k] - model.axes[axis].eval(t)).abs();
-                let es = (tables.s[axis][k] - model.s(axis, t)).abs();
-                assert!(ef <= 1e-12 * f_scale, "f axis {axis} k {k}: {ef}");
-                assert!(es <= 1e-12 * s_scale, "S axis {axis} k {k}: {es}");
+    for halves in [false, true] {
+        let mut rng = Rng::new(1);
+        for _ in 0..50 {
+            let model = random_model_with(&mut rng, halves);
+            let tables = SampledTables::new(&model);
+            assert_eq!(tables.tau, model.grid());
+            for axis in 0..3 {
+                let f_scale = tables.f[axis].iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                let s_scale = tables.s[axis].iter().fold(1e-6f64, |m, v| m.max(v.abs()));
+                for (k, &t) in tables.tau.iter().enumerate() {
+                    // Unit-circle table vs direct cos of 2πjτ + φ: a few ulps of the scale.
+                    let ef = (tables.f[axis][k] - model.axes[axis].eval(t)).abs();
+                    let es = (tables.s[axis][k] - model.s(axis, t)).abs();
+                    assert!(ef <= 1e-12 * f_scale, "f axis {axis} k {k}: {ef}");
+                    assert!(es <= 1e-12 * s_scale, "S axis {axis} k {k}: {es}");
+                }
             }
         }
     }
@@ -127,7 +129,7 @@ fn force_and_friction_filters_are_conservative() {
 fn a_stance_without_load_needs_infinite_friction() {
     let axis = |c0: f64| AxisModel {
         c0,
-        harmonics: vec![2],
+        harmonics: vec![2.0],
         amps: vec![10.0],
         phases: vec![0.3],
         poly: Vec::new(),

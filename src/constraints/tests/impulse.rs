@@ -1,6 +1,6 @@
 //! `H` and `H_0` against Simpson quadrature, the affine form of §8.2, degenerate inputs.
 
-use super::{force_at, random_context, random_model, Rng};
+use super::{force_at, random_context, random_model, random_model_with, Rng};
 use crate::constraints::impulse::cross;
 use crate::constraints::impulse::moment_integral;
 use crate::constraints::{
@@ -38,20 +38,22 @@ fn h_simpson(model: &ForceModel, ctx: &StanceContext, intervals: usize) -> ([f64
 
 #[test]
 fn h_matches_simpson_quadrature() {
-    let mut rng = Rng::new(20);
-    for _ in 0..100 {
-        let model = random_model(&mut rng);
-        let ctx = random_context(&mut rng);
-        let (h, _) = angular_impulse(&model, &ctx);
-        let (h_ref, scale) = h_simpson(&model, &ctx, 2048);
-        for a in 0..3 {
-            // Simpson with 2048 intervals on j ≤ 6: error ~1e-11 of the integrand's scale.
-            assert!(
-                (h[a] - h_ref[a]).abs() <= 1e-8 * scale,
-                "axis {a}: {} vs {}",
-                h[a],
-                h_ref[a]
-            );
+    for halves in [false, true] {
+        let mut rng = Rng::new(20);
+        for _ in 0..100 {
+            let model = random_model_with(&mut rng, halves);
+            let ctx = random_context(&mut rng);
+            let (h, _) = angular_impulse(&model, &ctx);
+            let (h_ref, scale) = h_simpson(&model, &ctx, 2048);
+            for a in 0..3 {
+                // Simpson with 2048 intervals on j ≤ 6: error ~1e-11 of the integrand's scale.
+                assert!(
+                    (h[a] - h_ref[a]).abs() <= 1e-8 * scale,
+                    "axis {a}: {} vs {}",
+                    h[a],
+                    h_ref[a]
+                );
+            }
         }
     }
 }
@@ -94,7 +96,7 @@ fn precompute_stores_h_and_h0() {
 
 #[test]
 fn degenerate_models_do_not_panic() {
-    let axis = |harmonics: Vec<u32>, amps: Vec<f64>, phases: Vec<f64>| AxisModel {
+    let axis = |harmonics: Vec<f64>, amps: Vec<f64>, phases: Vec<f64>| AxisModel {
         c0: 1.0,
         harmonics,
         amps,
@@ -107,15 +109,23 @@ fn degenerate_models_do_not_panic() {
         (
             70.0,
             0.2,
-            axis(vec![0, 1, 1], vec![2.0, 3.0, 1.0], vec![0.1, 0.2, 0.3]),
+            axis(
+                vec![0.0, 1.0, 1.0],
+                vec![2.0, 3.0, 1.0],
+                vec![0.1, 0.2, 0.3],
+            ),
         ),
-        (70.0, 0.2, axis(vec![1, 2], vec![1.0], vec![0.0, 0.0, 0.0])),
-        (0.0, 0.2, axis(vec![1], vec![1.0], vec![0.0])),
-        (70.0, 0.0, axis(vec![1], vec![1.0], vec![0.0])),
+        (
+            70.0,
+            0.2,
+            axis(vec![1.0, 2.0], vec![1.0], vec![0.0, 0.0, 0.0]),
+        ),
+        (0.0, 0.2, axis(vec![1.0], vec![1.0], vec![0.0])),
+        (70.0, 0.0, axis(vec![1.0], vec![1.0], vec![0.0])),
         (
             f64::NAN,
             f64::INFINITY,
-            axis(vec![3], vec![f64::NAN], vec![f64::INFINITY]),
+            axis(vec![3.0], vec![f64::NAN], vec![f64::INFINITY]),
         ),
     ];
     for (i, (mass_kg, dt_s, ax)) in cases.into_iter().enumerate() {
@@ -173,7 +183,7 @@ fn degenerate_models_do_not_panic() {
 fn j_zero_terms_and_repeated_harmonics_match_simpson() {
     let ax = |c0: f64| AxisModel {
         c0,
-        harmonics: vec![0, 2, 2, 5],
+        harmonics: vec![0.0, 2.0, 2.0, 5.0],
         amps: vec![40.0, 120.0, 60.0, 30.0],
         phases: vec![0.7, -1.1, 2.0, 0.4],
         poly: Vec::new(),
@@ -206,34 +216,36 @@ fn j_zero_terms_and_repeated_harmonics_match_simpson() {
 
 #[test]
 fn every_moment_integral_matches_simpson() {
-    let mut rng = Rng::new(23);
-    let n = 2048;
-    for _ in 0..20 {
-        let model = random_model(&mut rng);
-        let ctx = random_context(&mut rng);
-        for a in 0..3 {
-            for b in 0..3 {
-                let (mut q, mut scale) = (0.0, 0.0);
-                for i in 0..=n {
-                    let tau = i as f64 / n as f64;
-                    let w = match i {
-                        0 => 1.0,
-                        _ if i == n => 1.0,
-                        _ if i % 2 == 1 => 4.0,
-                        _ => 2.0,
-                    };
-                    let r = com_offset(&model, &ctx, [1.0; 3], tau)[a];
-                    let f = model.axes[b].eval(tau);
-                    q += w * r * f;
-                    scale += w * (r * f).abs();
+    for halves in [false, true] {
+        let mut rng = Rng::new(23);
+        let n = 2048;
+        for _ in 0..20 {
+            let model = random_model_with(&mut rng, halves);
+            let ctx = random_context(&mut rng);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let (mut q, mut scale) = (0.0, 0.0);
+                    for i in 0..=n {
+                        let tau = i as f64 / n as f64;
+                        let w = match i {
+                            0 => 1.0,
+                            _ if i == n => 1.0,
+                            _ if i % 2 == 1 => 4.0,
+                            _ => 2.0,
+                        };
+                        let r = com_offset(&model, &ctx, [1.0; 3], tau)[a];
+                        let f = model.axes[b].eval(tau);
+                        q += w * r * f;
+                        scale += w * (r * f).abs();
+                    }
+                    let (q, scale) = (q / (3.0 * n as f64), scale / (3.0 * n as f64));
+                    let exact = moment_integral(&model, &ctx, a, b);
+                    // Simpson with 2048 intervals on j ≤ 6 (products up to j = 12): ~1e-10 of scale.
+                    assert!(
+                        (exact - q).abs() <= 1e-8 * scale,
+                        "∫ r_{a} f_{b}: {exact} vs {q}"
+                    );
                 }
-                let (q, scale) = (q / (3.0 * n as f64), scale / (3.0 * n as f64));
-                let exact = moment_integral(&model, &ctx, a, b);
-                // Simpson with 2048 intervals on j ≤ 6 (products up to j = 12): ~1e-10 of scale.
-                assert!(
-                    (exact - q).abs() <= 1e-8 * scale,
-                    "∫ r_{a} f_{b}: {exact} vs {q}"
-                );
             }
         }
     }

@@ -16,7 +16,18 @@ pub(super) use crate::testkit::Rng;
 /// A random stance-like model (`testkit::bell_model`): ringing up to 0.1 body weights,
 /// 1–4 harmonics `j ∈ 1..=6` per axis.
 pub(super) fn random_model(rng: &mut Rng) -> ForceModel {
-    crate::testkit::bell_model(rng, 0.1, Harmonics { terms: 4, max_j: 6 })
+    random_model_with(rng, false)
+}
+
+/// [`random_model`], or with `halves` every harmonic `j − ½` (half-range cosines, the
+/// Fourier model of `force_model::cosine`) from the same draws.
+pub(super) fn random_model_with(rng: &mut Rng, halves: bool) -> ForceModel {
+    let h = Harmonics {
+        terms: 4,
+        max_j: 6,
+        halves,
+    };
+    crate::testkit::bell_model(rng, 0.1, h)
 }
 
 /// A random original context: running-like speeds, heights, contact points.

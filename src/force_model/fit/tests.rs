@@ -71,7 +71,7 @@ fn synthetic_stance_is_recovered_exactly() {
         );
         assert_eq!(
             got.harmonics,
-            want.1.iter().map(|t| t.0).collect::<Vec<_>>()
+            want.1.iter().map(|t| f64::from(t.0)).collect::<Vec<_>>()
         );
         for (i, &(_, a, p)) in want.1.iter().enumerate() {
             assert!((got.amps[i] - a).abs() < 1e-9);
@@ -79,7 +79,7 @@ fn synthetic_stance_is_recovered_exactly() {
         }
         assert!(got.fit_rms < 1e-9);
     }
-    assert_eq!((fm.mass_kg, fm.dt_s, fm.j_max()), (m, dt, 4));
+    assert_eq!((fm.mass_kg, fm.dt_s, fm.j_max()), (m, dt, 4.0));
 }
 
 #[test]
@@ -126,7 +126,7 @@ fn dft_reconstruction_reproduces_all_samples() {
         .map(|j| 3.0 * (TAU * 5.0 * j as f64 / 64.0 + 0.4).cos())
         .collect();
     let model = fit_axis(&mut ws, &pure, 31, &FitOptions::default()).unwrap();
-    assert_eq!(model.harmonics, vec![5]);
+    assert_eq!(model.harmonics, vec![5.0]);
     assert!((model.amps[0] - 3.0).abs() < 1e-12 && (model.phases[0] - 0.4).abs() < 1e-12);
 }
 
@@ -169,7 +169,7 @@ fn j_cap_rule() {
         &FitOptions::default(),
     )
     .unwrap();
-    assert_eq!(fm.axes[2].harmonics, vec![1]);
+    assert_eq!(fm.axes[2].harmonics, vec![1.0]);
     assert!((fm.axes[2].fit_rms - 300.0 / 2f64.sqrt()).abs() < 1e-9); // RMS of the dropped cosine
     assert!(fm.axes[0].harmonics.is_empty() && fm.axes[0].c0.abs() < 1e-9);
 }
@@ -192,10 +192,10 @@ fn selection_follows_energy_cap_and_ties() {
         };
         fit_axis(ws, &s, 31, &o).unwrap().harmonics
     };
-    assert_eq!(fit(&mut ws, 6, 0.99), vec![1, 2]);
-    assert_eq!(fit(&mut ws, 6, 0.999), vec![1, 2, 3]);
-    assert_eq!(fit(&mut ws, 1, 0.999), vec![1]);
-    assert_eq!(fit(&mut ws, 6, 0.0), Vec::<u32>::new());
+    assert_eq!(fit(&mut ws, 6, 0.99), vec![1.0, 2.0]);
+    assert_eq!(fit(&mut ws, 6, 0.999), vec![1.0, 2.0, 3.0]);
+    assert_eq!(fit(&mut ws, 1, 0.999), vec![1.0]);
+    assert_eq!(fit(&mut ws, 6, 0.0), Vec::<f64>::new());
     // Exactly equal amplitudes (k = 2 and 4): the lower k comes first.
     let mut order = Vec::new();
     dominant_order(&[9.0, 1.0, 3.0, 0.5, 3.0, 3.5], &mut order);
@@ -240,7 +240,7 @@ fn degenerate_inputs_are_errors_not_panics() {
         )
         .unwrap();
         assert!(fm.j().iter().chain(&fm.p()).all(|v| v.is_finite()));
-        assert!(fm.j_max() <= 1);
+        assert!(fm.j_max() <= 1.0);
     }
 }
 

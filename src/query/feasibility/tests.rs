@@ -123,7 +123,7 @@ fn pulling_dip_is_infeasible_for_every_beta() {
     // f_v = w(1 − cos 2πτ) + 0.5w cos 8πτ: −0.21w at τ = 1/8, below −0.05 · max f_v.
     let v = AxisModel {
         c0: w,
-        harmonics: vec![1, 4],
+        harmonics: vec![1.0, 4.0],
         amps: vec![w, 0.5 * w],
         phases: vec![PI, 0.0],
         poly: Vec::new(),
@@ -131,7 +131,7 @@ fn pulling_dip_is_infeasible_for_every_beta() {
     };
     let h = AxisModel {
         c0: 0.0,
-        harmonics: vec![1],
+        harmonics: vec![1.0],
         amps: vec![0.2 * w],
         phases: vec![0.0],
         poly: Vec::new(),

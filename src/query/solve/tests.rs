@@ -150,7 +150,7 @@ fn forward_simulation_reproduces_random_requests() {
 fn model_with(c0: [f64; 3], phi: f64) -> ForceModel {
     let axis = |c0: f64, amp: f64| AxisModel {
         c0,
-        harmonics: vec![1],
+        harmonics: vec![1.0],
         amps: vec![amp],
         phases: vec![phi],
         poly: Vec::new(),
