@@ -294,7 +294,8 @@ fn force_models_round_trip_through_parquet() {
                     .unwrap()
                     .get_as_series(i)
                     .unwrap();
-                let h: Vec<i32> = h.i32().unwrap().iter().map(|v| v.unwrap()).collect();
+                // Cycles per stance: whole for the periodic fit, halves for half-range cosines.
+                let h: Vec<f64> = h.f64().unwrap().iter().map(|v| v.unwrap()).collect();
                 let amp = list_f64(&df, &format!("amp_{ax}_n"), i);
                 let ph = list_f64(&df, &format!("phase_{ax}_rad"), i);
                 assert_eq!((h.len(), amp.len()), (ph.len(), ph.len()), "{sid} {ax}");
@@ -318,7 +319,7 @@ fn force_models_round_trip_through_parquet() {
                         .iter()
                         .zip(amp)
                         .zip(ph)
-                        .map(|((&h, &a), &p)| a * (2.0 * PI * h as f64 * tau + p).cos())
+                        .map(|((&h, &a), &p)| a * (2.0 * PI * h * tau + p).cos())
                         .sum::<f64>()
                         + poly
                             .iter()
@@ -353,5 +354,6 @@ fn force_models_round_trip_through_parquet() {
     );
 }
 
-/// One stance axis as stored: (c0, harmonics, amplitudes, phases).
-type StoredAxis = (f64, Vec<i32>, Vec<f64>, Vec<f64>, Vec<f64>);
+/// One stance axis as stored: (c0, harmonics in cycles per stance, amplitudes, phases,
+/// polynomial coefficients).
+type StoredAxis = (f64, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);

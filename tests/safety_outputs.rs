@@ -485,3 +485,81 @@ fn a_held_lock_makes_a_second_build_exit_2() {
         "the lock file is removed at the end of a build"
     );
 }
+
+// See: the review of issue 39 item 3 — `forces --per-contact --clip C --out
+// L/frames.parquet` exited 0 and the next read of L failed ("column 'ground_z_m':
+// missing"); `forces --out L/stances.parquet` broke `info`. An output that is one of the
+// library's own files (its tables, its manifest, a dataset table's folder, the folder
+// itself) is refused before any work, and the library is byte-for-byte what it was; an
+// output beside the tables (the pipelines' `runs.parquet`) is still written.
+#[test]
+fn outputs_refuse_to_replace_the_librarys_own_files() {
+    use super::util::{ok, refused};
+    let dir = tmp();
+    let lib = dir.path().join("lib");
+    let clip = fixture("run_120hz_m_yup.bvh");
+    ok(&["build", &clip, "--out", &s(&lib), "--quiet"]);
+    let before = snapshot(&lib);
+    let (l, o) = (s(&lib), |name: &str| s(&lib.join(name)));
+    let stance = "run_120hz_m_yup:R:51";
+    for args in [
+        vec![
+            "forces",
+            "--lib",
+            &l,
+            "--per-contact",
+            "--clip",
+            "run_120hz_m_yup",
+            "--out",
+            &o("frames.parquet"),
+        ],
+        vec!["forces", "--lib", &l, "--out", &o("stances.parquet")],
+        vec![
+            "query",
+            "run",
+            "--lib",
+            &l,
+            "--speed",
+            "3",
+            "--out",
+            &o("clips.parquet"),
+        ],
+        vec![
+            "query",
+            "jump",
+            "--lib",
+            &l,
+            "--height",
+            "1.3",
+            "--out",
+            &o("manifest.json"),
+        ],
+        vec![
+            "plot",
+            "stance",
+            "--lib",
+            &l,
+            "--stance",
+            stance,
+            "--out",
+            &o("contacts.parquet"),
+        ],
+        vec!["edit", "run", "--lib", &l, "--speed", "3", "--out", &l],
+        vec!["forces", "--lib", &l, "--out", &o("stances/part.parquet")],
+    ] {
+        refused(&args, &["--out", "library"]);
+    }
+    assert_eq!(snapshot(&lib), before, "the library changed");
+    ok(&["info", &l]);
+    ok(&[
+        "query",
+        "run",
+        "--lib",
+        &l,
+        "--speed",
+        "3",
+        "--out",
+        &o("runs.parquet"),
+        "--quiet",
+    ]);
+}

@@ -73,6 +73,60 @@ impl Layout {
 /// keys when read (the others are sorted by `character_id` first).
 const CLIP_ORDERED: [&str; 2] = [CLIPS_FILE, STANCES_FILE];
 
+/// Refuses an output path that is one of the library `lib`'s own files: the folder itself,
+/// `manifest.json`, a table file ([`TABLE_FILES`]) or a dataset table's folder. Those are
+/// written only by `build` and `merge`; a query, edit, plot or force export written there
+/// replaced a table (`forces --out LIB/frames.parquet` broke the next read). Other paths
+/// inside the folder stay allowed (the pipelines write their answers beside the tables).
+/// Paths are compared after resolving `..` and the symbolic links of the parts that exist.
+///
+/// # Errors
+/// `out` is the library folder or one of its tables.
+pub fn check_output_outside(lib: &Path, out: &Path) -> Result<()> {
+    let resolve = |p: &Path| -> PathBuf {
+        let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        // The deepest existing ancestor, canonicalised, with the rest appended.
+        let mut head = abs.clone();
+        let mut tail = Vec::new();
+        while !head.exists() {
+            match (head.file_name().map(|n| n.to_os_string()), head.parent()) {
+                (Some(n), Some(parent)) => {
+                    tail.push(n);
+                    head = parent.to_path_buf();
+                }
+                _ => return abs,
+            }
+        }
+        let mut r = head.canonicalize().unwrap_or(head);
+        r.extend(tail.iter().rev());
+        r
+    };
+    let (lib_r, out_r) = (resolve(lib), resolve(out));
+    let Ok(rel) = out_r.strip_prefix(&lib_r) else {
+        return Ok(());
+    };
+    let first = rel
+        .components()
+        .next()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned());
+    let owned = match first.as_deref() {
+        None => true,
+        Some(f) => f == MANIFEST_FILE || TABLE_FILES.iter().any(|t| f == *t || f == table_name(t)),
+    };
+    if owned {
+        return Err(Error::invalid(
+            "--out",
+            format!(
+                "{} is the library {}'s own file or folder, written only by `build` and \
+                 `merge`; write the output elsewhere",
+                out.display(),
+                lib.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The layout of the library at `lib` (manifest [`LAYOUT_MANIFEST_KEY`]; a folder without
 /// a readable manifest, or a manifest without the key, is a `file` library).
 ///

@@ -28,6 +28,7 @@ fn target(c: &EditCommon) -> EditTarget {
 /// Bad options, an unreadable library or source, no solvable cycle, an infeasible request
 /// (without `--allow-infeasible`), an unwritable output.
 pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
+    crate::library::layout::check_output_outside(&a.common.lib, &a.common.out)?;
     let e = RunEdit {
         target: target(&a.common),
         run: RunTarget {
@@ -49,6 +50,7 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
 /// Bad options, an unreadable library or source, no solvable pair, an infeasible request
 /// (without `--allow-infeasible`), an unwritable output.
 pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
+    crate::library::layout::check_output_outside(&a.common.lib, &a.common.out)?;
     let e = JumpEdit {
         target: target(&a.common),
         jump: JumpTarget {

@@ -53,6 +53,7 @@ fn format_of(a: &ForcesArgs) -> anyhow::Result<ForcesFormat> {
 /// Bad options (each named), an unreadable library, an unknown `--stance` id or clip
 /// (nothing is written), an unwritable output.
 pub fn run(a: ForcesArgs) -> anyhow::Result<Outcome> {
+    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
     let format = format_of(&a)?;
     crate::library::provenance::check_layout(&a.lib)?;
     if a.per_contact {

@@ -11,6 +11,7 @@ use crate::pipeline::queries::{map_jumps, MapQuery, MapReport, HIGHER_BY};
 /// # Errors
 /// Bad grid options, an unreadable library, an unwritable output folder.
 pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
+    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
     let q = MapQuery {
         lib: a.lib.clone(),
         heights: a.heights()?.values(),

@@ -16,6 +16,7 @@ use crate::pipeline::queries::{
 /// # Errors
 /// Bad options, an unreadable library, an unwritable output.
 pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
+    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
     let q = RunQuery {
         lib: a.lib.clone(),
         speeds: a.speeds()?,
@@ -93,6 +94,7 @@ pub fn print_run(report: &RunReport, out: &Path) {
 /// # Errors
 /// Bad options, an unreadable library, an unwritable output.
 pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
+    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
     anyhow::ensure!(
         a.distance_scale.is_none() || a.height_scale.is_some(),
         "--distance-scale goes with --height-scale (with --height give --distance in m)"
