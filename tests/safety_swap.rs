@@ -89,7 +89,7 @@ fn issue40_item9_reads_during_rebuilds_answer_from_one_generation_or_say_it_chan
     assert_ne!(expected[0], expected[1]);
 
     let done = AtomicBool::new(false);
-    let (reads, changed, bad) = std::thread::scope(|scope| {
+    let (reads, changed, bad, seen) = std::thread::scope(|scope| {
         scope.spawn(|| {
             for i in 0..BUILDS {
                 build(&sets[i % 2], &lib);
@@ -102,6 +102,7 @@ fn issue40_item9_reads_during_rebuilds_answer_from_one_generation_or_say_it_chan
                 let out = dir.path().join(format!("runs-{k}.parquet"));
                 scope.spawn(move || {
                     let (mut reads, mut changed, mut bad) = (0, 0, Vec::new());
+                    let mut seen = std::collections::BTreeSet::new();
                     let mut i = 0;
                     while !done.load(Ordering::SeqCst) {
                         i += 1;
@@ -127,6 +128,7 @@ fn issue40_item9_reads_during_rebuilds_answer_from_one_generation_or_say_it_chan
                         }
                         if args[1] == "info" {
                             let c = check(&stdout);
+                            seen.extend(c.filter(|c| expected.contains(c)));
                             if !c.is_some_and(|c| expected.contains(&c)) {
                                 bad.push(format!(
                                     "info: (clips, stances) {c:?}, not one of {expected:?}"
@@ -147,20 +149,27 @@ fn issue40_item9_reads_during_rebuilds_answer_from_one_generation_or_say_it_chan
                             }
                         }
                     }
-                    (reads, changed, bad)
+                    (reads, changed, bad, seen)
                 })
             })
             .collect();
         readers.into_iter().map(|r| r.join().unwrap()).fold(
-            (0, 0, Vec::new()),
-            |(a, b, mut c), (x, y, z)| {
+            (0, 0, Vec::new(), std::collections::BTreeSet::new()),
+            |(a, b, mut c, mut d), (x, y, z, w)| {
                 c.extend(z);
-                (a + x, b + y, c)
+                d.extend(w);
+                (a + x, b + y, c, d)
             },
         )
     });
     println!("{reads} reads during {BUILDS} rebuilds: {changed} said the library changed");
     assert!(reads >= 50, "only {reads} reads");
+    // The reads overlapped the swaps: `info` saw both generations (else nothing was tested).
+    assert_eq!(
+        seen.len(),
+        expected.len(),
+        "info saw only {seen:?} of {expected:?}: the reads did not overlap the rebuilds"
+    );
     assert!(
         bad.is_empty(),
         "{} inconsistent reads of {reads}:\n{}",

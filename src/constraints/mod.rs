@@ -45,7 +45,7 @@
 //!
 //! let axis = |c0: f64, amp: f64, phase: f64| AxisModel {
 //!     c0,
-//!     harmonics: vec![1],
+//!     harmonics: vec![1.0],
 //!     amps: vec![amp],
 //!     phases: vec![phase],
 //!     poly: Vec::new(),

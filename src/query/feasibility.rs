@@ -60,9 +60,9 @@
 //! use stancelib::query::feasibility::{approx, exact, relative_limits};
 //!
 //! let bell = 2.0 * 70.0 * GRAVITY;
-//! let v = AxisModel { c0: bell, harmonics: vec![1], amps: vec![bell],
+//! let v = AxisModel { c0: bell, harmonics: vec![1.0], amps: vec![bell],
 //!                     phases: vec![std::f64::consts::PI], poly: vec![], fit_rms: 0.0 };
-//! let h = AxisModel { c0: 0.0, harmonics: vec![1], amps: vec![200.0], phases: vec![0.0],
+//! let h = AxisModel { c0: 0.0, harmonics: vec![1.0], amps: vec![200.0], phases: vec![0.0],
 //!                     poly: vec![], fit_rms: 0.0 };
 //! let model = ForceModel { mass_kg: 70.0, dt_s: 0.25, axes: [h, AxisModel::constant(0.0), v] };
 //! let ctx = StanceContext { vs: 3.0, vps: 0.0, t_td: 0.1, z_td: 0.9, cp: [0.2, 0.0] };
