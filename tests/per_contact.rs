@@ -37,6 +37,25 @@ const WALKS: [(&str, bool); 3] = [
 const MATCH_TOL_S: f64 = 0.15;
 /// The plates' event threshold, N (SOURCES.md): a foot below it carries nothing.
 const PLATE_ON_N: f64 = 20.0;
+/// Targets the split does not meet, each with its reason: (walk, foot, figure, why).
+/// Printed as "KNOWN MISS"; one that starts meeting its target fails the test.
+const KNOWN_MISSES: [(&str, &str, &str, &str); 2] = [
+    (
+        "gait2354_s01_walk1",
+        "left",
+        "fore-aft RMSE",
+        GAIT2354_FORE_AFT,
+    ),
+    (
+        "gait2354_s01_walk1",
+        "right",
+        "fore-aft RMSE",
+        GAIT2354_FORE_AFT,
+    ),
+];
+const GAIT2354_FORE_AFT: &str = "the clip's knees jump where the leg is nearly straight \
+    (fixed-length two-bone IK when it was made), so its total force m(a + g) is itself \
+    0.11 BW off the plates fore-aft and no split of it reaches 0.05 (docs/forces-and-plots.md)";
 
 /// A plate event of one foot: (kind, foot index 0 left 1 right, time s).
 type PlateEvent = (&'static str, usize, f64);
@@ -323,6 +342,7 @@ fn per_contact_forces_match_each_foots_plate_on_the_walks() {
     };
     let mut out = String::new();
     let mut failures = Vec::new();
+    let mut misses = Vec::new();
     outln!(
         out,
         "per foot against its plate (SG low-passed as the COM), BW = body weight:\n  {:<24} {:<5} {:>7} {:>6} {:>8} {:>8} {:>7} {:>6}  touchdown error",
@@ -371,16 +391,9 @@ fn per_contact_forces_match_each_foots_plate_on_the_walks() {
             );
             // Issue 39 targets: vertical ≤ 0.10 BW and r ≥ 0.95; the synthetic walk ≤ 0.05.
             let vert_max = if synthetic { 0.05 } else { 0.10 };
-            // Fore-aft: the issue's 0.05 BW. gait2354's kinematic total force alone is
-            // 0.11 BW off the plates fore-aft (the treadmill walk, printed below), so its
-            // feet cannot reach it: asserted at what the split reaches there. The clip's
-            // knees jump where the leg is nearly straight (fixed-length two-bone IK when
-            // the clip was made; docs/forces-and-plots.md), stepping the COM by mm.
-            let fa_max = if clip == "gait2354_s01_walk1" {
-                0.10
-            } else {
-                0.05
-            };
+            // Fore-aft: the issue's 0.05 BW on every walk; the known misses below are
+            // printed, and fail the test once they pass (so the list stays true).
+            let fa_max = 0.05;
             // COP: 6 cm (measured 3–6 cm; a foot is about 25 cm long).
             for (what, v, ok) in [
                 ("vertical RMSE", f.vertical_bw, f.vertical_bw <= vert_max),
@@ -388,8 +401,20 @@ fn per_contact_forces_match_each_foots_plate_on_the_walks() {
                 ("fore-aft RMSE", f.fore_aft_bw, f.fore_aft_bw <= fa_max),
                 ("COP RMSE", f.cop_m, f.cop_m <= 0.06),
             ] {
-                if !ok {
-                    failures.push(format!("{clip} {side}: {what} {v:.3}"));
+                let known = KNOWN_MISSES
+                    .iter()
+                    .find(|m| m.0 == clip && m.1 == side && m.2 == what);
+                match (ok, known) {
+                    (false, None) => failures.push(format!("{clip} {side}: {what} {v:.3}")),
+                    (false, Some(m)) => misses.push(format!(
+                        "KNOWN MISS {clip} {side}: {what} {v:.3} (target {fa_max}): {}",
+                        m.3
+                    )),
+                    (true, Some(_)) => failures.push(format!(
+                        "{clip} {side}: {what} {v:.3} now meets its target: remove it from \
+                         KNOWN_MISSES"
+                    )),
+                    (true, None) => {}
                 }
             }
             if f.frames < 50 {
@@ -402,10 +427,9 @@ fn per_contact_forces_match_each_foots_plate_on_the_walks() {
             "  {clip:<24} total force m(a + g) fore-aft against the plates' total: {total:.3} BW"
         );
     }
-    outln!(
-        out,
-        "not met: fore-aft ≤ 0.05 BW on gait2354_s01_walk1 (its total force is already off by more)"
-    );
+    for m in &misses {
+        outln!(out, "{m}");
+    }
     print!("{out}");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -554,6 +578,96 @@ fn total_fore_aft(fp: &util::ForcePlateClip, table: &Path) -> f64 {
     rmse(&est, &meas) / fp.bw
 }
 
+// See: issue 39 item 3 review — "feet that stand together are split as if handing over":
+// the drop jump's two-foot landing went to the smooth transition (at 0.42 s L 21 N / R 900 N
+// where the plates read 470 / 564 N; per-foot vertical RMSE over the landing 0.46 BW). It is
+// no handover (0.75 s together): the lever rule shares it.
+#[test]
+fn per_contact_forces_share_the_drop_jumps_two_foot_landing() {
+    let Some(data) =
+        util::shared_or_skip("per_contact_forces_share_the_drop_jumps_two_foot_landing")
+    else {
+        return;
+    };
+    let clip = "opencap_s4_DJ1_dropjump";
+    let fp = util::forceplate_clip(&data, clip);
+    let dir = tempfile::tempdir().unwrap();
+    let lib = walk_library(&data, clip, fp.mass, dir.path());
+    let table = dir.path().join("per_contact.parquet");
+    util::ok(&[
+        "forces",
+        "--lib",
+        &util::s(&lib),
+        "--per-contact",
+        "--clip",
+        clip,
+        "--out",
+        &util::s(&table),
+    ]);
+    let (plates, _, _, rate) = plates_of(&fp);
+    let (time, feet) = read_rows(&table);
+    let split = Table::open(&table).unwrap().strings("split").unwrap();
+    // The two-foot landing: scored frames with both feet in contact, in the landing
+    // (before 1.3 s: the clip ends 0.12 s after the second landing).
+    let rows: Vec<(usize, usize)> = scored(&fp, &time, &feet, &plates, rate)
+        .into_iter()
+        .filter(|&(k, _)| feet[0][2][k].is_finite() && feet[1][2][k].is_finite())
+        .filter(|&(k, _)| time[k] < 1.3)
+        .collect();
+    let mut out = String::new();
+    let mut failures = Vec::new();
+    outln!(
+        out,
+        "drop jump, two-foot landing, {} frames, per foot against its plate:",
+        rows.len()
+    );
+    for (foot, side) in ["left", "right"].into_iter().enumerate() {
+        let est: Vec<f64> = rows.iter().map(|&(k, _)| feet[foot][2][k]).collect();
+        let meas: Vec<f64> = rows.iter().map(|&(_, i)| plates[foot].f[2][i]).collect();
+        let fa: Vec<f64> = rows.iter().map(|&(k, _)| feet[foot][0][k]).collect();
+        let fa_m: Vec<f64> = rows.iter().map(|&(_, i)| plates[foot].f[0][i]).collect();
+        let (v, r, f) = (
+            rmse(&est, &meas) / fp.bw,
+            pearson(&est, &meas),
+            rmse(&fa, &fa_m) / fp.bw,
+        );
+        outln!(
+            out,
+            "  {side:<5} vertical {v:.3} BW (r {r:.3}), fore-aft {f:.3} BW"
+        );
+        // Measured 0.087 / 0.087 BW (the transition: 0.46); 0.10 leaves room for a frame of
+        // event timing.
+        if v > 0.10 {
+            failures.push(format!("{side}: vertical RMSE {v:.3} BW > 0.10"));
+        }
+    }
+    let k = time
+        .iter()
+        .position(|t| (t - 0.42).abs() < 1e-6)
+        .expect("0.42 s");
+    let i = (0.42 * rate).round() as usize;
+    outln!(
+        out,
+        "  at 0.42 s ({}): L {:.0} N / R {:.0} N, plates {:.0} / {:.0} N",
+        split[k],
+        feet[0][2][k],
+        feet[1][2][k],
+        plates[0].f[2][i],
+        plates[1].f[2][i]
+    );
+    if split[k] != "lever" {
+        failures.push(format!(
+            "0.42 s split by '{}', not the lever rule",
+            split[k]
+        ));
+    }
+    if rows.len() < 50 {
+        failures.push(format!("only {} frames of the landing scored", rows.len()));
+    }
+    print!("{out}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 // See: issue 39 item 3 — "`stancelib forces --per-contact` writes per-foot force and COP
 // time series, also in OpenSim's `.mot` GRF layout": the three formats hold the same
 // rows, the feet sum to m(a + g), `--stance` keeps the stance's frames, and every option
@@ -675,7 +789,12 @@ fn per_contact_export_writes_parquet_csv_and_mot_and_refuses_what_cannot_act() {
         ),
         (
             vec!["forces", "--lib", &l, "--format", "csv", "--out", &o_csv],
-            "--per-contact",
+            "--format csv needs --per-contact",
+        ),
+        // See: issue 39 item 3 review — no --format was given: name the extension.
+        (
+            vec!["forces", "--lib", &l, "--out", &o_csv],
+            "a .csv output needs --per-contact",
         ),
         (
             vec!["forces", "--lib", &l, "--per-contact", "--out", &o],

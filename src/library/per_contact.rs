@@ -4,7 +4,7 @@
 //! Parquet or CSV table or an OpenSim `.mot` ground-reaction file.
 //!
 //! Table columns ([`per_contact_columns`]): `clip`, `frame`, `time_clip_s`, `split`
-//! (`none`, `single`, `transition`, `even`), then per effector `<e>` of
+//! (`none`, `single`, `transition`, `lever`, `even`), then per effector `<e>` of
 //! [`crate::contacts::EFFECTORS`]: `<e>_f{x,y,z}_n` (force on the body, world Z up, N) and
 //! `<e>_cop_{x,y,z}_m` (m), null where `<e>` is not in contact.
 //!
@@ -28,7 +28,7 @@ use super::schema::{clips, contacts, frames, CLIPS_FILE, CONTACTS_FILE, FRAMES_F
 use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
 use crate::force_model::per_contact::{
-    foot_cop, heading_from_velocity, split, ContactSpan, SplitOptions,
+    foot_cop, heading_from_velocity, split, ContactSpan, SplitInput, SplitOptions,
 };
 use crate::force_model::GRAVITY;
 use crate::math::v3::V3;
@@ -45,6 +45,8 @@ pub struct ContactClip {
     pub time_s: Vec<f64>,
     /// Total force on the body m(a_COM + g ẑ), world, N.
     pub total: Vec<V3>,
+    /// COM position, m.
+    pub com: Vec<V3>,
     /// SG COM velocity, m/s.
     pub com_v: Vec<V3>,
     /// Local floor, m.
@@ -81,13 +83,14 @@ fn xyz(t: &Table, names: [&str; 3]) -> Result<Vec<V3>> {
     Ok((0..x.len()).map(|i| [x[i], y[i], z[i]]).collect())
 }
 
-/// Reads `clip` from the library `lib` (frames, contacts, mass and leg length).
+/// Reads `clip` from the library `lib` (frames, contacts, mass and leg length). The
+/// caller checks the library's layout first ([`super::provenance::check_layout`]; `forces`
+/// does so once for either of its paths).
 ///
 /// # Errors
 /// A missing or malformed table or column (named with its file), a clip the library does
 /// not hold, or a clip without a mass or leg length.
 pub fn read_contact_clip(lib: &Path, clip: &str) -> Result<ContactClip> {
-    super::provenance::check_layout(lib)?;
     let path = lib.join(FRAMES_FILE);
     let t = Table::open(&path)?;
     let names = t.strings(frames::CLIP)?;
@@ -103,6 +106,7 @@ pub fn read_contact_clip(lib: &Path, clip: &str) -> Result<ContactClip> {
     let (frame, time) = (t.i64s(frames::FRAME)?, t.f64s(frames::TIME)?);
     let ground = t.f64s(frames::GROUND_Z)?;
     let acc = pick(xyz(&t, frames::COM_A)?);
+    let com = pick(xyz(&t, frames::COM)?);
     let com_v = pick(xyz(&t, frames::COM_V)?);
     let pos = |p: &str| -> Result<Vec<Option<V3>>> {
         let c: Vec<Vec<Option<f64>>> = (0..3)
@@ -138,6 +142,7 @@ pub fn read_contact_clip(lib: &Path, clip: &str) -> Result<ContactClip> {
         frame: rows.iter().map(|&i| frame[i]).collect(),
         time_s: rows.iter().map(|&i| time[i]).collect(),
         total,
+        com,
         com_v,
         ground_z: rows.iter().map(|&i| ground[i]).collect(),
         point,
@@ -202,7 +207,30 @@ pub fn contact_rows(
 ) -> ContactRows {
     let spans: Vec<ContactSpan> = c.spans.iter().map(|s| s.0).collect();
     let heading = heading_from_velocity(&c.com_v);
-    let parts = split(&c.time_s, &c.total, &heading, &spans, opts);
+    // Each contact's COP at every frame it holds (the lever rule needs them).
+    let cop: Vec<[Option<V3>; 4]> = (0..c.time_s.len())
+        .map(|k| {
+            let t = c.time_s[k];
+            std::array::from_fn(|e| {
+                let surface = c.spans.iter().find(|(s, _)| s.effector == e && s.holds(t));
+                match (surface, c.point[e][k]) {
+                    (Some(&(_, z)), Some(pt)) if e < 2 => {
+                        Some(foot_cop(pt, c.toe[e][k], c.ground_z[k], z, c.leg_scale))
+                    }
+                    (Some(&(_, z)), Some(pt)) => Some([pt[0], pt[1], z]),
+                    _ => None,
+                }
+            })
+        })
+        .collect();
+    let input = SplitInput {
+        time_s: &c.time_s,
+        total: &c.total,
+        heading: &heading,
+        com: &c.com,
+        cop: &cop,
+    };
+    let parts = split(&input, &spans, opts);
     let mut out = ContactRows {
         clip: c.clip.clone(),
         ..Default::default()
@@ -214,26 +242,9 @@ pub fn contact_rows(
         out.frame.push(c.frame[k]);
         out.time_s.push(c.time_s[k]);
         out.split.push(p.rule.as_str());
-        let t = c.time_s[k];
-        for e in 0..4 {
-            let surface = c
-                .spans
-                .iter()
-                .find(|(s, _)| {
-                    s.effector == e
-                        && s.td_s.is_none_or(|a| a <= t)
-                        && s.lo_s.is_none_or(|b| t <= b)
-                })
-                .map(|s| s.1);
-            let cop = match (p.force[e], surface, c.point[e][k]) {
-                (Some(_), Some(z), Some(pt)) if e < 2 => {
-                    Some(foot_cop(pt, c.toe[e][k], c.ground_z[k], z, c.leg_scale))
-                }
-                (Some(_), Some(z), Some(pt)) => Some([pt[0], pt[1], z]),
-                _ => None,
-            };
+        for (e, c) in cop[k].iter().enumerate() {
             out.force[e].push(p.force[e]);
-            out.cop[e].push(cop);
+            out.cop[e].push(p.force[e].and(*c));
         }
     }
     out
@@ -284,15 +295,29 @@ fn num(v: Option<f64>) -> String {
     v.map_or(String::new(), |x| format!("{x:.6}"))
 }
 
+/// A CSV field quoted as RFC 4180 asks: in double quotes (each inner quote doubled) when
+/// it holds a comma, a quote, CR or LF; as it is otherwise.
+pub fn csv_field(v: &str) -> std::borrow::Cow<'_, str> {
+    if v.contains([',', '"', '\r', '\n']) {
+        format!("\"{}\"", v.replace('"', "\"\"")).into()
+    } else {
+        v.into()
+    }
+}
+
 /// The rows as CSV text (header [`per_contact_columns`]; empty cells for nulls; six
-/// decimals).
+/// decimals; text fields quoted per RFC 4180 where they need it, [`csv_field`]).
 pub fn per_contact_csv(r: &ContactRows) -> String {
     let mut s = per_contact_columns().join(",");
     s.push('\n');
+    let clip = csv_field(&r.clip);
     for k in 0..r.frame.len() {
         let mut line = format!(
             "{},{},{:.6},{}",
-            r.clip, r.frame[k], r.time_s[k], r.split[k]
+            clip,
+            r.frame[k],
+            r.time_s[k],
+            csv_field(r.split[k])
         );
         for e in 0..4 {
             for v in [&r.force[e], &r.cop[e]] {
@@ -422,6 +447,28 @@ mod tests {
         assert_eq!(lines[0].split(',').count(), per_contact_columns().len());
         assert!(lines[1].starts_with("c,3,0.030000,single,1.000000,2.000000,3.000000,0.500000"));
         assert!(lines[2].ends_with(",,,"));
+        let df = per_contact_table(&rows()).unwrap();
+        assert_eq!(df.width(), per_contact_columns().len());
+    }
+
+    // See: issue 39 item 3 review — "CSV output does not quote fields": a clip named
+    // `walk,"1"` gave rows of 53 fields under a 52-column header.
+    #[test]
+    fn the_csv_quotes_a_clip_name_with_a_comma_or_quote() {
+        let mut r = rows();
+        r.clip = "walk,\"1\"".into();
+        let c = per_contact_csv(&r);
+        let line = c.lines().nth(1).unwrap();
+        assert!(
+            line.starts_with("\"walk,\"\"1\"\"\",3,0.030000,single,"),
+            "{line}"
+        );
+        // Unquoted, the fields are the header's.
+        let unquoted = line.replacen("\"walk,\"\"1\"\"\"", "w", 1);
+        assert_eq!(unquoted.split(',').count(), per_contact_columns().len());
+        assert_eq!(csv_field("a\nb"), "\"a\nb\"");
+        assert_eq!(csv_field("a\rb"), "\"a\rb\"");
+        assert_eq!(csv_field("plain"), "plain");
         let df = per_contact_table(&rows()).unwrap();
         assert_eq!(df.width(), per_contact_columns().len());
         assert_eq!(df.height(), 2);

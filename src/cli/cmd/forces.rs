@@ -38,10 +38,12 @@ fn format_of(a: &ForcesArgs) -> anyhow::Result<ForcesFormat> {
             anyhow::bail!("--clip {c} needs --per-contact (the stance models are per stance)");
         }
         if format != ForcesFormat::Parquet {
-            anyhow::bail!(
-                "--format {} needs --per-contact (the stance models are written as Parquet)",
-                format.as_str()
-            );
+            // Name what the user gave: the option, or only the extension.
+            let what = match a.format {
+                Some(f) => format!("--format {}", f.as_str()),
+                None => format!("a .{} output", format.as_str()),
+            };
+            anyhow::bail!("{what} needs --per-contact (the stance models are written as Parquet)");
         }
     }
     Ok(format)
@@ -55,6 +57,7 @@ fn format_of(a: &ForcesArgs) -> anyhow::Result<ForcesFormat> {
 pub fn run(a: ForcesArgs) -> anyhow::Result<Outcome> {
     crate::library::layout::check_output_outside(&a.lib, &a.out)?;
     let format = format_of(&a)?;
+    // Once for both paths (`read_contact_clip` leaves it to its caller).
     crate::library::provenance::check_layout(&a.lib)?;
     if a.per_contact {
         return run_per_contact(&a, format);
@@ -101,9 +104,14 @@ fn run_per_contact(a: &ForcesArgs, format: ForcesFormat) -> anyhow::Result<Outco
     let c =
         read_contact_clip(&a.lib, &clip).with_context(|| format!("library {}", a.lib.display()))?;
     let rows = contact_rows(&c, range, &SplitOptions::default());
-    if let Some(dir) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    }
+    // `write_table` creates the output's folder; the text formats do it here.
+    let write_text = |text: String| -> anyhow::Result<()> {
+        if let Some(dir) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+        }
+        Ok(write_text_atomic(&a.out, &text)?)
+    };
     match format {
         ForcesFormat::Parquet => {
             let mut df = per_contact_table(&rows)?;
@@ -116,22 +124,24 @@ fn run_per_contact(a: &ForcesArgs, format: ForcesFormat) -> anyhow::Result<Outco
             )?;
             write_table(&a.out, &mut df, &kv)?;
         }
-        ForcesFormat::Csv => write_text_atomic(&a.out, &per_contact_csv(&rows))?,
+        ForcesFormat::Csv => write_text(per_contact_csv(&rows))?,
         ForcesFormat::Mot => {
             let name = a
                 .out
                 .file_stem()
                 .and_then(|s| s.to_str())
                 .unwrap_or("ground_reactions");
-            write_text_atomic(&a.out, &per_contact_mot(&rows, name))?;
+            write_text(per_contact_mot(&rows, name))?;
         }
     }
-    let shared = rows.split.iter().filter(|s| **s == "transition").count();
+    let count = |rule: &str| rows.split.iter().filter(|s| **s == rule).count();
     crate::say!(
-        "forces --per-contact: clip {}, {} frame(s), {} in double support → {} ({})",
+        "forces --per-contact: clip {}, {} frame(s), {} handing over, {} by the lever rule, {} even → {} ({})",
         clip,
         rows.frame.len(),
-        shared,
+        count("transition"),
+        count("lever"),
+        count("even"),
         a.out.display(),
         format.as_str()
     );
