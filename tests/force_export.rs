@@ -10,7 +10,7 @@ use stancelib::force_model::export::StanceTimes;
 use stancelib::library::forces::{read_force_stances, read_up_axis, FORCES_COLUMNS};
 use stancelib::library::plates::PlateFoot;
 use stancelib::library::read::Table;
-use stancelib::pipeline::plots::read_plates;
+use stancelib::pipeline::commands::plots::read_plates;
 use stancelib::plot::stance::STANCE_PLOT_PX;
 use stancelib::skeleton::units::UpAxis;
 

@@ -267,7 +267,7 @@ fn issue40_item11_per_character_map_files_are_one_per_id_and_fit_a_file_name() {
             .map(|id| {
                 format!(
                     "jump_map_{}.png",
-                    stancelib::pipeline::queries::file_safe(id)
+                    stancelib::pipeline::commands::queries::file_safe(id)
                 )
             })
             .collect();

@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::inputs::{read_side_text, SideInput};
 use crate::force_model::export::{kinematic_force, sample_forces};
 use crate::library::clip_view::{read_clip_view, ClipView};
 use crate::library::forces::{
@@ -14,6 +13,7 @@ use crate::library::forces::{
 };
 use crate::library::plates::{parse_plates, PlateFoot, PlateSample};
 use crate::library::schema::{CLIPS_FILE, FRAMES_FILE, STANCES_FILE};
+use crate::pipeline::engine::inputs::{read_side_text, SideInput};
 use crate::plot::stance::{stance_png, time_window, StancePlot, WorldForces};
 use crate::plot::write_png;
 use crate::skeleton::units::UpAxis;

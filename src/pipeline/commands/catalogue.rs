@@ -191,7 +191,7 @@ fn characters(
 }
 
 /// Every run cycle, with its verdict at its own speed as `query run --speed v_orig` gives
-/// it with default options (`crate::pipeline::queries::run_query` at `L = M = 1`).
+/// it with default options (`crate::pipeline::commands::query_run::run_query` at `L = M = 1`).
 fn cycles(lib: &StanceLibrary) -> Vec<CatalogueCycle> {
     let active = DEFAULT_QUERY_ACTIVE_FRACTION;
     let all = run_cycles(&lib.stances);
