@@ -4,7 +4,8 @@
 
 use std::collections::BTreeMap;
 
-use stancelib::library::read::{open_library, read_stances, Table};
+use stancelib::library::read::{open_library, read_stances};
+use stancelib::library::table::Table;
 use stancelib::pipeline::commands::catalogue::catalogue;
 use stancelib::query::jump::recorded_jump;
 

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use stancelib::library::read::Table;
+use stancelib::library::table::Table;
 use stancelib::pipeline::engine::inputs::discover;
 use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::query::jump::{is_landing, is_liftoff, recorded_jump};

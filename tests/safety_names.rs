@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use polars::prelude::*;
 use stancelib::library::layout::file_kv;
 use stancelib::library::manifest::MAX_MANIFEST_BYTES;
-use stancelib::library::read::read_parquet;
+use stancelib::library::table::read_parquet;
 use stancelib::library::write::write_atomic;
 
 use crate::util::{fixture_clips, fixture_library, ok, refused, reseal, root, s, stancelib};

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use stancelib::library::read::read_parquet;
+use stancelib::library::table::read_parquet;
 
 use super::cli::{fixture, good_fixtures, stancelib, strings, tmp};
 

@@ -277,7 +277,7 @@ fn row_groups_hold_64_ki_rows_whatever_the_batches() {
 /// Per row group of `path`: the one value of each column of `names` (an error, so a
 /// failure, where a group holds more than one).
 fn group_values(path: &Path, names: &[&str]) -> Vec<Vec<String>> {
-    let mut r = stancelib::library::row_groups::GroupFileReader::open(path).unwrap();
+    let mut r = stancelib::library::group_reader::GroupFileReader::open(path).unwrap();
     let mut out = Vec::new();
     loop {
         let values: Vec<Option<Vec<u8>>> = names.iter().map(|n| r.peek_value(n).unwrap()).collect();
@@ -316,7 +316,7 @@ fn per_clip_tables_hold_a_row_group_per_clip() {
     let d = tmp();
     let out = d.path().join("lib");
     streamed(&fixture_inputs(), &out, 2, 2);
-    let clips = stancelib::library::read::read_parquet(&out.join("clips.parquet")).unwrap();
+    let clips = stancelib::library::table::read_parquet(&out.join("clips.parquet")).unwrap();
     let with_frames: Vec<String> = clips_with_frames(&clips)
         .into_iter()
         .map(|(_, c)| c)
@@ -397,7 +397,7 @@ fn two_fixture_shards() -> (tempfile::TempDir, PathBuf, PathBuf) {
 fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
     let (d, a, b) = two_fixture_shards();
     let clips_path = b.join("clips.parquet");
-    let mut clips = stancelib::library::read::read_parquet(&clips_path).unwrap();
+    let mut clips = stancelib::library::table::read_parquet(&clips_path).unwrap();
     let (last, name) = clips_with_frames(&clips)
         .pop()
         .expect("a clip with frames in shard 2");

@@ -48,7 +48,6 @@ use rayon::prelude::*;
 
 use super::row_groups::{encode, EncodedGroup, GroupFileWriter, GroupSchema};
 use super::scratch::{scratch_name, Scratch};
-use super::write::ROW_GROUP_ROWS;
 use crate::error::{Error, Result};
 
 /// A Parquet table being written under a temporary name in its folder; renamed into place
@@ -346,7 +345,7 @@ fn footer_entries(
             f.dtype = ArrowDataType::Utf8;
         }
     }
-    let (key, value) = super::write::arrow_schema_entry(&arrow, kv);
+    let (key, value) = arrow_schema_entry(&arrow, kv);
     let mut meta: Vec<KeyValue> = Vec::with_capacity(kv.len() + 1);
     meta.push(KeyValue {
         key,
@@ -656,7 +655,7 @@ impl TableWriter {
     }
 
     /// Append `g`, a row group of the same table (a shard's, read by
-    /// [`super::row_groups::GroupFileReader`]) after the rows pushed so far, as it is: its
+    /// [`super::group_reader::GroupFileReader`]) after the rows pushed so far, as it is: its
     /// pages are not decoded. Only when no rows wait for their group.
     ///
     /// # Errors
@@ -731,6 +730,55 @@ pub fn read_rows(path: &Path, offset: usize, len: usize) -> Result<DataFrame> {
         .with_slice(Some((offset, len)))
         .finish()
         .map_err(|e| io(path, "cannot read parquet", e))
+}
+
+/// Rows per Parquet row group.
+pub const ROW_GROUP_ROWS: usize = 65_536;
+
+/// The `ARROW:schema` key-value entry of `schema` (an Arrow schema of the oldest
+/// compatibility level) whose schema metadata is `kv` itself.
+///
+/// pyarrow takes `read_table(f).schema.metadata` from this Arrow schema, not from the
+/// file's key-value list, so the `stancelib.*` keys go into both.
+pub(crate) fn arrow_schema_entry(
+    schema: &polars_arrow::datatypes::ArrowSchema,
+    kv: &[(String, String)],
+) -> (String, String) {
+    use polars_arrow::io::ipc::write::{default_ipc_fields, schema_to_bytes};
+    let meta: polars_arrow::datatypes::Metadata = kv
+        .iter()
+        .map(|(k, v)| (PlSmallStr::from_str(k), PlSmallStr::from_str(v)))
+        .collect();
+    let ipc = schema_to_bytes(
+        schema,
+        &default_ipc_fields(schema.iter_values()),
+        Some(&meta),
+    );
+    // The legacy IPC framing Arrow readers expect: continuation marker, length, message.
+    let mut framed = Vec::with_capacity(ipc.len() + 8);
+    framed.extend_from_slice(&[255, 255, 255, 255]);
+    framed.extend_from_slice(&(ipc.len() as u32).to_le_bytes());
+    framed.extend_from_slice(&ipc);
+    ("ARROW:schema".to_string(), base64(&framed))
+}
+
+/// Standard base64 with padding (RFC 4648 §4), as the `ARROW:schema` value is written.
+pub(crate) fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for c in bytes.chunks(3) {
+        let n = (u32::from(c[0]) << 16)
+            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+            | u32::from(*c.get(2).unwrap_or(&0));
+        for (i, shift) in [18, 12, 6, 0].into_iter().enumerate() {
+            if i <= c.len() {
+                out.push(char::from(A[((n >> shift) & 63) as usize]));
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -151,7 +151,7 @@ fn a_long_clip_name_keeps_whole_statistics() {
     let mut w = TableWriter::create(d.path(), name, &df.clear()).unwrap();
     w.push(&df).unwrap();
     w.finish(&[]).unwrap();
-    let mut r = super::super::row_groups::GroupFileReader::open(&d.path().join(name)).unwrap();
+    let mut r = super::super::group_reader::GroupFileReader::open(&d.path().join(name)).unwrap();
     assert_eq!(r.peek_value("clip").unwrap(), Some(long.into_bytes()));
 }
 
@@ -174,7 +174,7 @@ fn a_pushed_group_equals_its_rows() {
     let mut w = TableWriter::create(&rows, name, &df.clear()).unwrap();
     w.push(&df).unwrap();
     w.finish(&[]).unwrap();
-    let open = || super::super::row_groups::GroupFileReader::open(&rows.join(name)).unwrap();
+    let open = || super::super::group_reader::GroupFileReader::open(&rows.join(name)).unwrap();
     let mut r = open();
     let mut w = TableWriter::create(&groups, name, &df.clear()).unwrap();
     w.push(&df.slice(0, 2)).unwrap();

@@ -424,7 +424,7 @@ pub fn clip_character(
 ) -> Option<String> {
     let has = |id: &str| all.keys().any(|(c, _)| c == id);
     let sha = crate::pipeline::engine::inputs::file_sha256(clip);
-    let clips = crate::library::read::Table::open_columns(
+    let clips = crate::library::table::Table::open_columns(
         &lib.join(crate::library::schema::CLIPS_FILE),
         &["content_sha256", "character_id"],
     )

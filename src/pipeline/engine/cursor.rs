@@ -9,10 +9,10 @@ use polars::prelude::*;
 use super::tables::strings;
 use crate::error::{Error, Result};
 use crate::library::layout::{locate_path, read_source, TableSource};
-use crate::library::read::parquet_rows;
 use crate::library::schema::frames;
 use crate::library::stream::read_rows;
-use crate::library::write::ROW_GROUP_ROWS;
+use crate::library::stream::ROW_GROUP_ROWS;
+use crate::library::table::parquet_rows;
 
 /// A table sorted by clip, read forward in clip order: the rows of a range of clips at a
 /// time, never the whole file (the last row group read is kept, as the next range of

@@ -32,18 +32,18 @@ use super::sink::{Defer, Detached, LibrarySink};
 use super::streaming::replace_library;
 use super::tables::Tables;
 use crate::error::{Error, Result};
+use crate::library::group_reader::GroupFileReader;
 use crate::library::integrity::{check_table, recorded_digests, Digests};
 use crate::library::layout::sorted;
 use crate::library::layout::{locate, table_exists, Layout};
-use crate::library::read::read_parquet;
-use crate::library::row_groups::GroupFileReader;
 use crate::library::schema::sort_keys;
 use crate::library::schema::{
     group_column, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, STANCES_FILE,
 };
 use crate::library::stream::TableWriter;
-use crate::library::write::ROW_GROUP_ROWS;
+use crate::library::stream::ROW_GROUP_ROWS;
+use crate::library::table::read_parquet;
 
 /// What a merge wrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -434,7 +434,7 @@ fn copy_groups(
 /// A `dataset` shard's samples are read partition by partition.
 fn push_samples(sink: &mut LibrarySink, lib: &Path) -> Result<()> {
     for path in locate(lib, KINEMATICS_SAMPLES_FILE)?.files() {
-        let total = crate::library::read::parquet_rows(&path)?;
+        let total = crate::library::table::parquet_rows(&path)?;
         let mut at = 0;
         while at < total {
             let rows = crate::library::stream::read_rows(&path, at, ROW_GROUP_ROWS)?;

@@ -30,6 +30,7 @@ use rayon::prelude::*;
 
 use super::tables::{cast_like, pe, strings, Tables};
 use crate::error::{Error, Result};
+use crate::library::group_reader::GroupFileReader;
 use crate::library::integrity::{
     add_clip_rows, library_digests, ClipRows, CLIP_ROWS_KEY, TABLES_KEY,
 };
@@ -37,7 +38,6 @@ use crate::library::kinematics::{
     add_character_legs, facets_table, points_frame, samples_table, Facet, PointRows, Sample,
 };
 use crate::library::layout::{convert_to_dataset, Layout};
-use crate::library::row_groups::GroupFileReader;
 use crate::library::schema::{
     clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, KINEMATICS_FILE,
     KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX,
@@ -50,7 +50,8 @@ use crate::library::schema::{
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::spill::SampleSpill;
 use crate::library::stream::TableWriter;
-use crate::library::write::{write_atomic, ROW_GROUP_ROWS};
+use crate::library::stream::ROW_GROUP_ROWS;
+use crate::library::write::write_atomic;
 use crate::stances::limits::{group_facts, limits, ClipFacts, StanceFacts};
 use crate::twopac::hull::{HullOptions, StreamedHull};
 use crate::twopac::kinematic::OutlierRule;

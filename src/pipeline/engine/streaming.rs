@@ -51,10 +51,10 @@ use crate::library::integrity::{
 };
 use crate::library::layout::Layout;
 use crate::library::provenance::library_layout;
-use crate::library::read::read_parquet;
 use crate::library::schema::{clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION};
 use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{first_non_finite, ErrorRow};
+use crate::library::table::read_parquet;
 use crate::library::{ClipRecord, ClipStatus, Status};
 use crate::stances::build::StanceNote;
 use crate::stances::{build_clip, Stance, StanceOptions};
