@@ -283,7 +283,7 @@ impl Error {
 }
 
 /// Why an input cannot be read; every variant that comes from the system keeps its
-/// error (the OS reason). Found by `pipeline::inputs` (the only place that inspects
+/// error (the OS reason). Found by `pipeline::engine::inputs` (the only place that inspects
 /// inputs), for BVH clips and side inputs alike.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

@@ -4,8 +4,9 @@
 
 use std::collections::BTreeMap;
 
-use stancelib::library::read::{open_library, read_stances, Table};
-use stancelib::pipeline::catalogue::catalogue;
+use stancelib::library::read::{open_library, read_stances};
+use stancelib::library::table::Table;
+use stancelib::pipeline::commands::catalogue::catalogue;
 use stancelib::query::jump::recorded_jump;
 
 use crate::util::{first_stance_ids, fixture_library, ok, refused, s, string_at};

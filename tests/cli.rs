@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use stancelib::library::read::read_parquet;
 use stancelib::library::schema::{CLIPS_COLUMNS, CONTACTS_COLUMNS};
+use stancelib::library::table::read_parquet;
 
 pub(super) use crate::util::{root, stancelib};
 
@@ -218,9 +218,9 @@ fn every_pipeline_file_parses() {
         .collect();
     assert!(files.len() >= 2);
     for f in files {
-        let p = stancelib::pipeline::inputs::read_pipeline(&f).unwrap_or_else(|e| panic!("{e}"));
+        let p = stancelib::pipeline::spec::read_pipeline(&f).unwrap_or_else(|e| panic!("{e}"));
         if let Some(b) = &p.body {
-            stancelib::pipeline::inputs::read_body(&stancelib::pipeline::spec::relative_to(&f, b))
+            stancelib::pipeline::spec::read_body(&stancelib::pipeline::spec::relative_to(&f, b))
                 .unwrap();
         }
     }

@@ -11,7 +11,7 @@ use super::edit_motion::{
     fixture, library, measure, read_plan, recorded_jump_against_source,
 };
 use super::util::{ok, refused, s, shared_or_skip};
-use stancelib::library::read::read_parquet;
+use stancelib::library::table::read_parquet;
 use std::path::{Path, PathBuf};
 
 // See: issue 14 item 3 — "iterate root correction and leg IK until the COM error is below
@@ -553,7 +553,7 @@ fn issue37_item5_edit_run_contact_time_and_cadence_are_the_querys() {
             &s(&q),
             "--quiet",
         ]);
-        let t = stancelib::library::read::Table::open(&q).unwrap();
+        let t = stancelib::library::table::Table::open(&q).unwrap();
         let row = super::util::first_stance_ids(&t)
             .iter()
             .position(|x| *x == id)

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use stancelib::bvh::parse_file;
 use stancelib::edit::rotation::{angle_deg, from_euler, Quat};
 use stancelib::ingest::{ClipFrames, ClipSummary, ContactRun, IngestOptions};
-use stancelib::library::read::{open_library, read_parquet};
+use stancelib::library::read::open_library;
+use stancelib::library::table::read_parquet;
 use stancelib::query::run::run_cycles;
 use stancelib::skeleton::Skeleton;
 use stancelib::stances::segment::Boundary;
@@ -959,7 +960,7 @@ fn edited_runs_follow_the_gait_law_of_the_query() {
             q.to_str().unwrap(),
             "--quiet",
         ]);
-        let t = stancelib::library::read::Table::open(&q).unwrap();
+        let t = stancelib::library::table::Table::open(&q).unwrap();
         let row = super::util::first_stance_ids(&t)
             .iter()
             .position(|x| *x == id)

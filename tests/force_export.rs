@@ -7,10 +7,10 @@ use crate::util::{fixture_library, ok, s, shared_or_skip, stancelib};
 use std::path::{Path, PathBuf};
 
 use stancelib::force_model::export::StanceTimes;
+use stancelib::ingest::plates::PlateFoot;
 use stancelib::library::forces::{read_force_stances, read_up_axis, FORCES_COLUMNS};
-use stancelib::library::plates::PlateFoot;
-use stancelib::library::read::Table;
-use stancelib::pipeline::plots::read_plates;
+use stancelib::library::table::Table;
+use stancelib::pipeline::commands::plots::read_plates;
 use stancelib::plot::stance::STANCE_PLOT_PX;
 use stancelib::skeleton::units::UpAxis;
 

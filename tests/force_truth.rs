@@ -8,8 +8,8 @@ use std::path::PathBuf;
 
 use polars::prelude::*;
 use stancelib::ingest::DEFAULT_MASS_KG;
-use stancelib::library::read::read_parquet;
-use stancelib::pipeline::build::{build, write_library, BuildOptions};
+use stancelib::library::table::read_parquet;
+use stancelib::pipeline::engine::streaming::{build, write_library, BuildOptions};
 use stancelib::stances::Stance;
 use stancelib::synth::{SynthClip, SynthMotion};
 

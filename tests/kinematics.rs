@@ -3,10 +3,10 @@
 
 use std::collections::BTreeMap;
 
-use stancelib::library::read::Table;
-use stancelib::pipeline::batch::discover;
-use stancelib::pipeline::build::{build_and_write, BuildOptions};
-use stancelib::pipeline::twopac::read_polytopes;
+use stancelib::library::table::Table;
+use stancelib::pipeline::commands::twopac::read_polytopes;
+use stancelib::pipeline::engine::inputs::discover;
+use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 
 use crate::util::shared_or_skip;
 

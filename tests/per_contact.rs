@@ -21,7 +21,7 @@ use stancelib::contacts::detect::PointTrack;
 use stancelib::contacts::raw_speed;
 use stancelib::contacts::walking::{self, DEFAULT_WALK_LO_RATIO, DEFAULT_WALK_TD_RATIO};
 use stancelib::ingest::IngestOptions;
-use stancelib::library::read::Table;
+use stancelib::library::table::Table;
 use stancelib::math::savgol::{window_for_rate, SavGol};
 
 use crate::forceplate::pearson;

@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use stancelib::library::read::Table;
-use stancelib::pipeline::batch::discover;
-use stancelib::pipeline::build::{build_and_write, BuildOptions};
+use stancelib::library::table::Table;
+use stancelib::pipeline::engine::inputs::discover;
+use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::query::jump::{is_landing, is_liftoff, recorded_jump};
 
 use crate::util::{first_stance_ids, ok, shared_or_skip, stancelib, string_at};
@@ -489,7 +489,7 @@ fn running_stances_are_feasible_as_recorded() {
     // sides, asked for its own speed (the run policy at k = 1: the identity), passes the
     // exact check at μ = 0.7 with its character's absolute limits and the queries' default
     // active set; target ≥ 85 % (54 % with the Fourier model).
-    use stancelib::pipeline::queries::load_pool;
+    use stancelib::pipeline::commands::queries::load_pool;
     use stancelib::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
     use stancelib::query::limits::{absolute_limits, stance_limits};
     use stancelib::query::run::{policy_request, scale_and_check};

@@ -36,7 +36,7 @@ fn pyarrow_and_duckdb_read_the_library() {
     crate::util::ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     // Independent counts from our side: stances per clip from the in-process build.
     let files: Vec<std::path::PathBuf> = args[1..4].iter().map(std::path::PathBuf::from).collect();
-    let report = stancelib::pipeline::build::build(&files, &Default::default());
+    let report = stancelib::pipeline::engine::streaming::build(&files, &Default::default());
     let n_stances = report.stances.len();
     let first = &report.stances[0];
     let script = format!(

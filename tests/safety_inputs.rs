@@ -102,7 +102,8 @@ fn savgol_memory_bomb_short_frame_time_is_a_per_clip_error() {
     let dir = tempfile::tempdir().unwrap();
     let bad = write_temp(dir.path(), "fast.bvh", &text);
     let good = fixture("run_30hz_in_yup.bvh");
-    let recs = stancelib::pipeline::batch::ingest_all(&[bad, good], &IngestOptions::default());
+    let recs =
+        stancelib::pipeline::engine::batch::ingest_all(&[bad, good], &IngestOptions::default());
     let by = |c: &str| recs.iter().find(|r| r.clip.contains(c)).unwrap();
     assert_eq!(by("fast").status, Status::Error);
     assert_eq!(by("fast").error_stage, Some("frames"));
@@ -185,7 +186,7 @@ fn silent_nan_offsets_scaled_by_1e155_are_a_per_clip_error() {
     }
     let dir = tempfile::tempdir().unwrap();
     let bad = write_temp(dir.path(), "huge.bvh", &text);
-    let recs = stancelib::pipeline::batch::ingest_all(&[bad], &IngestOptions::default());
+    let recs = stancelib::pipeline::engine::batch::ingest_all(&[bad], &IngestOptions::default());
     assert_eq!(recs[0].status, Status::Error);
     let msg = recs[0].message.as_deref().unwrap();
     assert!(msg.contains("non-finite rest-pose leg length"), "{msg}");

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use polars::prelude::*;
 use stancelib::library::layout::file_kv;
 use stancelib::library::manifest::MAX_MANIFEST_BYTES;
-use stancelib::library::read::read_parquet;
+use stancelib::library::table::read_parquet;
 use stancelib::library::write::write_atomic;
 
 use crate::util::{fixture_clips, fixture_library, ok, refused, reseal, root, s, stancelib};
@@ -267,7 +267,7 @@ fn issue40_item11_per_character_map_files_are_one_per_id_and_fit_a_file_name() {
             .map(|id| {
                 format!(
                     "jump_map_{}.png",
-                    stancelib::pipeline::queries::file_safe(id)
+                    stancelib::pipeline::commands::queries::file_safe(id)
                 )
             })
             .collect();

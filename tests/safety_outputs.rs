@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use stancelib::library::read::read_parquet;
+use stancelib::library::table::read_parquet;
 
 use super::cli::{fixture, good_fixtures, stancelib, strings, tmp};
 
@@ -358,7 +358,7 @@ fn a_file_over_the_size_limit_is_a_per_input_error() {
     clips_in(&clips, 1);
     // Sparse: no disk space, no read (the size is refused before the file is opened).
     let big = std::fs::File::create(clips.join("huge.bvh")).unwrap();
-    big.set_len(stancelib::pipeline::batch::MAX_BVH_BYTES + 1)
+    big.set_len(stancelib::pipeline::engine::inputs::MAX_BVH_BYTES + 1)
         .unwrap();
     let out = d.path().join("out");
     let (code, _, err) = frames(&[&clips], &out);

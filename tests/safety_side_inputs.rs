@@ -12,8 +12,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::util::{fixture_clips, fixture_library, root, s};
-use stancelib::library::read::Table;
-use stancelib::pipeline::inputs::{
+use stancelib::library::table::Table;
+use stancelib::pipeline::engine::inputs::{
     SideInput, MAX_BVH_BYTES, MAX_JSON_BYTES, MAX_PLATES_BYTES, MAX_POINTS_BYTES, MAX_TOML_BYTES,
 };
 

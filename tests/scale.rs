@@ -5,9 +5,11 @@
 
 use std::path::{Path, PathBuf};
 
-use stancelib::pipeline::build::{build, build_into, write_library, BuildOptions, BuildPlan};
-use stancelib::pipeline::output::OutputRules;
-use stancelib::pipeline::shard::{shard_of, Shard};
+use stancelib::pipeline::engine::output::OutputRules;
+use stancelib::pipeline::engine::shard::{shard_of, Shard};
+use stancelib::pipeline::engine::streaming::{
+    build, build_into, write_library, BuildOptions, BuildPlan,
+};
 
 use super::util::{root, s, shared_or_skip, stable_manifest, stancelib};
 
@@ -18,14 +20,14 @@ fn tmp() -> tempfile::TempDir {
 /// Every fixture clip, the malformed ones of `fixtures/bvh/bad` too (their error rows
 /// must merge as well).
 fn fixture_inputs() -> Vec<PathBuf> {
-    stancelib::pipeline::batch::discover(&[root().join("fixtures/bvh")]).unwrap()
+    stancelib::pipeline::engine::inputs::discover(&[root().join("fixtures/bvh")]).unwrap()
 }
 
 /// `n` real clips of the bulk CMU set (every `step`-th, so several subjects), or `None`
 /// (skipped outside CI) when the shared data is absent.
 pub(super) fn real_subset(test: &str, n: usize) -> Option<Vec<PathBuf>> {
     let data = shared_or_skip(test)?;
-    let all = stancelib::pipeline::batch::discover(&[data.join("bvh-bulk/cmu")]).unwrap();
+    let all = stancelib::pipeline::engine::inputs::discover(&[data.join("bvh-bulk/cmu")]).unwrap();
     let step = (all.len() / n).max(1);
     Some(all.into_iter().step_by(step).take(n).collect())
 }
@@ -201,7 +203,8 @@ fn a_streaming_build_does_not_depend_on_batch_size_or_threads() {
 #[test]
 fn a_streamed_frames_run_equals_one_batch_of_every_clip() {
     use stancelib::ingest::IngestOptions;
-    use stancelib::pipeline::batch::{frames_into, ingest_all};
+    use stancelib::pipeline::commands::frames::frames_into;
+    use stancelib::pipeline::engine::batch::ingest_all;
     let mut files = fixture_inputs();
     if let Some(real) = real_subset("a_streamed_frames_run_equals_one_batch", 6) {
         files.extend(real);
@@ -274,7 +277,7 @@ fn row_groups_hold_64_ki_rows_whatever_the_batches() {
 /// Per row group of `path`: the one value of each column of `names` (an error, so a
 /// failure, where a group holds more than one).
 fn group_values(path: &Path, names: &[&str]) -> Vec<Vec<String>> {
-    let mut r = stancelib::library::row_groups::GroupFileReader::open(path).unwrap();
+    let mut r = stancelib::library::group_reader::GroupFileReader::open(path).unwrap();
     let mut out = Vec::new();
     loop {
         let values: Vec<Option<Vec<u8>>> = names.iter().map(|n| r.peek_value(n).unwrap()).collect();
@@ -313,7 +316,7 @@ fn per_clip_tables_hold_a_row_group_per_clip() {
     let d = tmp();
     let out = d.path().join("lib");
     streamed(&fixture_inputs(), &out, 2, 2);
-    let clips = stancelib::library::read::read_parquet(&out.join("clips.parquet")).unwrap();
+    let clips = stancelib::library::table::read_parquet(&out.join("clips.parquet")).unwrap();
     let with_frames: Vec<String> = clips_with_frames(&clips)
         .into_iter()
         .map(|(_, c)| c)
@@ -394,7 +397,7 @@ fn two_fixture_shards() -> (tempfile::TempDir, PathBuf, PathBuf) {
 fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
     let (d, a, b) = two_fixture_shards();
     let clips_path = b.join("clips.parquet");
-    let mut clips = stancelib::library::read::read_parquet(&clips_path).unwrap();
+    let mut clips = stancelib::library::table::read_parquet(&clips_path).unwrap();
     let (last, name) = clips_with_frames(&clips)
         .pop()
         .expect("a clip with frames in shard 2");
@@ -640,7 +643,7 @@ fn an_incremental_shard_rebuilds_only_its_missing_clips() {
     let bad = root().join("fixtures/bvh/bad");
     let good_in_shard: Vec<&PathBuf> = inputs
         .iter()
-        .filter(|p| !p.starts_with(&bad) && stancelib::pipeline::shard::shard_of(p, 2) == 1)
+        .filter(|p| !p.starts_with(&bad) && stancelib::pipeline::engine::shard::shard_of(p, 2) == 1)
         .collect();
     assert!(good_in_shard.len() >= 2, "{good_in_shard:?}");
     let late = good_in_shard[good_in_shard.len() - 1].clone();

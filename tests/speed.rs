@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use stancelib::bvh::parse_file;
-use stancelib::pipeline::batch::discover;
+use stancelib::pipeline::engine::inputs::discover;
 use stancelib::skeleton::fk::{self, FkWorkspace, Simd, IDENTITY};
 use stancelib::skeleton::landmarks::{self, leg_length, Mapping};
 use stancelib::skeleton::units::detect_unit;

@@ -12,7 +12,7 @@ fn fixture_text(name: &str) -> String {
     std::fs::read_to_string(root().join("fixtures/bvh").join(name)).unwrap()
 }
 
-// See: issue 13 item 4 — `pipeline/batch.rs` filed every ingest error as a skeleton
+// See: issue 13 item 4 — `pipeline/engine/batch.rs` filed every ingest error as a skeleton
 // error ("skeleton: <path>: …") with its cause flattened into the text.
 #[test]
 fn batch_ingest_errors_keep_their_kind_not_skeleton() {
@@ -27,7 +27,8 @@ fn batch_ingest_errors_keep_their_kind_not_skeleton() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("fast.bvh");
     std::fs::write(&bad, &text).unwrap();
-    let rec = stancelib::pipeline::batch::ingest_file(&bad, "fast".into(), &Default::default());
+    let rec =
+        stancelib::pipeline::engine::batch::ingest_file(&bad, "fast".into(), &Default::default());
     assert_eq!(rec.status, Status::Error);
     assert_eq!(rec.error_stage, Some("frames"));
     let msg = rec.message.unwrap();

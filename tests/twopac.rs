@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
-use stancelib::library::read::Table;
+use stancelib::library::table::Table;
 
 use crate::util::{fails, ok};
 
@@ -445,8 +445,8 @@ fn twopac_plans_a_recorded_walk_with_the_library_polytopes() {
     let lib = dir.path().join("lib");
     let clip = "cmu_07_01_walk_mb";
     let files = vec![data.join("walk").join(format!("{clip}.bvh"))];
-    let opts = stancelib::pipeline::build::BuildOptions::default();
-    stancelib::pipeline::build::build_and_write(&files, &lib, &opts, false).unwrap();
+    let opts = stancelib::pipeline::engine::streaming::BuildOptions::default();
+    stancelib::pipeline::engine::streaming::build_and_write(&files, &lib, &opts, false).unwrap();
     let c = Table::open(&lib.join("contacts.parquet")).unwrap();
     let (eff, first, last) = (
         c.strings("effector").unwrap(),

@@ -540,7 +540,7 @@ pub fn parquet_kv(path: &Path) -> std::collections::BTreeMap<String, String> {
 }
 
 /// The string column `name` of `t` at `row` (`None` where null).
-pub fn string_at(t: &stancelib::library::read::Table, name: &str, row: usize) -> Option<String> {
+pub fn string_at(t: &stancelib::library::table::Table, name: &str, row: usize) -> Option<String> {
     t.df.column(name)
         .unwrap_or_else(|_| panic!("no column {name}"))
         .str()
@@ -550,7 +550,7 @@ pub fn string_at(t: &stancelib::library::read::Table, name: &str, row: usize) ->
 }
 
 /// The first stance id of each row of a `query run` table: the row's cycle.
-pub fn first_stance_ids(t: &stancelib::library::read::Table) -> Vec<String> {
+pub fn first_stance_ids(t: &stancelib::library::table::Table) -> Vec<String> {
     let lists = t.df.column("stance_ids").unwrap().list().unwrap().clone();
     (0..t.height())
         .map(|i| {

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::library::layout::Layout;
-use crate::pipeline::queries::{speed_range, LimitOptions};
-use crate::pipeline::shard::Shard;
+use crate::pipeline::commands::queries::{speed_range, LimitOptions};
+use crate::pipeline::engine::shard::Shard;
 use crate::pipeline::spec::Overrides;
 use crate::query::feasibility::LimitForm;
 use crate::query::map::Axis;
@@ -172,12 +172,12 @@ fn limits_help(command: &str) -> Option<String> {
         format!("each start:stop:step range: at most {MAX_AXIS_VALUES} values (MAX_AXIS_VALUES)");
     let threads = format!(
         "--threads: at most {} × the cores (MAX_THREADS_PER_CORE)",
-        crate::pipeline::batch::MAX_THREADS_PER_CORE
+        crate::pipeline::engine::batch::MAX_THREADS_PER_CORE
     );
     let bvh = format!(
         "inputs: regular files of at most {} GiB (MAX_BVH_BYTES), lines of at most {} MiB \
          (MAX_LINE_BYTES)",
-        crate::pipeline::inputs::MAX_BVH_BYTES >> 30,
+        crate::pipeline::engine::inputs::MAX_BVH_BYTES >> 30,
         crate::bvh::MAX_LINE_BYTES >> 20
     );
     let twopac = format!(
@@ -731,9 +731,9 @@ impl BodyArgs {
     ///
     /// # Errors
     /// A mass, unit or up axis that does not parse; more threads than
-    /// [`max_threads`](crate::pipeline::batch::max_threads).
+    /// [`max_threads`](crate::pipeline::engine::batch::max_threads).
     pub fn overrides(&self) -> anyhow::Result<Overrides> {
-        crate::pipeline::batch::check_threads("--threads", self.threads)?;
+        crate::pipeline::engine::batch::check_threads("--threads", self.threads)?;
         if let Some(m) = self.mass {
             crate::ingest::masses::check_body_mass(m)
                 .map_err(|e| anyhow::anyhow!("--mass: {e}"))?;

@@ -97,7 +97,7 @@ pub enum Outcome {
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     QUIET.store(cli.quiet, Ordering::Relaxed);
     JSON.store(cli.json, Ordering::Relaxed);
-    crate::pipeline::batch::set_progress(!cli.quiet);
+    crate::pipeline::engine::batch::set_progress(!cli.quiet);
     let outcome = dispatch(cli.command)?;
     match STDOUT_ERROR.lock().ok().and_then(|mut e| e.take()) {
         Some(e) => Err(anyhow::Error::new(e).context("cannot write to stdout")),

@@ -21,7 +21,7 @@
 //!       `query::jump`; best = `query::pairs::jump_rank` (feasible first, then the least
 //!       change of the recorded forces)
 //! ```
-//! Pure: the library and the pool are in memory; the I/O is in `pipeline::edit`.
+//! Pure: the library and the pool are in memory; the I/O is in `pipeline::commands::edit`.
 
 use std::collections::BTreeMap;
 

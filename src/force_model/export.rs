@@ -39,7 +39,7 @@
 //! ```
 
 use super::{ForceModel, GRAVITY};
-use crate::stances::params::Heading;
+use crate::math::heading::Heading;
 
 /// When a stance happened in its clip: the map `t = td_clip_s + τ·dt_s`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -112,7 +112,7 @@ pub fn sample_forces(
 mod tests {
     use super::*;
     use crate::force_model::AxisModel;
-    use crate::stances::params::HeadingFrom;
+    use crate::math::heading::HeadingFrom;
     use crate::testkit::Rng;
 
     fn norm(v: [f64; 3]) -> f64 {

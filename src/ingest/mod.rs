@@ -18,6 +18,7 @@
 pub mod body;
 mod clip;
 pub mod masses;
+pub mod plates;
 mod points;
 
 use std::collections::BTreeMap;

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use polars::prelude::*;
 
-use super::read::Table;
 use super::schema::{clips, flights, frames, CLIPS_FILE, FRAMES_FILE};
+use super::table::Table;
 /// The support effectors, in the order of the contact bars.
 pub use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};

@@ -19,9 +19,10 @@ use std::path::Path;
 use polars::prelude::*;
 
 use super::columns::col;
-use super::read::{read_stances, Table};
+use super::read::read_stances;
 use super::schema::{clips, frames, stances};
 use super::stances::PoolStance;
+use super::table::Table;
 use crate::error::{Error, Result};
 use crate::force_model::export::{sample_forces, StanceTimes};
 use crate::skeleton::units::UpAxis;

@@ -7,7 +7,7 @@
 //! generation(LIB) = SHA-256 of LIB/manifest.json   (none: no readable manifest)
 //! ```
 //! A build writes a new library into a temporary folder and swaps the whole folder into
-//! place (`pipeline::output::swap_into_place`), so every table a reader opens belongs to
+//! place (`pipeline::engine::output::swap_into_place`), so every table a reader opens belongs to
 //! the folder at `LIB` at that moment. Each build's manifest records its tables' SHA-256,
 //! its creation time and its wall time in nanoseconds: two folders with the same manifest
 //! bytes hold the same tables. A read pinned by [`read_consistently`] therefore

@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::provenance::manifest_sha256;
-use super::read::{same_content, Table};
+use super::read::same_content;
 use super::schema::{clips, errors, stances as S, CLIPS_FILE, ERRORS_FILE, STANCES_FILE};
+use super::table::Table;
 use crate::error::{escape, Error, Result};
 
 /// Stances beyond a person's bounds listed by the text summary (`--json` lists all).

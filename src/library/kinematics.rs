@@ -17,8 +17,8 @@ use std::sync::Arc;
 use polars::prelude::*;
 
 use super::columns::col;
-use super::read::Table;
 use super::schema::{clips as C, contacts as CT, frames as F, kinematics as K, KINEMATICS_FILE};
+use super::table::Table;
 use crate::error::{Error, Result};
 use crate::kinematics::com_in_contact_frame;
 

@@ -8,15 +8,16 @@
 pub mod atomic;
 pub mod clip_view;
 pub(crate) mod columns;
+pub(crate) mod footer;
 pub mod forces;
 pub mod generation;
+pub mod group_reader;
 pub mod info;
 pub mod integrity;
 pub mod kinematics;
 pub mod layout;
 pub mod manifest;
 pub mod per_contact;
-pub mod plates;
 pub mod provenance;
 #[doc(hidden)]
 pub mod read;
@@ -26,6 +27,7 @@ pub mod scratch;
 pub mod spill;
 pub mod stances;
 pub mod stream;
+pub mod table;
 pub mod write;
 
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};

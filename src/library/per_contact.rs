@@ -23,8 +23,8 @@ use std::path::Path;
 use polars::prelude::*;
 
 use super::columns::col;
-use super::read::Table;
 use super::schema::{clips, contacts, frames, CLIPS_FILE, CONTACTS_FILE, FRAMES_FILE};
+use super::table::Table;
 use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
 use crate::force_model::per_contact::{

@@ -30,17 +30,14 @@ use polars::prelude::ArrowSchema;
 use polars_parquet::write::{
     CompressedPage, DynIter, DynStreamingIterator, FileWriter, SchemaDescriptor, WriteOptions,
 };
-use polars_parquet_format::thrift::protocol::{
-    TCompactInputProtocol, TCompactOutputProtocol, TFieldIdentifier, TInputProtocol,
-    TListIdentifier, TOutputProtocol, TStructIdentifier, TType,
-};
+use polars_parquet_format::thrift::protocol::{TCompactInputProtocol, TCompactOutputProtocol};
 use polars_parquet_format::{ColumnChunk, FileMetaData, KeyValue, OffsetIndex, RowGroup};
 
+use super::footer::*;
 use super::scratch::{scratch_name, Scratch};
-use crate::error::{Error, Result};
 
 /// The Parquet magic bytes, at the start and the end of a file.
-const MAGIC: &[u8; 4] = b"PAR1";
+pub(super) const MAGIC: &[u8; 4] = b"PAR1";
 
 /// The thrift reader's allocation budget per byte of the structure read. The reader
 /// charges 8 bytes per claimed list element when it reads the list's header (2 per
@@ -48,28 +45,28 @@ const MAGIC: &[u8; 4] = b"PAR1";
 /// (a column chunk) is about 544 bytes, so a structure read with a budget of `b` bytes
 /// allocates at most about 68 × `b` bytes however its lengths lie. The structures this tool writes fit the budget: every
 /// group written is read back through it (`encode`), and so is every footer entry.
-const THRIFT_BUDGET_PER_BYTE: usize = 4;
+pub(super) const THRIFT_BUDGET_PER_BYTE: usize = 4;
 
 /// The longest footer entry of one row group read (bytes): a group of this tool's tables
 /// (at most about 50 columns) takes about 4 kB; a longer entry is refused (when read
 /// back from a file, once it has been parsed within the budget of this length).
-const MAX_GROUP_ENTRY_BYTES: usize = 256 << 10;
+pub(super) const MAX_GROUP_ENTRY_BYTES: usize = 256 << 10;
 
 /// The most bytes between two column chunks of a group (the first one's metadata): a
 /// chunk's metadata is a few hundred bytes, longer only by its string statistics (values
 /// of more than about 30 kB in a column would not be read back).
-const CHUNK_GAP_BYTES: i64 = 64 * 1024;
+pub(super) const CHUNK_GAP_BYTES: i64 = 64 * 1024;
 
 /// The longest column or offset index of one column chunk read (bytes): an offset index
 /// takes about 12 bytes a page, a column index a page's statistics.
-const MAX_INDEX_BYTES: i32 = 16 << 20;
+pub(super) const MAX_INDEX_BYTES: i32 = 16 << 20;
 
 /// The longest whole footer read at once (only footers this tool just wrote in memory are).
-const MAX_FOOTER_BYTES: usize = 64 << 20;
+pub(super) const MAX_FOOTER_BYTES: usize = 64 << 20;
 
 /// One column chunk of an [`EncodedGroup`].
 #[derive(Debug, Clone, PartialEq)]
-struct Chunk {
+pub(super) struct Chunk {
     /// Its pages (headers and compressed data): a range of the group's bytes.
     pages: Range<usize>,
     /// Its footer entry, every offset counted from the chunk's first page; no page index
@@ -100,29 +97,20 @@ impl EncodedGroup {
     }
 }
 
-/// What a malformed file or buffer is reported as.
-fn malformed(why: impl Into<String>) -> std::io::Error {
-    std::io::Error::new(std::io::ErrorKind::InvalidData, why.into())
-}
-
-fn thrift_err(e: polars_parquet_format::thrift::Error) -> std::io::Error {
-    malformed(format!("parquet metadata: {e}"))
-}
-
 /// Where a column chunk's pages start: its dictionary page, else its first data page.
-fn chunk_start(c: &ColumnChunk) -> Option<i64> {
+pub(super) fn chunk_start(c: &ColumnChunk) -> Option<i64> {
     let m = c.meta_data.as_ref()?;
     Some(m.dictionary_page_offset.unwrap_or(m.data_page_offset))
 }
 
 /// `o + by`, or an error where a corrupt offset overflows.
-fn moved(o: i64, by: i64) -> std::io::Result<i64> {
+pub(super) fn moved(o: i64, by: i64) -> std::io::Result<i64> {
     o.checked_add(by)
         .ok_or_else(|| malformed(format!("offset {o} + {by} overflows")))
 }
 
 /// Move every byte position of a column chunk's footer entry by `by` bytes.
-fn shift_chunk(c: &mut ColumnChunk, by: i64) -> std::io::Result<()> {
+pub(super) fn shift_chunk(c: &mut ColumnChunk, by: i64) -> std::io::Result<()> {
     c.file_offset = moved(c.file_offset, by)?;
     if let Some(m) = c.meta_data.as_mut() {
         m.data_page_offset = moved(m.data_page_offset, by)?;
@@ -133,7 +121,7 @@ fn shift_chunk(c: &mut ColumnChunk, by: i64) -> std::io::Result<()> {
 }
 
 /// Move every page position of an offset index by `by` bytes.
-fn shift_offsets(index: &mut OffsetIndex, by: i64) -> std::io::Result<()> {
+pub(super) fn shift_offsets(index: &mut OffsetIndex, by: i64) -> std::io::Result<()> {
     for p in &mut index.page_locations {
         p.offset = moved(p.offset, by)?;
     }
@@ -142,7 +130,7 @@ fn shift_offsets(index: &mut OffsetIndex, by: i64) -> std::io::Result<()> {
 
 /// Read a thrift structure from `bytes`, with an allocation budget in proportion to them
 /// ([`THRIFT_BUDGET_PER_BYTE`]).
-fn read_thrift<'b, T>(
+pub(super) fn read_thrift<'b, T>(
     bytes: &'b [u8],
     read: impl FnOnce(&mut TCompactInputProtocol<&'b [u8]>) -> polars_parquet_format::thrift::Result<T>,
 ) -> std::io::Result<T> {
@@ -152,7 +140,7 @@ fn read_thrift<'b, T>(
 }
 
 /// The thrift bytes of a structure.
-fn thrift_bytes(
+pub(super) fn thrift_bytes(
     write: impl FnOnce(
         &mut TCompactOutputProtocol<&mut Vec<u8>>,
     ) -> polars_parquet_format::thrift::Result<usize>,
@@ -163,7 +151,7 @@ fn thrift_bytes(
 }
 
 /// `range` of `bytes`, or an error if it lies outside.
-fn slice(bytes: &[u8], start: i64, len: i64) -> std::io::Result<&[u8]> {
+pub(super) fn slice(bytes: &[u8], start: i64, len: i64) -> std::io::Result<&[u8]> {
     let (Ok(start), Ok(len)) = (usize::try_from(start), usize::try_from(len)) else {
         return Err(malformed("negative offset or length"));
     };
@@ -174,7 +162,7 @@ fn slice(bytes: &[u8], start: i64, len: i64) -> std::io::Result<&[u8]> {
 }
 
 /// A source of a file's bytes by position.
-trait ReadAt {
+pub(super) trait ReadAt {
     fn read_at(&mut self, start: i64, len: i64) -> std::io::Result<Vec<u8>>;
 }
 
@@ -204,7 +192,7 @@ impl ReadAt for File {
 
 /// Group `rg` of a file read through `src`: its pages and its metadata made relative to
 /// each column chunk (module docs). The chunks' pages are read in one span.
-fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGroup> {
+pub(super) fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGroup> {
     let mut spans = Vec::with_capacity(rg.columns.len());
     for c in &rg.columns {
         let start = chunk_start(c).ok_or_else(|| malformed("column chunk without metadata"))?;
@@ -297,7 +285,7 @@ fn take_group(src: &mut impl ReadAt, rg: &RowGroup) -> std::io::Result<EncodedGr
 }
 
 /// `l`, the length of a page index, if it is at most [`MAX_INDEX_BYTES`].
-fn index_len(l: i32) -> std::io::Result<i32> {
+pub(super) fn index_len(l: i32) -> std::io::Result<i32> {
     if (0..=MAX_INDEX_BYTES).contains(&l) {
         Ok(l)
     } else {
@@ -307,7 +295,7 @@ fn index_len(l: i32) -> std::io::Result<i32> {
 
 /// Where the footer of a Parquet file of `len` bytes starts, and its length: from its last
 /// 8 bytes (the footer's length, `PAR1`).
-fn footer_span(src: &mut impl ReadAt, len: u64) -> std::io::Result<(u64, u64)> {
+pub(super) fn footer_span(src: &mut impl ReadAt, len: u64) -> std::io::Result<(u64, u64)> {
     if len < 12 {
         return Err(malformed("too short for a parquet file"));
     }
@@ -323,7 +311,7 @@ fn footer_span(src: &mut impl ReadAt, len: u64) -> std::io::Result<(u64, u64)> {
 }
 
 /// The whole footer of a Parquet file held in `bytes` or read from `file`.
-fn read_footer(src: &mut impl ReadAt, len: u64) -> std::io::Result<FileMetaData> {
+pub(super) fn read_footer(src: &mut impl ReadAt, len: u64) -> std::io::Result<FileMetaData> {
     let (start, meta_len) = footer_span(src, len)?;
     if meta_len as usize > MAX_FOOTER_BYTES {
         return Err(malformed(format!("a footer of {meta_len} bytes")));
@@ -371,7 +359,7 @@ impl GroupSchema {
 
 /// The bytes of a one-group Parquet file polars writes for `pages` (one `Vec` per leaf
 /// column, in order) of `rows` rows.
-fn encode_group_bytes(
+pub(super) fn encode_group_bytes(
     schema: &GroupSchema,
     rows: u64,
     pages: &[Vec<CompressedPage>],
@@ -390,7 +378,7 @@ fn encode_group_bytes(
 }
 
 /// The one row group of a Parquet file held in `bytes`.
-fn group_from_bytes(bytes: &[u8]) -> std::io::Result<EncodedGroup> {
+pub(super) fn group_from_bytes(bytes: &[u8]) -> std::io::Result<EncodedGroup> {
     let mut src = bytes;
     let footer = read_footer(&mut src, bytes.len() as u64)?;
     match footer.row_groups.as_slice() {
@@ -415,11 +403,11 @@ pub fn encode(
 /// Bytes a [`ScratchStream`] holds in memory before it moves them to its file: a small
 /// table (a query's output) writes no scratch file at all; the frames of a large build
 /// (about 4 kB of footer entry and 2 kB of page index a clip) go to disk.
-const SCRATCH_MEMORY_BYTES: usize = 1 << 20;
+pub(super) const SCRATCH_MEMORY_BYTES: usize = 1 << 20;
 
 /// A stream written in order and read back once: in memory up to
 /// [`SCRATCH_MEMORY_BYTES`], then in a scratch file at `path`, removed when dropped.
-struct ScratchStream {
+pub(super) struct ScratchStream {
     path: PathBuf,
     held: Vec<u8>,
     out: Option<BufWriter<File>>,
@@ -520,7 +508,7 @@ pub fn scratch_stems(table: &str) -> [String; 3] {
 
 /// Per leaf column of a footer's schema (depth-first, the root left out): its path and
 /// physical type.
-fn leaf_columns(
+pub(super) fn leaf_columns(
     schema: &[polars_parquet_format::SchemaElement],
 ) -> Vec<(Vec<String>, Option<polars_parquet_format::Type>)> {
     fn walk(
@@ -718,473 +706,5 @@ impl GroupFileWriter {
     }
 }
 
-/// A writer that counts the bytes written through it.
-struct Counted<'a, W: Write> {
-    inner: &'a mut W,
-    bytes: usize,
-}
-
-impl<W: Write> Write for Counted<'_, W> {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let n = self.inner.write(buf)?;
-        self.bytes += n;
-        Ok(n)
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.inner.flush()
-    }
-}
-
-/// A reader that counts the bytes read through it.
-struct CountedRead<'a, R: Read> {
-    inner: &'a mut R,
-    bytes: usize,
-}
-
-impl<R: Read> Read for CountedRead<'_, R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.bytes += n;
-        Ok(n)
-    }
-}
-
-fn len_i32(n: usize) -> std::io::Result<i32> {
-    i32::try_from(n).map_err(|_| malformed(format!("{n} bytes: over a thrift length")))
-}
-
-/// List field `id` of `n` structs, each written by `item(p, k)`, as the generated thrift
-/// code writes a list field.
-fn write_struct_list<P: TOutputProtocol>(
-    p: &mut P,
-    name: &str,
-    id: i16,
-    n: usize,
-    mut item: impl FnMut(&mut P, usize) -> std::io::Result<usize>,
-) -> std::io::Result<()> {
-    let size = u32::try_from(n).map_err(|_| malformed("list too long"))?;
-    p.write_field_begin(&TFieldIdentifier::new(name, TType::List, id))
-        .map_err(thrift_err)?;
-    p.write_list_begin(&TListIdentifier::new(TType::Struct, size))
-        .map_err(thrift_err)?;
-    for k in 0..n {
-        item(p, k)?;
-    }
-    p.write_list_end().map_err(thrift_err)?;
-    p.write_field_end().map_err(thrift_err)?;
-    Ok(())
-}
-
-/// `footer` as polars writes it (`FileMetaData::write_to_out_protocol`, field for field),
-/// its `groups` row groups taken one at a time from `next_group` instead of its own list.
-fn write_footer(
-    out: &mut impl Write,
-    footer: &FileMetaData,
-    groups: usize,
-    next_group: &mut dyn FnMut() -> std::io::Result<RowGroup>,
-) -> std::io::Result<()> {
-    let e = thrift_err;
-    let mut p = TCompactOutputProtocol::new(out);
-    p.write_struct_begin(&TStructIdentifier::new("FileMetaData"))
-        .map_err(e)?;
-    p.write_field_begin(&TFieldIdentifier::new("version", TType::I32, 1))
-        .map_err(e)?;
-    p.write_i32(footer.version).map_err(e)?;
-    p.write_field_end().map_err(e)?;
-    let schema = &footer.schema;
-    write_struct_list(&mut p, "schema", 2, schema.len(), |p, k| {
-        schema[k].write_to_out_protocol(p).map_err(e)
-    })?;
-    p.write_field_begin(&TFieldIdentifier::new("num_rows", TType::I64, 3))
-        .map_err(e)?;
-    p.write_i64(footer.num_rows).map_err(e)?;
-    p.write_field_end().map_err(e)?;
-    write_struct_list(&mut p, "row_groups", 4, groups, |p, _| {
-        next_group()?.write_to_out_protocol(p).map_err(e)
-    })?;
-    // The fields after the groups, written by a copy of the footer without groups, would
-    // restart the field numbering; they are written here in polars' order instead.
-    if let Some(kv) = &footer.key_value_metadata {
-        write_struct_list(&mut p, "key_value_metadata", 5, kv.len(), |p, k| {
-            kv[k].write_to_out_protocol(p).map_err(e)
-        })?;
-    }
-    if let Some(by) = &footer.created_by {
-        p.write_field_begin(&TFieldIdentifier::new("created_by", TType::String, 6))
-            .map_err(e)?;
-        p.write_string(by).map_err(e)?;
-        p.write_field_end().map_err(e)?;
-    }
-    if let Some(orders) = &footer.column_orders {
-        write_struct_list(&mut p, "column_orders", 7, orders.len(), |p, k| {
-            orders[k].write_to_out_protocol(p).map_err(e)
-        })?;
-    }
-    if footer.encryption_algorithm.is_some() || footer.footer_signing_key_metadata.is_some() {
-        return Err(malformed("encrypted footers are not supported"));
-    }
-    p.write_field_stop().map_err(e)?;
-    p.write_struct_end().map_err(e)?;
-    Ok(())
-}
-
-/// The statistics (minimum, maximum) of the leaf column named `name` in a group's footer
-/// entry, raw Parquet bytes (a string's UTF-8).
-fn column_range<'a>(rg: &'a RowGroup, name: &str) -> Option<(&'a [u8], &'a [u8])> {
-    rg.columns.iter().find_map(|c| {
-        let m = c.meta_data.as_ref()?;
-        if m.path_in_schema.len() != 1 || m.path_in_schema[0] != name {
-            return None;
-        }
-        let st = m.statistics.as_ref()?;
-        Some((st.min_value.as_deref()?, st.max_value.as_deref()?))
-    })
-}
-
-/// The row groups of a Parquet file, read in order one at a time as [`EncodedGroup`]s.
-/// The footer is read as the groups are, never held whole: a file of thousands of
-/// groups (one per clip) costs one group's metadata in memory.
-pub struct GroupFileReader {
-    path: PathBuf,
-    data: File,
-    /// The footer, positioned at the next group's entry in its list of row groups.
-    footer: BufReader<File>,
-    /// Groups whose entries are not read yet.
-    left: usize,
-    /// The next group's entry, read ahead by [`GroupFileReader::peek_value`].
-    next: Option<RowGroup>,
-}
-
-fn io(path: &Path, what: &str, e: impl std::error::Error + Send + Sync + 'static) -> Error {
-    Error::io(path, what, e)
-}
-
-/// Read a footer up to its list of row groups; the number of groups.
-fn footer_to_groups(footer: &mut BufReader<File>, len: usize) -> std::io::Result<usize> {
-    let mut p = TCompactInputProtocol::new(footer, len.saturating_mul(THRIFT_BUDGET_PER_BYTE));
-    p.read_struct_begin().map_err(thrift_err)?;
-    loop {
-        let field = p.read_field_begin().map_err(thrift_err)?;
-        match (field.field_type, field.id) {
-            (TType::Stop, _) => return Err(malformed("footer without row groups")),
-            (TType::List, Some(4)) => {
-                let list = p.read_list_begin().map_err(thrift_err)?;
-                return Ok(list.size as usize);
-            }
-            (t, _) => p.skip(t).map_err(thrift_err)?,
-        }
-        p.read_field_end().map_err(thrift_err)?;
-    }
-}
-
-impl GroupFileReader {
-    /// Open `path` and read its footer up to the first group's entry.
-    ///
-    /// # Errors
-    /// The file cannot be read or is not Parquet.
-    pub fn open(path: &Path) -> Result<GroupFileReader> {
-        let err = |e| io(path, "cannot read parquet", e);
-        let mut data = File::open(path).map_err(|e| io(path, "cannot open", e))?;
-        let len = data.metadata().map_err(err)?.len();
-        let (start, meta_len) = footer_span(&mut data, len).map_err(err)?;
-        let mut footer = BufReader::new(File::open(path).map_err(|e| io(path, "cannot open", e))?);
-        footer.seek(SeekFrom::Start(start)).map_err(err)?;
-        let left = footer_to_groups(&mut footer, meta_len as usize).map_err(err)?;
-        Ok(GroupFileReader {
-            path: path.to_path_buf(),
-            data,
-            footer,
-            left,
-            next: None,
-        })
-    }
-
-    /// The next group's entry, read from the footer if not read yet (`None` after the last).
-    fn peek(&mut self) -> Result<Option<&RowGroup>> {
-        if self.next.is_none() && self.left > 0 {
-            let rg = self
-                .read_entry()
-                .map_err(|e| io(&self.path, "cannot read parquet", e))?;
-            self.left -= 1;
-            self.next = Some(rg);
-        }
-        Ok(self.next.as_ref())
-    }
-
-    /// The next group's entry, read with the allocation budget of the longest entry
-    /// accepted ([`MAX_GROUP_ENTRY_BYTES`]): whatever lengths a corrupt entry claims, it
-    /// allocates a bounded amount (about 70 MB at most) before it is refused.
-    fn read_entry(&mut self) -> std::io::Result<RowGroup> {
-        let mut counted = CountedRead {
-            inner: &mut self.footer,
-            bytes: 0,
-        };
-        let budget = MAX_GROUP_ENTRY_BYTES * THRIFT_BUDGET_PER_BYTE;
-        let rg =
-            RowGroup::read_from_in_protocol(&mut TCompactInputProtocol::new(&mut counted, budget))
-                .map_err(thrift_err)?;
-        if counted.bytes > MAX_GROUP_ENTRY_BYTES {
-            return Err(malformed(format!(
-                "a row group entry of {} bytes",
-                counted.bytes
-            )));
-        }
-        Ok(rg)
-    }
-
-    /// The value of column `name` in the next group, when that group holds one value of it
-    /// (its minimum and maximum statistics are equal); `None` after the last group.
-    ///
-    /// # Errors
-    /// The footer cannot be read, or the group has no statistics for `name` or more than
-    /// one value of it (not a table of one clip per group).
-    pub fn peek_value(&mut self, name: &str) -> Result<Option<Vec<u8>>> {
-        let path = self.path.clone();
-        let Some(rg) = self.peek()? else {
-            return Ok(None);
-        };
-        match column_range(rg, name) {
-            Some((lo, hi)) if lo == hi => Ok(Some(lo.to_vec())),
-            _ => Err(io(
-                &path,
-                "cannot read parquet",
-                malformed(format!(
-                    "a row group holds no single value of column {name}"
-                )),
-            )),
-        }
-    }
-
-    /// The next row group with its pages; `None` after the last.
-    ///
-    /// # Errors
-    /// Its entry or bytes cannot be read or are malformed.
-    pub fn next_group(&mut self) -> Result<Option<EncodedGroup>> {
-        self.peek()?;
-        let Some(rg) = self.next.take() else {
-            return Ok(None);
-        };
-        take_group(&mut self.data, &rg)
-            .map(Some)
-            .map_err(|e| io(&self.path, "cannot read parquet", e))
-    }
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use polars::prelude::*;
-
-    /// A table of `n` rows: strings (dictionary pages), integers, floats, nulls, lists.
-    fn table(n: usize) -> DataFrame {
-        let mut df = df! {
-            "clip" => (0..n).map(|i| format!("clip_{:03}", i / 700)).collect::<Vec<_>>(),
-            "frame" => (0..n as i64).collect::<Vec<_>>(),
-            "x" => (0..n).map(|i| (i as f64 * 0.37).sin()).collect::<Vec<_>>(),
-            "z" => (0..n).map(|i| (i % 5 != 0).then_some(i as f64)).collect::<Vec<_>>(),
-        }
-        .unwrap();
-        let lists: Vec<Series> = (0..n)
-            .map(|i| Series::new("".into(), vec![i as f64; i % 3]))
-            .collect();
-        df.with_column(Series::new("l".into(), lists).into_column())
-            .unwrap();
-        df
-    }
-
-    fn schema_of(
-        df: &DataFrame,
-    ) -> (
-        GroupSchema,
-        Vec<(
-            polars_parquet::write::ParquetType,
-            Vec<polars_parquet::write::Encoding>,
-        )>,
-    ) {
-        super::super::stream::group_schema(df.schema()).unwrap()
-    }
-
-    fn pages(
-        df: &DataFrame,
-        columns: &[(
-            polars_parquet::write::ParquetType,
-            Vec<polars_parquet::write::Encoding>,
-        )],
-    ) -> Vec<Vec<CompressedPage>> {
-        super::super::stream::encode_group(df.columns(), columns).unwrap()
-    }
-
-    /// Groups appended one by one give the bytes polars' own writer gives for the same
-    /// groups; the file reads back as the table.
-    #[test]
-    fn appended_groups_give_polars_bytes() {
-        let df = table(5000);
-        let cuts = [(0, 1400), (1400, 2100), (3500, 1500)];
-        let (schema, columns) = schema_of(&df);
-        let kv = vec![KeyValue {
-            key: "k".into(),
-            value: Some("v".into()),
-        }];
-        let mut theirs = schema.writer();
-        for (at, n) in cuts {
-            let p = pages(&df.slice(at, n), &columns);
-            let it = DynIter::new(p.iter().map(|col| {
-                Ok(DynStreamingIterator::new(
-                    polars_parquet::write::fallible_streaming_iterator::convert(
-                        col.iter().map(PolarsResult::Ok),
-                    ),
-                ))
-            }));
-            theirs.write(n as u64, it).unwrap();
-        }
-        theirs.end(Some(kv.clone())).unwrap();
-        let theirs = theirs.into_inner();
-
-        let d = tempfile::tempdir().unwrap();
-        let path = d.path().join("t.parquet");
-        let mut w = GroupFileWriter::create(&path, "t.parquet", &schema).unwrap();
-        for (at, n) in cuts {
-            let g = encode(&schema, n as u64, &pages(&df.slice(at, n), &columns)).unwrap();
-            assert_eq!(g.rows(), n);
-            w.append(&g).unwrap();
-        }
-        w.finish(kv).unwrap();
-        let ours = std::fs::read(&path).unwrap();
-        assert!(
-            ours == theirs,
-            "the bytes differ ({} against {})",
-            ours.len(),
-            theirs.len()
-        );
-        let left: Vec<_> = std::fs::read_dir(d.path()).unwrap().collect();
-        assert_eq!(left.len(), 1, "scratch files left: {left:?}");
-        let back = ParquetReader::new(std::io::Cursor::new(ours))
-            .finish()
-            .unwrap();
-        assert!(back.equals_missing(&df));
-    }
-
-    /// A group read from one file and appended to another at another position gives the
-    /// bytes of the same group encoded for that file, and no group gives an empty file.
-    #[test]
-    fn a_group_moved_between_files_keeps_its_bytes() {
-        let df = table(4000);
-        let (schema, columns) = schema_of(&df);
-        let d = tempfile::tempdir().unwrap();
-        let write = |name: &str, cuts: &[(i64, usize)]| {
-            let path = d.path().join(name);
-            let mut w = GroupFileWriter::create(&path, "t.parquet", &schema).unwrap();
-            for &(at, n) in cuts {
-                w.append(&encode(&schema, n as u64, &pages(&df.slice(at, n), &columns)).unwrap())
-                    .unwrap();
-            }
-            w.finish(Vec::new()).unwrap();
-            path
-        };
-        let shard = write("shard.parquet", &[(0, 300), (300, 3700)]);
-        let direct = write("direct.parquet", &[(300, 3700), (0, 300)]);
-        let mut r = GroupFileReader::open(&shard).unwrap();
-        assert_eq!(r.peek_value("frame").ok(), None, "300 frames in a group");
-        assert_eq!(r.peek_value("clip").unwrap(), Some(b"clip_000".to_vec()));
-        let first = r.next_group().unwrap().unwrap();
-        assert!(r.peek_value("clip").is_err(), "clips 0 to 5 in a group");
-        let second = r.next_group().unwrap().unwrap();
-        assert_eq!((first.rows(), second.rows()), (300, 3700));
-        assert_eq!(r.peek_value("clip").unwrap(), None);
-        assert!(r.next_group().unwrap().is_none());
-        let moved = d.path().join("moved.parquet");
-        let mut w = GroupFileWriter::create(&moved, "moved.parquet", &schema).unwrap();
-        w.append(&second).unwrap();
-        w.append(&first).unwrap();
-        w.finish(Vec::new()).unwrap();
-        assert!(std::fs::read(&moved).unwrap() == std::fs::read(&direct).unwrap());
-        let empty = write("empty.parquet", &[]);
-        let back = ParquetReader::new(File::open(empty).unwrap())
-            .finish()
-            .unwrap();
-        assert_eq!(back.height(), 0);
-        assert_eq!(back.schema(), df.schema());
-    }
-
-    /// A footer whose row group claims 2^27 − 1 column chunks in a few bytes is an error,
-    /// not a 73 GB allocation; so is a group of another table's columns.
-    #[test]
-    fn lying_lengths_and_foreign_groups_are_errors() {
-        let d = tempfile::tempdir().unwrap();
-        let path = d.path().join("bad.parquet");
-        // FileMetaData field 4 (row_groups): a list of 1 struct whose field 1 (columns)
-        // is a list of structs of varint length 2^27 − 1, then nothing.
-        let mut footer = vec![0x49u8, 0x1C, 0x19, 0xFC];
-        let mut n: u32 = (1 << 27) - 1;
-        loop {
-            let b = (n & 0x7f) as u8;
-            n >>= 7;
-            if n == 0 {
-                footer.push(b);
-                break;
-            }
-            footer.push(b | 0x80);
-        }
-        footer.push(0);
-        let mut bytes = MAGIC.to_vec();
-        bytes.extend_from_slice(&footer);
-        bytes.extend_from_slice(&(footer.len() as u32).to_le_bytes());
-        bytes.extend_from_slice(MAGIC);
-        std::fs::write(&path, &bytes).unwrap();
-        let mut r = GroupFileReader::open(&path).unwrap();
-        let e = r.peek_value("clip").unwrap_err();
-        assert!(e.to_string().contains("bad.parquet"), "{e}");
-        // Refused by the allocation budget (not by the end of the data, which a machine
-        // that granted the allocation would only meet after it).
-        let why = format!("{e:?}");
-        assert!(why.contains("message too long"), "{why}"); // thrift SizeLimit
-
-        // A group of a two-column table appended to a five-column one.
-        let df = table(100);
-        let (schema, columns) = schema_of(&df);
-        let narrow = df.select(["clip", "frame"]).unwrap();
-        let (narrow_schema, narrow_columns) = schema_of(&narrow);
-        let g = encode(&narrow_schema, 100, &pages(&narrow, &narrow_columns)).unwrap();
-        let mut w =
-            GroupFileWriter::create(&d.path().join("t.parquet"), "t.parquet", &schema).unwrap();
-        let e = w.append(&g).unwrap_err().to_string();
-        assert!(e.contains("2 columns"), "{e}");
-        // The table's own groups still go in.
-        w.append(&encode(&schema, 100, &pages(&df, &columns)).unwrap())
-            .unwrap();
-        w.finish(Vec::new()).unwrap();
-    }
-
-    /// A file that is not Parquet, or is cut short, is an error naming it, not a panic.
-    #[test]
-    fn a_damaged_file_is_an_error() {
-        let df = table(800);
-        let (schema, columns) = schema_of(&df);
-        let d = tempfile::tempdir().unwrap();
-        let path = d.path().join("t.parquet");
-        let mut w = GroupFileWriter::create(&path, "t.parquet", &schema).unwrap();
-        w.append(&encode(&schema, 800, &pages(&df, &columns)).unwrap())
-            .unwrap();
-        w.finish(Vec::new()).unwrap();
-        let bytes = std::fs::read(&path).unwrap();
-        for cut in [0, 5, bytes.len() / 2, bytes.len() - 1] {
-            let bad = d.path().join(format!("cut{cut}.parquet"));
-            std::fs::write(&bad, &bytes[..cut]).unwrap();
-            let e = GroupFileReader::open(&bad)
-                .err()
-                .expect("a cut file is refused");
-            assert!(e.to_string().contains(&format!("cut{cut}")), "{e}");
-        }
-        // A footer whose offsets point past the end: the group read is refused.
-        let mut r = GroupFileReader::open(&path).unwrap();
-        r.peek().unwrap();
-        let m = r.next.as_mut().unwrap().columns[0]
-            .meta_data
-            .as_mut()
-            .unwrap();
-        m.data_page_offset = 1 << 40;
-        m.dictionary_page_offset = None;
-        assert!(r.next_group().is_err());
-    }
-}
+mod tests;

@@ -19,8 +19,8 @@ use std::path::Path;
 use polars::prelude::*;
 
 use super::columns::{col, list_col};
-use super::read::Table;
 use super::schema::{errors as E, flight_ref as F, stances as S};
+use super::table::Table;
 use crate::constraints::Coefficients;
 use crate::error::{Error, Result};
 use crate::force_model::{AxisModel, ForceModel};

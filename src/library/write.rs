@@ -19,9 +19,6 @@ use super::ClipRecord;
 use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
 
-/// Rows per Parquet row group.
-pub const ROW_GROUP_ROWS: usize = 65_536;
-
 fn polars_err(path: &Path, e: PolarsError) -> Error {
     Error::io(path, "cannot build table", e)
 }
@@ -352,7 +349,7 @@ pub fn joints_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
 
 /// Write a table to `dir/name` atomically: a temporary file in `dir`, then a rename, so a
 /// reader never sees a half-written file and an earlier file survives a failed write. The
-/// layout is that of [`TableWriter`] (row groups of [`ROW_GROUP_ROWS`] rows), so a table
+/// layout is that of [`TableWriter`] (row groups of [`ROW_GROUP_ROWS`](super::stream::ROW_GROUP_ROWS) rows), so a table
 /// written whole equals the same rows written in batches, byte for byte.
 ///
 /// # Errors
@@ -366,52 +363,6 @@ pub fn write_atomic(
     let mut w = TableWriter::create(dir, name, df)?;
     w.push(df)?;
     w.finish(kv)
-}
-
-/// The `ARROW:schema` key-value entry of `schema` (an Arrow schema of the oldest
-/// compatibility level) whose schema metadata is `kv` itself.
-///
-/// pyarrow takes `read_table(f).schema.metadata` from this Arrow schema, not from the
-/// file's key-value list, so the `stancelib.*` keys go into both.
-pub(crate) fn arrow_schema_entry(
-    schema: &polars_arrow::datatypes::ArrowSchema,
-    kv: &[(String, String)],
-) -> (String, String) {
-    use polars_arrow::io::ipc::write::{default_ipc_fields, schema_to_bytes};
-    let meta: polars_arrow::datatypes::Metadata = kv
-        .iter()
-        .map(|(k, v)| (PlSmallStr::from_str(k), PlSmallStr::from_str(v)))
-        .collect();
-    let ipc = schema_to_bytes(
-        schema,
-        &default_ipc_fields(schema.iter_values()),
-        Some(&meta),
-    );
-    // The legacy IPC framing Arrow readers expect: continuation marker, length, message.
-    let mut framed = Vec::with_capacity(ipc.len() + 8);
-    framed.extend_from_slice(&[255, 255, 255, 255]);
-    framed.extend_from_slice(&(ipc.len() as u32).to_le_bytes());
-    framed.extend_from_slice(&ipc);
-    ("ARROW:schema".to_string(), base64(&framed))
-}
-
-/// Standard base64 with padding (RFC 4648 §4), as the `ARROW:schema` value is written.
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
-    for c in bytes.chunks(3) {
-        let n = (u32::from(c[0]) << 16)
-            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
-            | u32::from(*c.get(2).unwrap_or(&0));
-        for (i, shift) in [18, 12, 6, 0].into_iter().enumerate() {
-            if i <= c.len() {
-                out.push(char::from(A[((n >> shift) & 63) as usize]));
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
 }
 
 /// The tables a `frames` run writes.
@@ -541,7 +492,11 @@ mod base64_tests {
             ("fooba", "Zm9vYmE="),
             ("foobar", "Zm9vYmFy"),
         ] {
-            assert_eq!(super::base64(plain.as_bytes()), coded, "{plain}");
+            assert_eq!(
+                crate::library::stream::base64(plain.as_bytes()),
+                coded,
+                "{plain}"
+            );
         }
     }
 }

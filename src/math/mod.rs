@@ -1,7 +1,9 @@
 //! Pure numerical helpers shared by the stages: Savitzky–Golay differentiation,
-//! order statistics, small polynomial least-squares fits and branch-free sin/cos.
+//! order statistics, small polynomial least-squares fits, branch-free sin/cos, and the
+//! stance heading frame.
 
 pub mod constants;
+pub mod heading;
 pub mod polyfit;
 pub mod savgol;
 pub mod spline;

@@ -9,14 +9,21 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::batch::discover;
-use super::build::{BuildOptions, BuildPlan};
-use super::inputs::{read_body, read_pipeline};
-use super::output::OutputRules;
-use super::queries::{query_stages, MapQuery, RunQuery};
-use super::spec::{expand_inputs, relative_to, resolve, resolve_fit, with_masses, Overrides};
+use super::commands::map_jumps::MapQuery;
+use super::commands::queries::{gait_law_choice, speed_range, LimitOptions};
+use super::commands::query_run::RunQuery;
+use super::engine::inputs::discover;
+use super::engine::output::OutputRules;
+use super::engine::streaming::{BuildOptions, BuildPlan};
+use super::spec::{
+    expand_inputs, read_body, read_pipeline, relative_to, resolve, resolve_fit, with_masses,
+    Overrides,
+};
 use crate::force_model::ForceModelKind;
 use crate::library::layout::Layout;
+use crate::pipeline::spec::{ConstraintsTable, QueriesTable};
+use crate::query::feasibility::LimitForm;
+use crate::query::map::{Axis, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};
 
 /// What the command line adds to a pipeline file.
 #[derive(Debug, Clone)]
@@ -113,4 +120,64 @@ pub fn pipeline_job(path: &Path, cl: &CommandLine<'_>) -> anyhow::Result<Pipelin
         run,
         map,
     })
+}
+
+/// The `[queries]` stages of a pipeline file on the library `lib` just built, as typed
+/// queries into `<lib>/queries/` (`runs.parquet`, `jump_map/`); `[constraints]` gives their
+/// limit options (`limits = "per_query"` keeps each query's default form). Every option is
+/// checked here, before any stage runs.
+///
+/// # Errors
+/// A bad speed, height or apex-speed range.
+pub fn query_stages(
+    q: &QueriesTable,
+    c: Option<&ConstraintsTable>,
+    lib: &Path,
+) -> anyhow::Result<(Option<RunQuery>, Option<MapQuery>)> {
+    let dir = lib.join("queries");
+    let limits = LimitOptions {
+        form: c
+            .and_then(|c| c.limits.as_deref())
+            .filter(|l| *l != "per_query")
+            .and_then(LimitForm::parse),
+        mu: c.and_then(|c| c.mu),
+        active_set: c.and_then(|c| c.active_set),
+    };
+    let run = match &q.run_speeds {
+        Some(speeds) => Some(RunQuery {
+            lib: lib.to_path_buf(),
+            speeds: speed_range("--speeds", speeds)?,
+            length_scale: q.length_scale.unwrap_or(1.0),
+            mass_scale: q.mass_scale.unwrap_or(1.0),
+            limits,
+            out: dir.join("runs.parquet"),
+            png: None,
+            gait_law: gait_law_choice(q.gait_law.as_deref())?,
+            keep_left_out: q.keep_left_out.unwrap_or(false),
+            explain: None,
+        }),
+        None => None,
+    };
+    let map = match q.jump_map {
+        Some(true) => Some(MapQuery {
+            lib: lib.to_path_buf(),
+            heights: axis_or("--heights", q.map_heights.as_deref(), DEFAULT_HEIGHTS)?,
+            speeds: axis_or("--speeds", q.map_speeds.as_deref(), DEFAULT_SPEEDS)?,
+            limits,
+            keep_left_out: q.keep_left_out.unwrap_or(false),
+            out: dir.join("jump_map"),
+            diagnostics: false,
+        }),
+        _ => None,
+    };
+    Ok((run, map))
+}
+
+/// The values of the range `given` as `flag`, else of `default`.
+fn axis_or(flag: &str, given: Option<&str>, default: Axis) -> anyhow::Result<Vec<f64>> {
+    Ok(match given {
+        Some(r) => Axis::parse(flag, r)?,
+        None => default,
+    }
+    .values())
 }

@@ -1,26 +1,12 @@
-//! Batch orchestration at the I/O edge: input discovery, clip names, per-file ingest in
-//! parallel with a progress bar, the streaming library build, shards and their merge, the
-//! output-folder policy, the declarative pipeline and body files, the `twopac` stage
-//! with its output tables, and a library's catalogue (`list`).
+//! Batch orchestration at the I/O edge, in three rooms:
+//! - [`engine`]: the build engine (inputs, batch ingest, the streaming build, shards and
+//!   merge, the output-folder policy), with typed errors;
+//! - [`commands`]: one stage per command (queries, edit, equilibrium, twopac, plots,
+//!   catalogue, and the entries of `frames`, `build` and `run`), `anyhow` at that edge;
+//! - the configuration: [`spec`] (pipeline and body files, parsed) and [`job`] (a pipeline
+//!   file resolved into a build and its query stages).
 
-pub mod batch;
-pub mod build;
-pub mod catalogue;
-pub mod edit;
-pub mod edit_outputs;
-pub mod equilibrium;
-pub mod inputs;
+pub mod commands;
+pub mod engine;
 pub mod job;
-pub mod memory;
-pub mod merge;
-pub mod names;
-pub mod ordered;
-pub mod output;
-pub mod plots;
-pub mod queries;
-pub mod shard;
-pub(crate) mod sink;
 pub mod spec;
-pub mod twopac;
-pub mod twopac_outputs;
-pub mod twopac_tables;

@@ -40,7 +40,7 @@ use stancelib::edit::pose::{pose_motion, Reference};
 use stancelib::edit::EditOptions;
 use stancelib::ingest::body::BodyModel;
 use stancelib::library::read::{open_library, read_stance_timing};
-use stancelib::pipeline::build::{build_and_write, BuildOptions};
+use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::query::feasibility::relative_limits;
 use stancelib::query::pool::Prepared;
 use stancelib::query::run::run_cycles;

@@ -27,7 +27,7 @@
 //! # Results
 //! 2026-12-06 (third session), the same sandbox with nothing else running, after each clip
 //! became a pool task and batches are handed over without a barrier
-//! (`pipeline::ordered`), profiling profile, bulk CMU set, 5 rounds (medians):
+//! (`pipeline::engine::ordered`), profiling profile, bulk CMU set, 5 rounds (medians):
 //!
 //! ```text
 //! threads  stage   wall s   frames/s  × limit
@@ -81,7 +81,7 @@ use std::time::Instant;
 use clap::Parser;
 use rayon::prelude::*;
 use stancelib::cli::args::Cli;
-use stancelib::pipeline::batch::discover;
+use stancelib::pipeline::engine::inputs::discover;
 
 /// The bulk set, relative to the crate root.
 const BULK: &str = "../shared/data/bvh-bulk/cmu";

@@ -3,7 +3,7 @@
 //!
 //! Run with `cargo bench --bench library` (`make bench`).
 //!
-//! - `build_shared`: `pipeline::build::build_and_write` of every shared clip (ingest, stances,
+//! - `build_shared`: `pipeline::engine::streaming::build_and_write` of every shared clip (ingest, stances,
 //!   force fits, coefficients, five Parquet tables and the manifest), wall time with the
 //!   default rayon pool. Target: under 2 s on 2 cores. Skipped with a message when
 //!   `../shared` is absent.
@@ -20,8 +20,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
-use stancelib::pipeline::batch::discover;
-use stancelib::pipeline::build::{build_and_write, BuildOptions};
+use stancelib::pipeline::engine::inputs::discover;
+use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::stances::{build_clip, StanceOptions};
 
 fn root() -> &'static Path {

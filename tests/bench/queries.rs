@@ -22,8 +22,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use stancelib::library::read::read_stances;
-use stancelib::pipeline::batch::discover;
-use stancelib::pipeline::build::{build_and_write, BuildOptions};
+use stancelib::pipeline::engine::inputs::discover;
+use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::query::feasibility::{approx, relative_limits};
 use stancelib::query::map::{jump_map, stance_relative_limits, Axis};
 use stancelib::query::pool::Prepared;

@@ -18,7 +18,7 @@
 //!
 //! # Results
 //! 2026-12-06 (third session), `SCALE_ROUNDS=3`, after batches are handed over without a
-//! barrier (`pipeline::ordered`):
+//! barrier (`pipeline::engine::ordered`):
 //!
 //! ```text
 //! scale: 93 clips and a 25× replica, build --threads 2, 3 rounds (medians)
@@ -87,7 +87,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use stancelib::pipeline::batch::discover;
+use stancelib::pipeline::engine::inputs::discover;
 
 /// The bulk set, relative to the crate root.
 const BULK: &str = "../shared/data/bvh-bulk/cmu";
@@ -170,7 +170,7 @@ fn main() {
         return;
     }
     let dir = std::env::var("SCALE_DIR").map_or_else(|_| PathBuf::from(BULK), PathBuf::from);
-    // The inputs `build` itself would take (`pipeline::batch::discover`).
+    // The inputs `build` itself would take (`pipeline::engine::inputs::discover`).
     let files = discover(std::slice::from_ref(&dir)).unwrap_or_default();
     if files.is_empty() {
         println!(

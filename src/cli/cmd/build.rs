@@ -6,11 +6,12 @@ use anyhow::Context;
 
 use super::super::args::{BuildArgs, MergeArgs};
 use super::super::Outcome;
-use crate::pipeline::batch::discover;
-use crate::pipeline::build::{build_library, BuildOptions, BuildPlan, BuildSummary};
-use crate::pipeline::inputs::read_body;
-use crate::pipeline::merge::merge_into;
-use crate::pipeline::output::OutputRules;
+use crate::pipeline::commands::build::build_library;
+use crate::pipeline::engine::inputs::discover;
+use crate::pipeline::engine::merge::merge_into;
+use crate::pipeline::engine::output::OutputRules;
+use crate::pipeline::engine::streaming::{BuildOptions, BuildPlan, BuildSummary};
+use crate::pipeline::spec::read_body;
 use crate::pipeline::spec::{resolve, resolve_fit, with_masses};
 
 /// Run `build`.

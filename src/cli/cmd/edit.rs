@@ -1,5 +1,5 @@
 //! `stancelib edit run` and `stancelib edit jump`: the options as typed requests, the edit
-//! stage ([`crate::pipeline::edit`]), the verdict in the terminal. Exit codes
+//! stage ([`crate::pipeline::commands::edit`]), the verdict in the terminal. Exit codes
 //! ([`crate::cli::args::EDIT_EXIT_HELP`], the same for runs and jumps): 0 feasible, converged
 //! and faithful; 1 written, but some frames did not converge (flagged in the plan table) or
 //! the posture leaves the recorded range, a knee locks through a flight or the root jerks
@@ -9,7 +9,9 @@
 use super::super::args::{EditCommon, EditJumpArgs, EditRunArgs};
 use super::super::Outcome;
 use crate::edit::select::{JumpTarget, RunTarget};
-use crate::pipeline::edit::{edit_jump, edit_run, EditReport, EditTarget, JumpEdit, RunEdit};
+use crate::pipeline::commands::edit::{
+    edit_jump, edit_run, EditReport, EditTarget, JumpEdit, RunEdit,
+};
 
 fn target(c: &EditCommon) -> EditTarget {
     EditTarget {

@@ -1,10 +1,10 @@
 //! `stancelib equilibrium`: the static/dynamic equilibrium verdict and robustness margin
 //! of one contact set at many COM states (spec two-pac §8.2, §9). The stage is
-//! [`crate::pipeline::equilibrium`]; this command delegates and prints.
+//! [`crate::pipeline::commands::equilibrium`]; this command delegates and prints.
 
 use super::super::args::EquilibriumArgs;
 use super::super::Outcome;
-use crate::pipeline::equilibrium::{run_equilibrium, EquilibriumJob, EquilibriumReport};
+use crate::pipeline::commands::equilibrium::{run_equilibrium, EquilibriumJob, EquilibriumReport};
 
 /// Run `equilibrium`.
 ///

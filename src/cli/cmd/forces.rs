@@ -14,7 +14,7 @@ use crate::library::per_contact::{
     contact_rows, per_contact_csv, per_contact_mot, per_contact_table, read_contact_clip,
 };
 use crate::library::schema::STANCES_FILE;
-use crate::pipeline::queries::{query_kv, write_table};
+use crate::pipeline::commands::queries::{query_kv, write_table};
 
 /// The output format: `--format`, else the `--out` extension, else Parquet.
 ///

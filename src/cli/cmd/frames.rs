@@ -6,8 +6,9 @@ use super::super::args::FramesArgs;
 use super::super::Outcome;
 use crate::ingest::IngestOptions;
 use crate::library::{ClipStatus, Status};
-use crate::pipeline::batch::{discover, frames_into};
-use crate::pipeline::inputs::read_body;
+use crate::pipeline::commands::frames::frames_into;
+use crate::pipeline::engine::inputs::discover;
+use crate::pipeline::spec::read_body;
 use crate::pipeline::spec::{resolve, with_masses};
 
 /// Run `frames`.

@@ -1,5 +1,5 @@
 //! `stancelib list LIB`: a catalogue of what a library holds (see
-//! [`crate::pipeline::catalogue`]): characters, recorded run cycles, recorded jumps, as
+//! [`crate::pipeline::commands::catalogue`]): characters, recorded run cycles, recorded jumps, as
 //! text or, with `--json`, one JSON object.
 //!
 //! A command of its own rather than sections of `info`: `info` reads a few columns and
@@ -10,7 +10,7 @@ use anyhow::Context;
 
 use super::super::args::ListArgs;
 use super::super::Outcome;
-use crate::pipeline::catalogue::{read_catalogue, Catalogue};
+use crate::pipeline::commands::catalogue::{read_catalogue, Catalogue};
 
 /// Clip names shown per character in the text (`--json` lists all).
 pub const CLIPS_SHOWN: usize = 3;

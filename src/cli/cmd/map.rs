@@ -4,7 +4,7 @@
 
 use super::super::args::MapJumpsArgs;
 use super::super::Outcome;
-use crate::pipeline::queries::{map_jumps, MapQuery, MapReport, HIGHER_BY};
+use crate::pipeline::commands::map_jumps::{map_jumps, MapQuery, MapReport, HIGHER_BY};
 
 /// Run `map jumps`.
 ///

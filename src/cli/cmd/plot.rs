@@ -1,9 +1,9 @@
 //! `stancelib plot stance` and `stancelib plot clip`: delegate to
-//! [`crate::pipeline::plots`] and print what was drawn.
+//! [`crate::pipeline::commands::plots`] and print what was drawn.
 
 use super::super::args::{PlotClipArgs, PlotStanceArgs};
 use super::super::Outcome;
-use crate::pipeline::plots::{plot_clip, plot_stance, StancePlotJob};
+use crate::pipeline::commands::plots::{plot_clip, plot_stance, StancePlotJob};
 
 /// Run `plot stance`.
 ///

@@ -7,9 +7,8 @@ use anyhow::Context;
 
 use super::super::args::{JumpArgs, RunQueryArgs};
 use super::super::Outcome;
-use crate::pipeline::queries::{
-    jump_query, run_query, JumpLine, JumpQuery, JumpTarget, RunQuery, RunReport,
-};
+use crate::pipeline::commands::query_jump::{jump_query, JumpLine, JumpQuery, JumpTarget};
+use crate::pipeline::commands::query_run::{run_query, RunQuery, RunReport};
 
 /// Run `query run`.
 ///
@@ -25,7 +24,7 @@ pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
         limits: a.lim.options(),
         out: a.out.clone(),
         png: a.png.clone(),
-        gait_law: crate::pipeline::queries::gait_law_choice(Some(&a.gait_law))
+        gait_law: crate::pipeline::commands::queries::gait_law_choice(Some(&a.gait_law))
             .context("--gait-law")?,
         keep_left_out: a.keep_left_out,
         explain: a.explain.clone(),

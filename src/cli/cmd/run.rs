@@ -6,9 +6,10 @@ use anyhow::Context;
 
 use super::super::args::RunArgs;
 use super::super::Outcome;
-use crate::pipeline::build::build_library;
+use crate::pipeline::commands::build::build_library;
+use crate::pipeline::commands::map_jumps::map_jumps;
+use crate::pipeline::commands::query_run::run_query;
 use crate::pipeline::job::{pipeline_job, CommandLine};
-use crate::pipeline::queries::{map_jumps, run_query};
 
 /// Run a pipeline file.
 ///

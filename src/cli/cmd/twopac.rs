@@ -4,13 +4,13 @@
 //! `trajectory.png` in the output folder.
 //!
 //! The stage itself (clip ingest, polytopes, plan, samples, solve times, outputs) is in
-//! [`crate::pipeline::twopac`] and [`crate::pipeline::twopac_outputs`]; this command
+//! [`crate::pipeline::commands::twopac`] and [`crate::pipeline::commands::twopac_outputs`]; this command
 //! turns its options into a job, delegates and prints.
 
 use super::super::args::TwopacArgs;
 use super::super::Outcome;
 use crate::math::constants::STATIC_TOL;
-use crate::pipeline::twopac_outputs::{run_twopac, TwopacJob, TwopacReport};
+use crate::pipeline::commands::twopac_outputs::{run_twopac, TwopacJob, TwopacReport};
 use crate::twopac::transition::QpForm;
 use crate::twopac::validate::{Validation, DEFAULT_STEP_S};
 

@@ -3,9 +3,9 @@
 //! temporary folder that replaces the library folder in one step.
 //!
 //! The build streams: clips are taken in name order in batches of at most
-//! [`DEFAULT_BATCH_CLIPS_PER_THREAD`] clips and [`DEFAULT_BATCH_BYTES_PER_THREAD`] file
+//! [`DEFAULT_BATCH_CLIPS_PER_THREAD`](super::batch::DEFAULT_BATCH_CLIPS_PER_THREAD) clips and [`DEFAULT_BATCH_BYTES_PER_THREAD`](super::batch::DEFAULT_BATCH_BYTES_PER_THREAD) file
 //! bytes per worker thread (`batch::batch_ends`), and each batch's rows are
-//! appended to the tables (`pipeline::sink`) while the next batch is built (two batches in
+//! appended to the tables (`pipeline::engine::sink`) while the next batch is built (two batches in
 //! memory at most), so memory depends on the largest clips and the thread count, not on
 //! the number of clips. The files are the same, byte for byte, whatever the batch size and
 //! thread count. Overlapping the writing with the next batch: bulk CMU set, 2 threads,
@@ -36,11 +36,14 @@ use indicatif::ProgressBar;
 use polars::prelude::*;
 use rayon::prelude::*;
 
-use super::batch::{file_sha256, ingest_file, progress};
+use super::batch::{ingest_file, progress};
+use super::cursor::ClipCursor;
+use super::inputs::file_sha256;
 use super::names::clip_names;
 use super::output::{claim, name_of, parent_of, swap_into_place, OutputRules};
 use super::shard::{inputs_fingerprint, shard_of, Shard};
-use super::sink::{combine, pe, strings, ClipCursor, LibrarySink, Tables};
+use super::sink::LibrarySink;
+use super::tables::{combine, strings, BuildReport, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
 use crate::library::integrity::{
@@ -48,27 +51,13 @@ use crate::library::integrity::{
 };
 use crate::library::layout::Layout;
 use crate::library::provenance::library_layout;
-use crate::library::read::read_parquet;
-use crate::library::schema::{
-    clips, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, SCHEMA_VERSION,
-    STANCES_FILE,
-};
+use crate::library::schema::{clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION};
 use crate::library::scratch::{scratch_name, Scratch};
-use crate::library::stances::{errors_table, first_non_finite, stances_table, ErrorRow};
-use crate::library::write::{clips_table, contacts_table, frames_table, joints_table};
+use crate::library::stances::{first_non_finite, ErrorRow};
+use crate::library::table::read_parquet;
 use crate::library::{ClipRecord, ClipStatus, Status};
 use crate::stances::build::StanceNote;
 use crate::stances::{build_clip, Stance, StanceOptions};
-
-/// Clips per batch and worker thread of a streaming build: a batch holds at most this
-/// many clips per thread in memory (with their frames) before its rows are written.
-pub const DEFAULT_BATCH_CLIPS_PER_THREAD: usize = 4;
-/// File bytes per batch and worker thread, at most (a larger clip is a batch of its own;
-/// `batch::batch_ends`): about four clips of the CMU set's mean size (0.97 MB). Without it a
-/// batch is bounded by its count alone, and the 25× replica, whose batches fall on other
-/// clips than the bulk set's, met a batch of the largest clips (heap peak 74 MB against
-/// 55 MB).
-pub const DEFAULT_BATCH_BYTES_PER_THREAD: u64 = 4 << 20;
 
 /// How a build runs: none of it changes the rows of a clip.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -77,8 +66,8 @@ pub struct BuildPlan {
     pub incremental: bool,
     /// Build only this shard of the inputs (`--shard I/N`).
     pub shard: Option<Shard>,
-    /// Most clips per batch; 0 = [`DEFAULT_BATCH_CLIPS_PER_THREAD`] × the worker threads
-    /// (the bytes per batch are bounded either way: [`DEFAULT_BATCH_BYTES_PER_THREAD`]).
+    /// Most clips per batch; 0 = [`DEFAULT_BATCH_CLIPS_PER_THREAD`](super::batch::DEFAULT_BATCH_CLIPS_PER_THREAD) × the worker threads
+    /// (the bytes per batch are bounded either way: [`DEFAULT_BATCH_BYTES_PER_THREAD`](super::batch::DEFAULT_BATCH_BYTES_PER_THREAD)).
     pub batch_clips: usize,
     /// How the tables are laid out (`--layout`; the rows are the same).
     pub layout: Layout,
@@ -101,17 +90,6 @@ impl BuildOptions {
             .map(|v| v.to_string())
             .unwrap_or_default()
     }
-}
-
-/// What a build produced in memory (with [`build`]: every clip).
-#[derive(Debug)]
-pub struct BuildReport {
-    /// One record per input file, sorted by clip.
-    pub records: Vec<ClipRecord>,
-    /// Every stance of those clips, sorted by (clip, first frame, label).
-    pub stances: Vec<Stance>,
-    /// Failed inputs and stages.
-    pub errors: Vec<ErrorRow>,
 }
 
 /// What a written build did.
@@ -269,37 +247,6 @@ fn assemble(mut per_clip: Vec<(ClipRecord, ClipStances)>) -> BuildReport {
         records,
         stances,
         errors,
-    }
-}
-
-impl Tables {
-    /// The tables of a build; `joints.parquet` too when the ingest kept joint positions
-    /// (`--joints`: the same table as `frames --joints` writes).
-    /// The tables are assembled side by side on the worker pool.
-    fn from_report(r: &BuildReport, joints: bool) -> Result<Tables> {
-        let rec = &r.records;
-        let ((frames, contacts), ((clips, stances), (errors, joints))) = rayon::join(
-            || rayon::join(|| frames_table(rec), || contacts_table(rec)),
-            || {
-                rayon::join(
-                    || rayon::join(|| clips_table(rec), || stances_table(&r.stances)),
-                    || {
-                        rayon::join(
-                            || errors_table(&r.errors),
-                            || joints.then(|| joints_table(rec)),
-                        )
-                    },
-                )
-            },
-        );
-        Ok(Tables {
-            frames: frames.map_err(|e| pe(FRAMES_FILE, e))?,
-            contacts: contacts.map_err(|e| pe(CONTACTS_FILE, e))?,
-            clips: clips.map_err(|e| pe(CLIPS_FILE, e))?,
-            stances: stances.map_err(|e| pe(STANCES_FILE, e))?,
-            errors: errors.map_err(|e| pe(ERRORS_FILE, e))?,
-            joints: joints.transpose().map_err(|e| pe(JOINTS_FILE, e))?,
-        })
     }
 }
 
@@ -613,23 +560,4 @@ pub(crate) fn replace_library(out: &Path, write: impl FnOnce(&Path) -> Result<()
         let _ = std::fs::remove_dir_all(&tmp);
     }
     result
-}
-
-/// `build`: builds `files` into `out` on `threads` workers (0 = all cores), as
-/// [`build_into`] does.
-///
-/// # Errors
-/// No readable inputs, a pool that cannot start, or what [`build_into`] reports.
-pub fn build_library(
-    files: &[PathBuf],
-    out: &Path,
-    opts: &BuildOptions,
-    threads: usize,
-    plan: &BuildPlan,
-    rules: &OutputRules,
-) -> anyhow::Result<BuildSummary> {
-    use anyhow::Context;
-    super::batch::worker_pool(files, threads)?
-        .install(|| build_into(files, out, opts, plan, rules))
-        .with_context(|| format!("writing the library to {}", out.display()))
 }

@@ -9,9 +9,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
-use super::build::{DEFAULT_BATCH_BYTES_PER_THREAD, DEFAULT_BATCH_CLIPS_PER_THREAD};
-use super::inputs::{bvh_too_large, open_input};
-pub use super::inputs::{check_input, discover, none_readable, InputProblem, MAX_BVH_BYTES};
+use super::inputs::{bvh_too_large, hex, open_input, InputProblem, MAX_BVH_BYTES};
 use super::names::clip_names;
 use crate::error::{Error, ErrorKind, Result};
 use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions, MASS_SOURCE_DEFAULT};
@@ -32,10 +30,6 @@ impl<R: Read> Read for HashingReader<R> {
         self.bytes += n as u64;
         Ok(n)
     }
-}
-
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// Ingest one file into its record. Never fails: errors become an `error` record.
@@ -208,15 +202,6 @@ fn ingest_counted_one(
     r
 }
 
-/// SHA-256 of an input's bytes, hex (`None` when it is not a readable regular file of at
-/// most [`MAX_BVH_BYTES`]).
-pub fn file_sha256(path: &Path) -> Option<String> {
-    let f = open_input(path).ok()?;
-    let mut h = Sha256::new();
-    let n = std::io::copy(&mut f.take(MAX_BVH_BYTES + 1), &mut h).ok()?;
-    (n <= MAX_BVH_BYTES).then(|| hex(&h.finalize()))
-}
-
 /// Worker threads allowed per core: `--threads` and the pipeline's `threads` are at most
 /// this many times `std::thread::available_parallelism()` (each worker holds one clip
 /// in memory; more threads than that only add memory and switching).
@@ -243,45 +228,6 @@ pub fn check_threads(field: &str, threads: usize) -> Result<()> {
         ));
     }
     Ok(())
-}
-
-/// Checks there is work, then starts the rayon pool with `threads` workers (0 = all cores).
-///
-/// # Errors
-/// No input files, none that can be read (nothing is written then), or a pool that cannot
-/// start.
-pub fn worker_pool(files: &[PathBuf], threads: usize) -> anyhow::Result<rayon::ThreadPool> {
-    use anyhow::Context;
-    if files.is_empty() {
-        anyhow::bail!("no .bvh files found in the inputs");
-    }
-    if let Some(why) = none_readable(files) {
-        anyhow::bail!("no input can be read (nothing was written):\n{why}");
-    }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("starting the worker threads")
-}
-
-/// `frames`: ingests `files` on `threads` workers and writes the frame, clip and contact
-/// tables (and joints, with `opts.joints`) to `out`; one record per file, failures
-/// included.
-///
-/// # Errors
-/// No readable input, a pool that cannot start, an unwritable output folder, or an output
-/// folder that holds a library ([`super::output::refuse_library`]).
-pub fn frames_into(
-    files: &[PathBuf],
-    out: &Path,
-    opts: &IngestOptions,
-    threads: usize,
-) -> anyhow::Result<Vec<ClipStatus>> {
-    use anyhow::Context;
-    super::output::refuse_library(out)?;
-    let pool = worker_pool(files, threads)?;
-    pool.install(|| stream_frames(files, out, opts))
-        .with_context(|| format!("writing tables to {}", out.display()))
 }
 
 /// Where each batch of a list of clips ends (exclusive indices, in order): consecutive
@@ -346,7 +292,11 @@ pub fn default_batch_bounds() -> (usize, u64) {
 /// tables are those of one batch of every clip, byte for byte ([`FramesWriter`]); batches
 /// are as a build's ([`default_batch_bounds`]). Records come back without their frames,
 /// contact runs and summaries (those are in the tables).
-fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<Vec<ClipStatus>> {
+pub(crate) fn stream_frames(
+    files: &[PathBuf],
+    out: &Path,
+    opts: &IngestOptions,
+) -> Result<Vec<ClipStatus>> {
     let mut named: Vec<(PathBuf, String)> = files.iter().cloned().zip(clip_names(files)).collect();
     named.sort_by(|a, b| a.1.cmp(&b.1));
     let (max_clips, max_bytes) = default_batch_bounds();
@@ -368,6 +318,17 @@ fn stream_frames(files: &[PathBuf], out: &Path, opts: &IngestOptions) -> Result<
     w.finish()?;
     Ok(records)
 }
+
+/// Clips per batch and worker thread of a streaming build: a batch holds at most this
+/// many clips per thread in memory (with their frames) before its rows are written.
+pub const DEFAULT_BATCH_CLIPS_PER_THREAD: usize = 4;
+
+/// File bytes per batch and worker thread, at most (a larger clip is a batch of its own;
+/// `batch::batch_ends`): about four clips of the CMU set's mean size (0.97 MB). Without it a
+/// batch is bounded by its count alone, and the 25× replica, whose batches fall on other
+/// clips than the bulk set's, met a batch of the largest clips (heap peak 74 MB against
+/// 55 MB).
+pub const DEFAULT_BATCH_BYTES_PER_THREAD: u64 = 4 << 20;
 
 #[cfg(test)]
 mod tests {

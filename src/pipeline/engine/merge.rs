@@ -26,21 +26,24 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use super::build::replace_library;
+use super::cursor::ClipCursor;
 use super::output::{claim, is_library, OutputRules};
-use super::sink::{sorted, ClipCursor, Defer, Detached, LibrarySink, Tables};
+use super::sink::{Defer, Detached, LibrarySink};
+use super::streaming::replace_library;
+use super::tables::Tables;
 use crate::error::{Error, Result};
+use crate::library::group_reader::GroupFileReader;
 use crate::library::integrity::{check_table, recorded_digests, Digests};
+use crate::library::layout::sorted;
 use crate::library::layout::{locate, table_exists, Layout};
-use crate::library::read::read_parquet;
-use crate::library::row_groups::GroupFileReader;
 use crate::library::schema::sort_keys;
 use crate::library::schema::{
     group_column, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, STANCES_FILE,
 };
 use crate::library::stream::TableWriter;
-use crate::library::write::ROW_GROUP_ROWS;
+use crate::library::stream::ROW_GROUP_ROWS;
+use crate::library::table::read_parquet;
 
 /// What a merge wrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -267,7 +270,7 @@ fn clip_plan(libs: &[ShardLib]) -> Result<Vec<(String, usize, usize)>> {
     for (k, lib) in libs.iter().enumerate() {
         let path = lib.dir.join(CLIPS_FILE);
         let df = read_parquet(&path)?;
-        let names = super::sink::strings(&df, "clip");
+        let names = super::tables::strings(&df, "clip");
         let frames: Vec<Option<i64>> = df
             .column("frames_kept")
             .and_then(|c| c.i64().map(|s| s.iter().collect()))
@@ -431,7 +434,7 @@ fn copy_groups(
 /// A `dataset` shard's samples are read partition by partition.
 fn push_samples(sink: &mut LibrarySink, lib: &Path) -> Result<()> {
     for path in locate(lib, KINEMATICS_SAMPLES_FILE)?.files() {
-        let total = crate::library::read::parquet_rows(&path)?;
+        let total = crate::library::table::parquet_rows(&path)?;
         let mut at = 0;
         while at < total {
             let rows = crate::library::stream::read_rows(&path, at, ROW_GROUP_ROWS)?;
@@ -608,7 +611,7 @@ fn merge_rows(
                 let Some(cur) = cur else { continue };
                 if let Some(rows) = cur.take_through(&last, &|_| true)? {
                     check_owner(&rows, name, k, &owner, libs)?;
-                    let rows = super::sink::cast_like(rows, df, name)?;
+                    let rows = super::tables::cast_like(rows, df, name)?;
                     df.vstack_mut(&rows)
                         .map_err(|e| Error::io(name, "cannot stack rows", e))?;
                 }
@@ -658,7 +661,7 @@ fn check_owner(
     owner: &BTreeMap<&str, usize>,
     libs: &[ShardLib],
 ) -> Result<()> {
-    let clips = super::sink::strings(rows, "clip");
+    let clips = super::tables::strings(rows, "clip");
     let Some(c) = clips.iter().find(|c| owner.get(c.as_str()) != Some(&k)) else {
         return Ok(());
     };
@@ -700,7 +703,7 @@ fn check_unique(
         .iter()
         .map(|c| c.get(i).map(|v| v.to_string()).unwrap_or_default())
         .collect();
-    let clip = super::sink::strings(&df.slice(i as i64, 1), "clip");
+    let clip = super::tables::strings(&df.slice(i as i64, 1), "clip");
     let shard = clip
         .first()
         .and_then(|c| owner.get(c.as_str()))

@@ -358,7 +358,7 @@ pub struct Recorded {
 /// # Errors
 /// The clip cannot be read or ingested, is not a body, or has no contact phase.
 pub fn clip_phases(clip: &Path) -> anyhow::Result<(PhasesFile, Recorded)> {
-    let bvh = super::inputs::read_side_bvh(clip)?;
+    let bvh = crate::pipeline::engine::inputs::read_side_bvh(clip)?;
     let mut opts = crate::ingest::IngestOptions::default();
     opts.contacts.static_mode = true;
     let outcome = crate::ingest::ingest(&bvh, &opts).with_context(|| clip.display().to_string())?;
@@ -423,8 +423,8 @@ pub fn clip_character(
     all: &BTreeMap<(String, String), Polytope>,
 ) -> Option<String> {
     let has = |id: &str| all.keys().any(|(c, _)| c == id);
-    let sha = crate::pipeline::batch::file_sha256(clip);
-    let clips = crate::library::read::Table::open_columns(
+    let sha = crate::pipeline::engine::inputs::file_sha256(clip);
+    let clips = crate::library::table::Table::open_columns(
         &lib.join(crate::library::schema::CLIPS_FILE),
         &["content_sha256", "character_id"],
     )
@@ -487,7 +487,7 @@ mod tests {
         std::fs::write(&clip, "not parsed here: only its bytes are hashed").unwrap();
         let other = dir.path().join("other.bvh");
         std::fs::write(&other, "another clip").unwrap();
-        let sha = crate::pipeline::batch::file_sha256(&clip).unwrap();
+        let sha = crate::pipeline::engine::inputs::file_sha256(&clip).unwrap();
         let mut df = DataFrame::new_infer_height(vec![
             Column::new("content_sha256".into(), vec![sha, "0".repeat(64)]),
             Column::new("character_id".into(), ["sk-b", "sk-c"]),

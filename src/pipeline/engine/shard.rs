@@ -15,7 +15,7 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use super::batch::file_sha256;
+use super::inputs::file_sha256;
 use crate::error::{Error, Result};
 
 /// Most shards one build may be cut into.

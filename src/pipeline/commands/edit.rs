@@ -24,7 +24,7 @@ use crate::ingest::body::BodyModel;
 use crate::library::provenance::library_body;
 use crate::library::read::{read_clip_sources, read_stance_timing};
 use crate::library::schema::{CLIPS_FILE, STANCES_FILE};
-use crate::pipeline::batch::file_sha256;
+use crate::pipeline::engine::inputs::file_sha256;
 use crate::plot::edit::edit_png;
 use crate::plot::write_png;
 use crate::query::feasibility::LimitForm;

@@ -6,14 +6,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use super::inputs::{read_side_text, SideInput};
 use crate::force_model::export::{kinematic_force, sample_forces};
+use crate::ingest::plates::{parse_plates, PlateFoot, PlateSample};
 use crate::library::clip_view::{read_clip_view, ClipView};
 use crate::library::forces::{
     read_clip_accelerations, read_force_stances, read_up_axis, select_stances,
 };
-use crate::library::plates::{parse_plates, PlateFoot, PlateSample};
 use crate::library::schema::{CLIPS_FILE, FRAMES_FILE, STANCES_FILE};
+use crate::pipeline::engine::inputs::{read_side_text, SideInput};
 use crate::plot::stance::{stance_png, time_window, StancePlot, WorldForces};
 use crate::plot::write_png;
 use crate::skeleton::units::UpAxis;

@@ -7,6 +7,8 @@
 
 use std::collections::HashSet;
 use std::io::Read;
+
+use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 pub use crate::error::InputProblem;
@@ -444,41 +446,20 @@ pub fn read_side_bvh(path: &Path) -> Result<crate::bvh::Bvh> {
     parsed
 }
 
-/// Reads and parses a pipeline file through [`read_side_text`].
-///
-/// # Errors
-/// As [`read_side_text`] and [`super::spec::parse_pipeline`].
-pub fn read_pipeline(path: &Path) -> Result<super::spec::PipelineFile> {
-    super::spec::parse_pipeline(path, &read_side_text(path, SideInput::Pipeline)?)
-}
-
-/// Reads and parses a body file through [`read_side_text`].
-///
-/// # Errors
-/// As [`read_side_text`] and [`super::spec::parse_body`].
-pub fn read_body(path: &Path) -> Result<super::spec::BodyFile> {
-    super::spec::parse_body(path, &read_side_text(path, SideInput::Body)?)
-}
-
 /// A BVH input that grew past [`MAX_BVH_BYTES`] while it was read.
 pub(super) fn bvh_too_large(bytes: u64) -> InputProblem {
     BVH_BOUND.too_large(bytes)
 }
 
-/// `(folder, file name)` of an output file path given as `--out`.
-///
-/// # Errors
-/// A path that does not end in a UTF-8 file name.
-pub fn split_out(out: &Path) -> anyhow::Result<(&Path, String)> {
-    use anyhow::Context;
-    let name = out
-        .file_name()
-        .and_then(|n| n.to_str())
-        .with_context(|| format!("--out {}: not a file name", out.display()))?
-        .to_string();
-    let dir = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    Ok((dir, name))
+/// SHA-256 of an input's bytes, hex (`None` when it is not a readable regular file of at
+/// most [`MAX_BVH_BYTES`]).
+pub fn file_sha256(path: &Path) -> Option<String> {
+    let f = open_input(path).ok()?;
+    let mut h = Sha256::new();
+    let n = std::io::copy(&mut f.take(MAX_BVH_BYTES + 1), &mut h).ok()?;
+    (n <= MAX_BVH_BYTES).then(|| hex(&h.finalize()))
+}
+
+pub(crate) fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }

@@ -33,8 +33,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::library::read::{open_library, StanceLibrary, Table};
+use crate::library::read::{open_library, StanceLibrary};
 use crate::library::schema::{clips, CLIPS_FILE};
+use crate::library::table::Table;
 use crate::math::stats::median;
 use crate::query::feasibility::{LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::gait::{GaitLaw, LawChoice};
@@ -191,7 +192,7 @@ fn characters(
 }
 
 /// Every run cycle, with its verdict at its own speed as `query run --speed v_orig` gives
-/// it with default options (`crate::pipeline::queries::run_query` at `L = M = 1`).
+/// it with default options (`crate::pipeline::commands::query_run::run_query` at `L = M = 1`).
 fn cycles(lib: &StanceLibrary) -> Vec<CatalogueCycle> {
     let active = DEFAULT_QUERY_ACTIVE_FRACTION;
     let all = run_cycles(&lib.stances);

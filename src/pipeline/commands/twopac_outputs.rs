@@ -8,7 +8,6 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use super::inputs::{read_side_text, SideInput};
 use super::twopac::{clip_phases, plot_data, resolve, rows, timings, PolytopeSource, Recorded};
 use super::twopac_tables::{
     form_name, phases_table, trajectory_table, transitions_table, validation_table, windows_table,
@@ -16,6 +15,7 @@ use super::twopac_tables::{
 };
 use crate::library::atomic::write_text_atomic;
 use crate::library::write::write_atomic;
+use crate::pipeline::engine::inputs::{read_side_text, SideInput};
 use crate::plot::trajectory::trajectory_png;
 use crate::plot::trajectory::{curve_verdict, CurveSample};
 use crate::plot::write_png;

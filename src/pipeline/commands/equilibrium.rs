@@ -17,13 +17,14 @@ use std::time::Instant;
 use anyhow::Context;
 use rayon::prelude::*;
 
-use super::batch::progress;
-use super::inputs::{open_side_input, read_side_text, split_out, SideInput};
+use super::split_out;
 use super::twopac_tables::equilibrium_table;
 use crate::error::Error;
-use crate::library::read::OpenedParquet;
 use crate::library::schema::com_state::{ACCELERATION, POSITION};
+use crate::library::table::OpenedParquet;
 use crate::library::write::write_atomic;
+use crate::pipeline::engine::batch::progress;
+use crate::pipeline::engine::inputs::{open_side_input, read_side_text, SideInput};
 use crate::plot::write_png;
 use crate::twopac::contact::{contact_points, min_mu, ContactPoint};
 use crate::twopac::equilibrium::{
