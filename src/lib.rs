@@ -3,7 +3,7 @@
 //! Turns motion-capture clips (BVH) into a physically grounded stance library.
 //!
 //! ## Stages
-//! The whole crate, data left to right; `math` (constants, 3-vectors, SG, fits) serves
+//! The whole crate, data left to right; `math` (constants, 3-vectors, SG, fits, heading) serves
 //! every stage, and only `bvh`, `library`, `pipeline` and `cli` touch files.
 //! ```text
 //!            ┌──────────────────────────── ingest (one clip, pure) ─────────────────────────┐
@@ -22,11 +22,14 @@
 //!                                     contact runs) or a phases JSON → twopac (contacts,
 //!                                     static region, transitions, trajectory, validation)
 //!
-//! pipeline drives the stages and writes their outputs: batch ingest in parallel, the
-//! streaming build, shards and merge, pipeline files (job), and one stage per command
-//! (queries, edit, equilibrium, twopac, plots) from typed options; cli only parses
-//! arguments into those options, delegates and prints. plot draws PNGs of the results;
-//! synth makes clips with known truth for the tests.
+//! pipeline drives the stages and writes their outputs, in three rooms: pipeline::engine
+//! (batch ingest in parallel, inputs, the streaming build, shards and merge; typed errors),
+//! pipeline::commands (one stage per command from typed options: queries, edit,
+//! equilibrium, twopac, plots, catalogue; anyhow at that edge) and the configuration
+//! (pipeline::spec, pipeline::job). cli only parses arguments into those options, delegates
+//! and prints. plot draws PNGs of the results; synth makes clips with known truth for the
+//! tests. Imports go one way: no circle between files or top-level modules
+//! (`tests/source_layout.rs`).
 //! ```
 //!
 //! The method of each stage (equations, units, the papers' numbering and where the tool

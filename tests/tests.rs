@@ -69,7 +69,7 @@
 //!
 //! # Command line and documentation
 //! - `cli`: the binary end to end: table layout, exit codes, determinism, atomic writes, pipelines.
-//! - `analyst`: issue 17 — the README's demo commands run and answer with numbers (issue 38
+//! - `documentation`: issue 17 — the README's demo commands run and answer with numbers (issue 38
 //!   item 6), the README has at most 300 lines, `docs/first-hour.md` runs as written and
 //!   reaches its answers, `docs/tables.md` is the written schemas; manifest date and
 //!   command line, query outputs naming their library, `info`, negative numbers, `--help`
@@ -105,11 +105,13 @@
 //!   escaped on the terminal, "rebuild" for old layouts, injective file names, `--pair`
 //!   with `:` in clip names, the manifest read bounded.
 //!
-//! # Structure (issue 13)
-//! - `structure_edges`: enumerated options parsed (any case) and refused before work;
-//!   outputs of every kind leave no temporary behind.
-//! - `structure_stages`: items 1, 4 — the contact stage's entry points give the ingest's
-//!   contacts; batch ingest errors keep their kind.
+//! # Structure (issues 13, 41)
+//! - `cli_options`: issue 13 items 2–3 — enumerated options parsed (any case) and refused
+//!   before work; outputs of every kind leave no temporary behind.
+//! - `stage_entry_points`: issue 13 items 1, 4 — the contact stage's entry points give the
+//!   ingest's contacts; batch ingest errors keep their kind.
+//! - `source_layout`: issue 41 — no import circle between files or top-level modules of
+//!   `src/`, no file over 800 lines but the registries, no `anyhow` in the build engine.
 //!
 //! # Speed (issue 15)
 //! - `speed`: the batched SIMD FK equals its scalar fallback bit for bit and the libm FK to
@@ -155,9 +157,9 @@ mod twopac;
 mod edit_checks;
 mod edit_motion;
 // Command line and documentation
-mod analyst;
 mod catalogue;
 mod cli;
+mod documentation;
 mod duplicates;
 mod masses;
 mod pictures;
@@ -174,9 +176,10 @@ mod safety_reuse;
 mod safety_side_inputs;
 mod safety_swap;
 mod safety_work;
-// Structure (issue 13)
-mod structure_edges;
-mod structure_stages;
+// Structure (issues 13, 41)
+mod cli_options;
+mod source_layout;
+mod stage_entry_points;
 // Speed (issue 15)
 mod speed;
 // Regressions and helpers

@@ -251,6 +251,7 @@ fn workspace_is_send() {
 }
 
 #[test]
+#[ignore = "a timing printout, no assertion: 10,000 fits; run with --ignored --nocapture"]
 fn timing_10000_stances() {
     // Not an assertion: prints the wall time of 10,000 fits plus the §4.3 flags on one
     // 60 s, 120 Hz clip (run with --nocapture; the dev profile is opt-level 1).

@@ -8,10 +8,9 @@
 //! ```
 //! At most two batches are held at once, as when batch i + 1 was built beside the writing
 //! of batch i and the two then joined. The join was a barrier: a worker that finished its
-//! share of a batch idled until the batch's largest clip was done. Here it takes the next
-//! batch's items instead (bulk CMU set, 2 threads: one worker idled about a quarter of the
-//! run, `perf` timeline, 2026-12-06). The batches, their order and the results are the
-//! same, so the outputs are too.
+//! share of a batch idled until the batch's largest clip was done (measured: `docs/decisions.md`,
+//! "Measurements of the build engine"). Here it takes the next batch's items instead. The
+//! batches, their order and the results are the same, so the outputs are too.
 //!
 //! A panic in a task or in `write` is carried to the caller after the other tasks end,
 //! even when `write` has failed meanwhile; an error from `write` is returned once the

@@ -8,9 +8,8 @@
 //! appended to the tables (`pipeline::engine::sink`) while the next batch is built (two batches in
 //! memory at most), so memory depends on the largest clips and the thread count, not on
 //! the number of clips. The files are the same, byte for byte, whatever the batch size and
-//! thread count. Overlapping the writing with the next batch: bulk CMU set, 2 threads,
-//! `farm-bench -n 9` against the build that wrote before reading on (2026-12-03), wall
-//! median 0.744 → 0.664 s (ratio 1.11; 1.16 in a quieter run), peak RSS 93 → 105 MiB.
+//! thread count. What overlapping the writing with the next batch gained, measured, is in
+//! `docs/decisions.md` ("Measurements of the build engine").
 //!
 //! With `incremental`, the rows of clips whose path, content hash and options are those
 //! of the previous library are taken from it instead of being rebuilt; the result is the
