@@ -128,7 +128,11 @@ fn dispatch(command: Command) -> anyhow::Result<Outcome> {
         Command::Query(QueryCommand::Jump(a)) => on(&a.lib.clone(), a, cmd::query::run_jump),
         Command::Map(MapCommand::Jumps(a)) => on(&a.lib.clone(), a, cmd::map::run),
         Command::Equilibrium(a) => cmd::equilibrium::run(a),
-        Command::Twopac(a) => cmd::twopac::run(a),
+        // With `--lib` it reads the library's polytopes and clips: one generation of it.
+        Command::Twopac(a) => match a.lib.clone() {
+            Some(lib) => on(&lib, a, cmd::twopac::run),
+            None => cmd::twopac::run(a),
+        },
         Command::Forces(a) => on(&a.lib.clone(), a, cmd::forces::run),
         Command::Plot(PlotCommand::Stance(a)) => on(&a.lib.clone(), a, cmd::plot::run_stance),
         Command::Edit(EditCommand::Run(a)) => on(&a.common.lib.clone(), a, cmd::edit::run),
