@@ -172,6 +172,7 @@ const SHARED_FIELDS: [&str; 6] = [
 /// ```text
 /// {"ingest": {"mass_kg": 70, "sex": "Male"}} vs {"ingest": {"mass_kg": 80, "sex": "Male"}}
 ///   → ("options.ingest.mass_kg", "70", "80")
+/// {"inputs": ["a", "b"]} vs {"inputs": ["a", "b", "c"]}  → ("inputs[2]", "none", "\"c\"")
 /// ```
 pub fn first_difference(
     pointer: &str,
@@ -190,11 +191,10 @@ pub fn first_difference(
                 keys.into_iter()
                     .find_map(|k| walk(format!("{path}.{k}"), x.get(k), y.get(k)))
             }
-            (Some(Value::Array(x)), Some(Value::Array(y))) if x.len() == y.len() => x
-                .iter()
-                .zip(y)
-                .enumerate()
-                .find_map(|(i, (p, q))| walk(format!("{path}[{i}]"), Some(p), Some(q))),
+            // Item by item; arrays of different lengths that agree as far as the shorter
+            // goes differ at its end (`[n]`: the longer one's item against `none`).
+            (Some(Value::Array(x)), Some(Value::Array(y))) => (0..x.len().max(y.len()))
+                .find_map(|i| walk(format!("{path}[{i}]"), x.get(i), y.get(i))),
             _ if a == b => None,
             _ => {
                 let show = |v: Option<&Value>| {
@@ -721,6 +721,24 @@ fn check_unique(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // See: the review of issue 40 item 11 — arrays of different lengths were printed
+    // whole, cut to the same 80 characters, so two long option lists read the same.
+    #[test]
+    fn first_difference_names_the_first_item_where_arrays_differ() {
+        let a = serde_json::json!({"inputs": ["a".repeat(100), "b"]});
+        let b = serde_json::json!({"inputs": ["a".repeat(100), "b", "c"]});
+        assert_eq!(
+            first_difference("/options", Some(&a), Some(&b)),
+            Some(("options.inputs[2]".into(), "none".into(), "\"c\"".into()))
+        );
+        let c = serde_json::json!({"inputs": ["a".repeat(100), "x", "c"]});
+        assert_eq!(
+            first_difference("/options", Some(&c), Some(&b)).map(|d| d.0),
+            Some("options.inputs[1]".into())
+        );
+        assert_eq!(first_difference("/options", Some(&b), Some(&b)), None);
+    }
 
     #[test]
     fn a_stopped_copy_ends_with_an_error_naming_the_library() {
