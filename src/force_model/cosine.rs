@@ -189,14 +189,7 @@ pub fn fit_cosine_with(
     opts: &RatioOptions,
 ) -> Result<CosineFit> {
     opts.check()?;
-    let n = samples[2].len();
-    if n < 2 || samples.iter().any(|s| s.len() != n) {
-        return Err(Error::config(
-            None,
-            None,
-            format!("fourier model: need ≥ 2 samples per axis, got {n}"),
-        ));
-    }
+    let n = super::ratio::sample_count(samples, "fourier")?;
     let tau = sample_grid(n);
     let k_max = vertical_degree(n_st, opts.vertical_degree).min(n - 1);
     let design = DMatrix::from_fn(n, k_max + 1, |j, k| half_cosine(k, tau[j]));

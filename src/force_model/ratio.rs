@@ -504,6 +504,22 @@ pub(super) fn ratio_data(
     )
 }
 
+/// The number of force samples per axis, the same on all three and at least 2.
+///
+/// # Errors
+/// A config error naming the `model` (`ratio`, `fourier`) otherwise.
+pub(crate) fn sample_count(samples: &[Vec<f64>; 3], model: &str) -> Result<usize> {
+    let n = samples[2].len();
+    if n < 2 || samples.iter().any(|s| s.len() != n) {
+        return Err(Error::config(
+            None,
+            None,
+            format!("{model} model: need ≥ 2 samples per axis, got {n}"),
+        ));
+    }
+    Ok(n)
+}
+
 /// Fits the ratio model to stance-axis force samples on `τ_j = j/(N−1)`.
 ///
 /// # Arguments
@@ -524,14 +540,7 @@ pub fn fit_ratio_with(
     opts: &RatioOptions,
 ) -> Result<RatioFit> {
     opts.check()?;
-    let n = samples[2].len();
-    if n < 2 || samples.iter().any(|s| s.len() != n) {
-        return Err(Error::config(
-            None,
-            None,
-            format!("ratio model: need ≥ 2 samples per axis, got {n}"),
-        ));
-    }
+    let n = sample_count(samples, "ratio")?;
     let tau = sample_grid(n);
     let d = vertical_degree(n_st, opts.vertical_degree).min(n - 1);
     let basis = bernstein_basis(d, &tau);
