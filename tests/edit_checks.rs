@@ -7,8 +7,8 @@
 //! and exits by it.
 
 use super::edit_motion::{
-    assert_bounds_except, cycle_of, edit, edit_cycle, first_cycle_against_source, first_jump,
-    fixture, library, measure, read_plan, recorded_jump_against_source,
+    assert_bounds_except, cycle_of, edit, edit_cycle, edit_with_output, first_cycle_against_source,
+    first_jump, fixture, library, measure, read_plan, recorded_jump_against_source,
 };
 use super::util::{ok, refused, s, shared_or_skip};
 use stancelib::library::table::read_parquet;
@@ -490,12 +490,14 @@ fn run_posture(
     out: &Path,
     src: &Path,
     dir: &Path,
+    swing_fold_deg: f64,
 ) -> (usize, [f64; 2], [f64; 2], [f64; 2], [f64; 2]) {
     let (e, r) = (gauged(out, dir), gauged(src, dir));
-    let (lean_r, knee_r) = (
+    let (lean_r, knee) = (
         range(r.lean.iter().copied()),
         range(r.knees.iter().flatten().copied()),
     );
+    let knee_r = [knee[0], knee[1] + swing_fold_deg];
     let outside = (0..e.lean.len())
         .filter(|&f| {
             let l = e.lean[f];
@@ -602,21 +604,25 @@ fn issue37_item5_edit_run_contact_time_and_cadence_are_the_querys() {
 // the toe instead. Measured from the written joints (not the editor's own gauge) against
 // the whole source clip ± 5° lean, ± 10° knee. 5 m/s (1.43 × the fixture's speed, 1.66 ×
 // the plate run's) is a known miss: the planned touchdown puts the contact 0.61 m ahead of
-// the COM (0.51 m recorded), beyond the leg even on its toe (docs/edited-motion.md).
+// the COM (0.51 m recorded), beyond the leg even on its toe (docs/edited-motion.md). The
+// swing knee may fold beyond the recording by the speed law the edit prints
+// (`edit::swing`), and its upper bound moves by that much. With the law the 5 m/s plate
+// run has 53 frames outside (32 without it: the left leg, too, now straightens in the 5
+// frames before each touchdown), the fixture 68 (73 without).
 #[test]
 fn issue37_item5_edit_run_posture_stays_within_the_recorded_range() {
     let dir = tempfile::tempdir().unwrap();
     let mut cases: Vec<(PathBuf, Vec<(f64, usize)>)> = vec![(
         fixture("run_120hz_m_yup"),
         // (speed, frames allowed outside): 0 at 2–4 m/s; the 5 m/s known miss as measured.
-        vec![(2.0, 0), (3.0, 0), (4.0, 0), (5.0, 73)],
+        vec![(2.0, 0), (3.0, 0), (4.0, 0), (5.0, 68)],
     )];
     if let Some(data) =
         shared_or_skip("issue37_item5_edit_run_posture_stays_within_the_recorded_range")
     {
         cases.push((
             data.join("forceplate/hamner_multi_run_3ms/clip.bvh"),
-            vec![(2.0, 0), (3.0, 0), (4.0, 0), (5.0, 32)],
+            vec![(2.0, 0), (3.0, 0), (4.0, 0), (5.0, 53)],
         ));
         cases.push((
             data.join("bvh/run/cmu_09_01_run_mb.bvh"),
@@ -628,7 +634,7 @@ fn issue37_item5_edit_run_posture_stays_within_the_recorded_range() {
         let lib = library(&sub, std::slice::from_ref(src));
         for &(v, allowed) in speeds {
             let out = sub.join(format!("run_{v}.bvh"));
-            let code = edit(&[
+            let (code, said) = edit_with_output(&[
                 "edit",
                 "run",
                 "--lib",
@@ -639,7 +645,10 @@ fn issue37_item5_edit_run_posture_stays_within_the_recorded_range() {
                 "--out",
                 &s(&out),
             ]);
-            let (outside, lean_e, knee_e, lean_r, knee_r) = run_posture(&out, src, &sub);
+            // The swing knee may fold beyond the recording by the speed law it names.
+            let fold = swing_law_deg(&said);
+            let (outside, lean_e, knee_e, lean_r, knee_r) =
+                run_posture(&out, src, &sub, fold.max(0.0));
             eprintln!(
                 "{} at {v} m/s (exit {code}): lean {:.1}…{:.1}° (recorded {:.1}…{:.1}°), knee \
                  {:.1}…{:.1}° (recorded {:.1}…{:.1}°), {outside} frame(s) outside",
@@ -666,6 +675,20 @@ fn issue37_item5_edit_run_posture_stays_within_the_recorded_range() {
             );
         }
     }
+}
+
+/// The swing fold of the speed law an edit run printed ("speed law +4.2°"), degrees.
+fn swing_law_deg(said: &str) -> f64 {
+    let at = said
+        .find("speed law ")
+        .expect("the edit names its swing law")
+        + "speed law ".len();
+    let num: String = said[at..]
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || matches!(c, '+' | '-' | '.'))
+        .collect();
+    num.parse()
+        .unwrap_or_else(|_| panic!("swing law in {said}"))
 }
 
 /// Standard gravity, m/s² (the unit of the spike bound).
@@ -1105,12 +1128,13 @@ fn gait(g: &Gauged, frames_dir: &Path) -> [f64; 9] {
 // way. Timing within the issue's 10 %; the touchdown distance within 20 % (the
 // recordings' own strides spread 0.142–0.158 and 0.204–0.248 m); knees at touchdown and
 // mid-stance within 10° and the trunk within 5° (`edit::fidelity`'s tolerances: one
-// runner's spread between trials); the COM's vertical range within 15 %. Measured (2 → 3
-// / 3 → 2 m/s): contact +6.1 / −1.5 %, period −3.2 / +4.1 %, touchdown distance +2.8 /
-// +13.8 %, knee at touchdown −5.1 / +3.1°, mid-stance +0.1 / +3.9°, lean −1.1 / +0.2°, COM
-// range −10.9 / +6.5 %. Known miss: the swing knee keeps the source's flexion (the edit
-// time-warps the recorded swing), where the runner folds it 14° more at 3 m/s than at 2
-// (−15.5 / +15.9°): printed, not asserted.
+// runner's spread between trials); the COM's vertical range within 15 %. The swing knee
+// (98th percentile of the flexion) within 10° too: the edit folds it by the speed law of
+// `edit::swing` (fitted across five runners; with this one left out it predicts +7.3° where
+// the runner folds 14.4° more at 3 m/s than at 2). Measured (2 → 3 / 3 → 2 m/s): contact
+// +6.4 / −1.3 %, period −5.4 / +4.1 %, touchdown distance +2.9 / +13.6 %, knee at
+// touchdown −4.1 / +3.1°, mid-stance −1.6 / +3.8°, swing knee −5.7 / +7.5° (−15.5 / +15.9°
+// when the edit replayed the recorded swing), lean −1.1 / +0.2°, COM range −12.2 / +8.2 %.
 #[test]
 fn edited_run_moves_like_the_same_runner_recorded_at_the_target_speed() {
     let Some(data) =
@@ -1131,17 +1155,17 @@ fn edited_run_moves_like_the_same_runner_recorded_at_the_target_speed() {
         "trunk lean °",
         "COM range m",
     ];
-    // (relative bound, absolute bound in degrees) per figure; None: printed only.
-    let bounds: [Option<(f64, f64)>; 9] = [
-        Some((0.01, 0.0)),
-        Some((0.10, 0.0)),
-        Some((0.10, 0.0)),
-        Some((0.20, 0.0)),
-        Some((0.0, KNEE_TOL_DEG)),
-        Some((0.0, KNEE_TOL_DEG)),
-        None,
-        Some((0.0, LEAN_TOL_DEG)),
-        Some((0.15, 0.0)),
+    // (relative bound, absolute bound in degrees) per figure.
+    let bounds: [(f64, f64); 9] = [
+        (0.01, 0.0),
+        (0.10, 0.0),
+        (0.10, 0.0),
+        (0.20, 0.0),
+        (0.0, KNEE_TOL_DEG),
+        (0.0, KNEE_TOL_DEG),
+        (0.0, KNEE_TOL_DEG),
+        (0.0, LEAN_TOL_DEG),
+        (0.15, 0.0),
     ];
     for (from, to) in [(2u32, 3u32), (3, 2)] {
         let sub = dir.path().join(format!("from{from}"));
@@ -1175,20 +1199,14 @@ fn edited_run_moves_like_the_same_runner_recorded_at_the_target_speed() {
             let (rel, diff) = (e[k] / r[k] - 1.0, e[k] - r[k]);
             eprintln!(
                 "{from} → {to} m/s, {name}: edited {:.3}, recorded at {to} m/s {:.3} \
-                 ({:+.1} %, {diff:+.2}){}",
+                 ({:+.1} %, {diff:+.2})",
                 e[k],
                 r[k],
                 100.0 * rel,
-                if bounds[k].is_none() {
-                    "  KNOWN MISS"
-                } else {
-                    ""
-                }
             );
             match bounds[k] {
-                Some((b, 0.0)) => assert!(rel.abs() <= b, "{from} → {to}: {name} {rel:+.3}"),
-                Some((_, deg)) => assert!(diff.abs() <= deg, "{from} → {to}: {name} {diff:+.2}°"),
-                None => {}
+                (b, 0.0) => assert!(rel.abs() <= b, "{from} → {to}: {name} {rel:+.3}"),
+                (_, deg) => assert!(diff.abs() <= deg, "{from} → {to}: {name} {diff:+.2}°"),
             }
         }
     }

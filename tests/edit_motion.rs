@@ -340,6 +340,11 @@ pub(super) fn assert_bounds_except(f: &Figures, misses: &[(&str, f64)]) {
 /// failed (exit 1) or as infeasible and written anyway (exit 3, `--allow-infeasible`);
 /// any other outcome fails. Returns the exit code.
 pub(super) fn edit(args: &[&str]) -> i32 {
+    edit_with_output(args).0
+}
+
+/// [`edit`], with what it printed on stdout.
+pub(super) fn edit_with_output(args: &[&str]) -> (i32, String) {
     let (code, out, err) = stancelib(args);
     assert!(
         matches!(code, 0 | 1 | 3),
@@ -359,7 +364,7 @@ pub(super) fn edit(args: &[&str]) -> i32 {
         3 => assert!(err.contains("infeasible"), "{err}"),
         _ => {}
     }
-    code
+    (code, out)
 }
 
 /// Mean speed of the run cycles rebuilt from a written BVH.

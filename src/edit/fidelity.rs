@@ -157,6 +157,9 @@ pub struct Fidelity {
     pub lean_edited_deg: [f64; 2],
     /// Knee flexion range (both legs), recorded and edited, deg.
     pub knee_recorded_deg: [f64; 2],
+    /// The reference's swing knees were folded by the run speed law (`super::swing`): the
+    /// "recorded" ranges are the recording's with that fold, and the texts say so.
+    pub swing_folded: bool,
     /// See `knee_recorded_deg`.
     pub knee_edited_deg: [f64; 2],
     /// Frames whose lean or knee is outside the recorded range plus its tolerance.
@@ -346,6 +349,7 @@ pub fn check(
         lean_recorded_deg: lean_rec,
         lean_edited_deg: range(&edited, &lean),
         knee_recorded_deg: knee_rec,
+        swing_folded: false,
         knee_edited_deg: range(&edited, &knee),
         lean_outside,
         knee_outside,
@@ -438,10 +442,11 @@ impl Fidelity {
         if self.knee_outside > 0 {
             let below = if o.knee_extension { "" } else { " (above)" };
             out.push(format!(
-                "knee flexion {:.1}…{:.1}° on {} frame(s) outside{below} the recorded {:.1}…{:.1}° ± {}°",
+                "knee flexion {:.1}…{:.1}° on {} frame(s) outside{below} the {} {:.1}…{:.1}° ± {}°",
                 self.knee_edited_deg[0],
                 self.knee_edited_deg[1],
                 self.knee_outside,
+                self.knee_reference_word(),
                 self.knee_recorded_deg[0],
                 self.knee_recorded_deg[1],
                 o.knee_tol_deg
@@ -477,6 +482,16 @@ impl Fidelity {
         out
     }
 
+    /// What the knee range is measured against: the recording, or the recording with its
+    /// swing folded by the speed law.
+    fn knee_reference_word(&self) -> &'static str {
+        if self.swing_folded {
+            "recorded, swing folded by the speed law,"
+        } else {
+            "recorded"
+        }
+    }
+
     /// A one-line summary of the figures.
     pub fn summary(&self) -> String {
         let locked: usize = self
@@ -491,7 +506,7 @@ impl Fidelity {
         };
         format!(
             "trunk lean {:.1}…{:.1}° (recorded {:.1}…{:.1}°), knee flexion {:.1}…{:.1}° \
-             (recorded {:.1}…{:.1}°){flights}, root acceleration ≤ {:.1} g (recorded {:.1} g), \
+             ({} {:.1}…{:.1}°){flights}, root acceleration ≤ {:.1} g (recorded {:.1} g), \
              {} frame(s) above {:.1} g where the recording is not{}",
             self.lean_edited_deg[0],
             self.lean_edited_deg[1],
@@ -499,6 +514,7 @@ impl Fidelity {
             self.lean_recorded_deg[1],
             self.knee_edited_deg[0],
             self.knee_edited_deg[1],
+            self.knee_reference_word(),
             self.knee_recorded_deg[0],
             self.knee_recorded_deg[1],
             self.root_accel_max_mps2 / G_MPS2,

@@ -16,6 +16,7 @@ use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
     choose_jump, choose_run, jump_stances, ChosenRun, EditLimits, JumpTarget, RunTarget,
 };
+use crate::edit::swing::{fold_change_deg, fold_swing_knees, swings, FoldReport, Swing};
 use crate::edit::{
     EditOptions, DEFAULT_JUMP_SWING_HOLD_S, MAX_CYCLES, MAX_EDIT_FRAME_JOINTS, MAX_FPS, MIN_FPS,
     RUN_KNEE_SLACK_DEG,
@@ -158,9 +159,12 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
     report_left_out("edit run", "cycle(s)", &chosen.left_out);
     let first = chosen.stances[0].source.stance_id.clone();
     let used = format!("{first} + {}", chosen.stances[1].source.stance_id);
+    let fold = swing_plan(&lib, &times, &chosen, e.run.length_scale);
     let achieved = run_achieved(&chosen, e.run.speed_mps);
     let order: Vec<usize> = (0..e.cycles).flat_map(|_| [0, 1]).collect();
-    let edit = compute(t, e.run.length_scale, chosen.stances, order, PlanKind::Run)?;
+    let stances = chosen.stances.clone();
+    let edit = compute(t, e.run.length_scale, stances, order, PlanKind::Run, &fold)?;
+    let achieved = format!("{achieved}; {}", swing_text(&edit.swing));
     let tm = &chosen.timing;
     let kv = query_kv(
         &t.lib,
@@ -171,6 +175,7 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
             "active_set": limits.active, "gait_law": tm.law.source.name(),
             "sigma_contact": tm.sigma_c, "sigma_step": tm.sigma_t, "kappa": tm.kappa,
             "speed_achieved_mps": chosen.speed_mps, "keep_left_out": e.run.keep_left_out,
+            "swing_fold_deg": edit.swing.asked_deg,
         }),
     )?;
     let title = format!(
@@ -178,6 +183,47 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
         e.run.speed_mps, e.cycles
     );
     finish(t, edit, kv, title, (used, achieved))
+}
+
+/// The swings of the chosen cycle's clip and the fold change the speed law asks of them
+/// ([`crate::edit::swing`]): from the recorded speed to the planned one, on a character
+/// `length_scale` times the source's size.
+fn swing_plan(
+    lib: &crate::library::read::StanceLibrary,
+    times: &[StanceTiming],
+    chosen: &ChosenRun,
+    length_scale: f64,
+) -> (Vec<Swing>, f64) {
+    let clip = &chosen.stances[0].source.clip;
+    let own = lib
+        .stances
+        .iter()
+        .zip(times)
+        .filter(|(s, _)| &s.clip == clip)
+        .map(|(s, t)| (s.label.as_str(), t.td_clip_s, t.lo_clip_s));
+    // `v_orig` is the recorded speed on the character (times √L): its legs are L times.
+    let leg = lib
+        .clips
+        .get(clip)
+        .and_then(|c| c.leg_m)
+        .unwrap_or(f64::NAN)
+        * length_scale;
+    let delta = fold_change_deg(chosen.v_orig, chosen.speed_mps, leg);
+    (swings(own), delta)
+}
+
+/// The swing fold in one phrase, for the verdict.
+fn swing_text(r: &FoldReport) -> String {
+    if r.folded == 0 {
+        return format!(
+            "swing knee as recorded (speed law {:+.1}°; {} of {} swings folded)",
+            r.asked_deg, r.folded, r.swings
+        );
+    }
+    format!(
+        "swing knee {:+.1}° at its fold (speed law {:+.1}°, {} of {} swings)",
+        r.applied_deg, r.asked_deg, r.folded, r.swings
+    )
 }
 
 /// A run's plan in one phrase: its mean speed, the gait law and each stance's contact time
@@ -247,7 +293,7 @@ pub fn edit_jump(e: &JumpEdit) -> anyhow::Result<EditReport> {
     } else {
         PlanKind::PairedJump
     };
-    let edit = compute(t, 1.0, stances, vec![0, 1], kind)?;
+    let edit = compute(t, 1.0, stances, vec![0, 1], kind, &(Vec::new(), 0.0))?;
     let (h, d) = (chosen.height_m, chosen.distance_m);
     let kv = query_kv(
         &t.lib,
@@ -343,13 +389,15 @@ fn check_frames(
     Ok(())
 }
 
-/// Builds the reference, places the plan and poses every frame.
+/// Builds the reference (its swing knees folded by `fold`'s change, [`fold_swing_knees`]),
+/// places the plan and poses every frame.
 fn compute(
     t: &EditTarget,
     length: f64,
     stances: Vec<EditStance>,
     order: Vec<usize>,
     kind: PlanKind,
+    fold: &(Vec<Swing>, f64),
 ) -> anyhow::Result<EditOutputs> {
     let clip = stances[0].source.clip.clone();
     let (bvh, unit, up) = source_clip(&t.lib, &clip, t.source.as_deref())?;
@@ -358,7 +406,8 @@ fn compute(
     let body =
         BodyModel::new(&bvh, unit, up, sex, &landmarks).with_context(|| format!("clip {clip}"))?;
     let frame_time_s = t.fps.map_or(bvh.motion.frame_time_s, |f| 1.0 / f);
-    let reference = Reference::new(body, bvh.motion.clone())
+    let (motion, swing) = fold_swing_knees(&body, &bvh.motion, &fold.0, fold.1);
+    let reference = Reference::new(body, motion)
         .with_context(|| format!("clip {clip}"))?
         .with_length_scale(length);
     let (path, sources) = place(&stances, &order, &reference, kind);
@@ -388,7 +437,7 @@ fn compute(
         .iter()
         .filter_map(EditStance::violation_detail)
         .collect();
-    let fidelity = check(
+    let mut fidelity = check(
         &reference.body,
         &reference.motion,
         &edited.motion,
@@ -398,6 +447,7 @@ fn compute(
             PlanKind::Jump | PlanKind::PairedJump => FidelityOptions::jump(),
         },
     );
+    fidelity.swing_folded = swing.folded > 0;
     Ok(EditOutputs {
         bvh,
         edited,
@@ -407,6 +457,7 @@ fn compute(
         footprints,
         violated,
         fidelity,
+        swing,
     })
 }
 

@@ -37,8 +37,11 @@ pub struct EditOutputs {
     /// `<stance_id>: <constraint> <value> > <limit> (by <margin>)` of every stance that
     /// breaks one (`query::tables::violation_detail`).
     pub violated: Vec<String>,
-    /// Posture and smoothness against the source ([`crate::edit::fidelity`]).
+    /// Posture and smoothness against the source ([`crate::edit::fidelity`]), its swing
+    /// knees folded by the speed law.
     pub fidelity: Fidelity,
+    /// The swing knee fold of a run ([`crate::edit::swing`]; nothing for a jump).
+    pub swing: crate::edit::swing::FoldReport,
 }
 
 /// The sidecar paths of `FILE.bvh`: `FILE.plan.parquet`, `FILE.png`.
