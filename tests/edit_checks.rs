@@ -991,42 +991,52 @@ fn issue38_item1_edits_print_their_verdict_and_exit_by_it() {
 // See: the known bug "edit jump --height 1.35 / --height 1.4 on the demo jump leaves frames
 // off the plan". Both now on the plan (the soft reach and the swing-foot hold,
 // `edit::DEFAULT_SOFT_REACH`, `DEFAULT_JUMP_SWING_HOLD_S`, on the fixture regenerated with
-// issue 39's feet; 1.42 m too). 1.5 m: push-off and landing frames stay up to 27.6 mm off
-// with the knees straight, the heel up 50° and the pelvis at its 10° bound — the plan puts
-// the COM farther from the contact than this body reaches, which the query's extension
-// limit allows (1.5 leg lengths, 1.26 m); the edit says so (exit 1).
+// issue 39's feet; 1.42 m too). 1.5 m put push-off and landing frames up to 27.6 mm off with
+// the knees straight, the heel up 50° and the pelvis at its 10° bound: the plan puts the
+// COM farther from the contact than this body reaches. Now the jump limits stop at the
+// body's reach (`query::limits::jump_limits`, `clips.parquet` `reach_m`), so the edit is
+// refused up front (exit 2, nothing written) naming the extension and the reach; with
+// `--allow-infeasible` it is written and says both (exit 3).
 #[test]
-fn demo_jump_at_1_4_m_converges_and_at_1_5_m_says_why_not() {
+fn demo_jump_at_1_4_m_converges_and_at_1_5_m_is_refused_beyond_its_reach() {
     let dir = tempfile::tempdir().unwrap();
     let lib = library(dir.path(), &[fixture("jump_120hz_cmu_yup")]);
-    let run = |h: &str| {
-        let out = dir.path().join(format!("jump_{h}.bvh"));
-        let (code, _, err) = super::util::stancelib(&[
-            "edit",
-            "jump",
-            "--lib",
-            &s(&lib),
-            "--height",
-            h,
-            "--out",
-            &s(&out),
-        ]);
-        let off = plan_f64(&out, "foot_error_m")
-            .into_iter()
-            .fold(0.0, f64::max);
-        eprintln!(
-            "--height {h}: exit {code}, support foot at most {:.2} mm off\n{err}",
-            off * 1e3
-        );
-        (code, err, off)
+    let reach = read_parquet(&lib.join("clips.parquet"))
+        .unwrap()
+        .column("reach_m")
+        .unwrap()
+        .f64()
+        .unwrap()
+        .get(0)
+        .unwrap();
+    let run = |h: &str, allow: bool| {
+        let out = dir.path().join(format!("jump_{h}_{allow}.bvh"));
+        let mut args = vec!["edit", "jump", "--lib", s(&lib).leak(), "--height", h];
+        if allow {
+            args.push("--allow-infeasible");
+        }
+        args.extend(["--out", s(&out).leak()]);
+        let (code, _, err) = super::util::stancelib(&args);
+        eprintln!("--height {h} (allow {allow}): exit {code}\n{err}");
+        (code, err, out)
     };
-    let (code, err, off) = run("1.4");
+    let (code, err, out) = run("1.4", false);
     assert_eq!(code, 0, "{err}");
+    let off = plan_f64(&out, "foot_error_m")
+        .into_iter()
+        .fold(0.0, f64::max);
     assert!(off <= 1e-3, "{off} m");
-    let (code, err, off) = run("1.5");
-    assert_eq!(code, 1, "{err}");
-    assert!(err.contains("out of reach"), "{err}");
-    assert!(off <= 0.04, "known miss: {off} m (measured 27.6 mm)");
+    let (code, err, out) = run("1.5", false);
+    assert_eq!(code, 2, "{err}");
+    assert!(!out.exists(), "a refused edit writes nothing");
+    let limit = format!("{reach:.3} m");
+    assert!(
+        err.contains("extension_max") && err.contains(&limit),
+        "{limit}: {err}"
+    );
+    let (code, err, out) = run("1.5", true);
+    assert_eq!(code, 3, "{err}");
+    assert!(out.exists() && err.contains("extension_max"), "{err}");
 }
 
 /// The gait of a clip as `frames` re-detects it from the written motion, medians over its

@@ -789,6 +789,7 @@ fn identity_and_apex(pc: &PlateClip) -> (f64, usize, f64, f64) {
             ClipInfo {
                 s_eff: None,
                 leg_m: None,
+                reach_m: None,
                 mass_kg: pc.mass,
                 content_sha256: String::new(),
             },

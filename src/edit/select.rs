@@ -35,7 +35,7 @@ use crate::library::read::StanceLibrary;
 use crate::query::feasibility::{LimitForm, Limits};
 use crate::query::gait::{GaitLaw, LawChoice, LawSource};
 use crate::query::jump::{is_landing, is_liftoff, jump, recorded_jump, Jump};
-use crate::query::limits::{absolute_limits, left_out_clips, stance_limits, LeftOut};
+use crate::query::limits::{absolute_limits, jump_limits, left_out_clips, stance_limits, LeftOut};
 use crate::query::pairs::jump_rank;
 use crate::query::pool::Prepared;
 use crate::query::run::{
@@ -352,7 +352,8 @@ pub fn choose_jump(
                 .height_m
                 .unwrap_or(h0 * target.height_scale.unwrap_or(1.0));
             let d = target.distance_m.unwrap_or(d0);
-            let lim = [i, j].map(|s| stance_limits(&pool[s], limits.form, &absolute, limits.mu));
+            let lim = [i, j]
+                .map(|s| jump_limits(&pool[s], limits.form, &absolute, limits.mu, &lib.clips));
             let r = jump(&pool[i], &pool[j], h, d, Some(lim)).map_err(|e| e.to_string());
             ([i, j], h, d, r, lim)
         })

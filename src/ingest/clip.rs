@@ -56,6 +56,7 @@ pub(super) fn run(
             .map(|k| ["TTIP_L", "TTIP_R"][k].to_string());
         return Err(Error::non_finite("COM", Some(skip + f), joint));
     }
+    summary.reach_m = clip_reach(lm, &frames, &toe, &com_pos, body.leg_m);
     let (com_v, com_a) = com_derivatives(&com_pos, dt, skip)?;
     let frame: Vec<i64> = (0..frames.len()).map(|f| (skip + f) as i64).collect();
     let time_s: Vec<f64> = frame.iter().map(|&f| f as f64 * dt).collect();
@@ -106,6 +107,26 @@ pub(super) fn run(
         joints,
     };
     Ok((frames, events.runs))
+}
+
+/// The body's reach from its COM ([`super::reach::body_reach_m`]), m.
+fn clip_reach(
+    lm: &Landmarks,
+    frames: &[&[V3]],
+    toe: &[Vec<V3>; 2],
+    com: &[V3],
+    leg_m: f64,
+) -> Option<f64> {
+    let pair =
+        |l: usize, r: usize| -> Vec<[V3; 2]> { frames.iter().map(|fp| [fp[l], fp[r]]).collect() };
+    let toes: Vec<[V3; 2]> = (0..frames.len()).map(|f| [toe[0][f], toe[1][f]]).collect();
+    super::reach::body_reach_m(
+        com,
+        &pair(lm.left.hip, lm.right.hip),
+        &pair(lm.left.ankle, lm.right.ankle),
+        &toes,
+        leg_m,
+    )
 }
 
 /// The per-clip fields of the body: unit, up axis, leg length and character id.

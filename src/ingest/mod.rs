@@ -20,6 +20,7 @@ mod clip;
 pub mod masses;
 pub mod plates;
 mod points;
+pub mod reach;
 
 use std::collections::BTreeMap;
 
@@ -170,6 +171,8 @@ pub struct ClipSummary {
     pub handedness_ok: Option<bool>,
     /// Leg length, m.
     pub leg_length_m: Option<f64>,
+    /// How far from its COM the body reaches a contact, m ([`reach`]).
+    pub reach_m: Option<f64>,
     /// `landmark=joint` pairs.
     pub skeleton: Option<String>,
     /// Toe-tip rules, left and right.

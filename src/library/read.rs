@@ -19,6 +19,9 @@ pub struct ClipInfo {
     pub s_eff: Option<f64>,
     /// Leg length `L_leg`, m.
     pub leg_m: Option<f64>,
+    /// How far from its COM the body reaches a contact, m (`clips.parquet` `reach_m`; none
+    /// in libraries built before it existed).
+    pub reach_m: Option<f64>,
     /// Body mass, kg.
     pub mass_kg: f64,
     /// SHA-256 of the clip file's bytes, hex (empty when the file was not read).
@@ -71,6 +74,7 @@ pub fn read_clip_info(path: &Path) -> Result<BTreeMap<String, ClipInfo>> {
         t.opt_f64(clips::MASS)?,
     );
     let sha = t.strings(clips::CONTENT_SHA256)?;
+    let reach = t.added_f64(clips::REACH)?;
     Ok(names
         .into_iter()
         .enumerate()
@@ -78,6 +82,7 @@ pub fn read_clip_info(path: &Path) -> Result<BTreeMap<String, ClipInfo>> {
             let info = ClipInfo {
                 s_eff: s_eff[i],
                 leg_m: leg[i],
+                reach_m: reach[i],
                 mass_kg: mass[i].unwrap_or(f64::NAN),
                 content_sha256: sha[i].clone(),
             };

@@ -121,6 +121,11 @@ pub const SAMPLES_SORT_KEYS: [&str; 4] = [
     kinematics::FRAME,
 ];
 
+/// Nullable columns added to the layout after libraries of its [`SCHEMA_VERSION`] were
+/// written: an older table without one reads as null (`Table::added_f64`) and an
+/// incremental build over it fills it with nulls for the clips it keeps.
+pub const ADDED_COLUMNS: [&str; 1] = [clips::REACH];
+
 /// Key-value metadata key of every library table: [`SCHEMA_VERSION`].
 pub const SCHEMA_VERSION_KEY: &str = "stancelib.schema_version";
 /// Key-value metadata key of every output: the tool version ([`TOOL_VERSION`]).
@@ -280,7 +285,7 @@ pub mod errors {
 }
 
 /// Columns of `clips.parquet`, in order.
-pub const CLIPS_COLUMNS: [&str; 25] = clips::COLUMNS;
+pub const CLIPS_COLUMNS: [&str; 26] = clips::COLUMNS;
 /// Fields of the `flights` struct in `clips.parquet`.
 pub const FLIGHT_FIELDS: [&str; 11] = flights::COLUMNS;
 /// Columns of `contacts.parquet`, in order.
@@ -327,6 +332,10 @@ pub mod clips {
     pub const HANDEDNESS_OK: &str = "handedness_ok";
     /// `leg_length_m`: Leg length `L_leg`, m.
     pub const LEG_LENGTH: &str = "leg_length_m";
+    /// `reach_m`: How far from its COM the body reaches a contact, m (straight leg below
+    /// the hip, foot on its toe; the jump limits' `χ_max`). Null in libraries built before
+    /// it existed.
+    pub const REACH: &str = "reach_m";
     /// `character_id`: Character id (`sk-` + 12 hex digits of the skeleton).
     pub const CHARACTER_ID: &str = "character_id";
     /// `mass_kg`: Body mass, kg.
@@ -349,7 +358,7 @@ pub mod clips {
     /// `warnings`: Advisory messages (list).
     pub const WARNINGS: &str = "warnings";
     /// Every column, in file order.
-    pub const COLUMNS: [&str; 25] = [
+    pub const COLUMNS: [&str; 26] = [
         PATH,
         CLIP,
         CONTENT_SHA256,
@@ -365,6 +374,7 @@ pub mod clips {
         UP_AXIS,
         HANDEDNESS_OK,
         LEG_LENGTH,
+        REACH,
         CHARACTER_ID,
         MASS,
         MASS_SOURCE,

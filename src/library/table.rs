@@ -155,6 +155,18 @@ impl Table {
         Ok(s.iter().collect())
     }
 
+    /// A float64 column added to the layout after some libraries were written: all null
+    /// when the table has no such column (an older library), else [`Table::opt_f64`].
+    ///
+    /// # Errors
+    /// The column exists with another type.
+    pub fn added_f64(&self, name: &str) -> Result<Vec<Option<f64>>> {
+        if self.df.column(name).is_err() {
+            return Ok(vec![None; self.height()]);
+        }
+        self.opt_f64(name)
+    }
+
     /// A float64 column without nulls.
     ///
     /// # Errors

@@ -221,6 +221,7 @@ pub fn clips_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
                 .collect::<Vec<_>>(),
         ),
         col(clips::LEG_LENGTH, f(&|r| r.summary.leg_length_m)),
+        col(clips::REACH, f(&|r| r.summary.reach_m)),
         col(clips::CHARACTER_ID, s(&|r| r.summary.character_id.clone())),
         col(
             clips::MASS,

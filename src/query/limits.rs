@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 
 use super::feasibility::{relative_limits, LimitForm, Limits};
 use super::pool::Prepared;
-use crate::library::read::{same_content, StanceLibrary};
+use crate::library::read::{same_content, ClipInfo, StanceLibrary};
 use crate::stances::limits::{limits, ClipFacts, StanceFacts, S_EFF_RANGE};
 use crate::stances::segment::Boundary;
 
@@ -91,6 +91,36 @@ pub fn stance_limits(
     Limits {
         mu: mu.unwrap_or(l.mu),
         ..l
+    }
+}
+
+/// A jump stance's limits: [`stance_limits`], with the absolute `χ_max` no farther than
+/// the body's reach (`ingest::reach`, `clips.parquet` `reach_m`) unless the stance itself
+/// reached farther when it was recorded (what the person did is possible):
+///
+/// ```text
+/// absolute: χ_max = min(χ_max of stance_limits, max(R, ext_max))
+/// ```
+/// A jump pushes and lands along the leg, so the straight leg on its toe bounds how far
+/// the COM gets from the contact; the edited jumps beyond `R` leave their plan
+/// (`docs/edited-motion.md`). Runs keep [`stance_limits`]: their touchdown is bounded by
+/// how far ahead the foot lands, which `R` does not measure. A clip without a reach (a
+/// library built before it existed) keeps [`stance_limits`].
+pub fn jump_limits(
+    p: &Prepared,
+    form: LimitForm,
+    absolute: &BTreeMap<String, Limits>,
+    mu: Option<f64>,
+    clips: &BTreeMap<String, ClipInfo>,
+) -> Limits {
+    let l = stance_limits(p, form, absolute, mu);
+    let reach = clips.get(&p.stance.clip).and_then(|c| c.reach_m);
+    match (form, reach) {
+        (LimitForm::Absolute, Some(r)) if r.is_finite() => Limits {
+            chi_max: l.chi_max.min(r.max(p.stance.coef.ext_max)),
+            ..l
+        },
+        _ => l,
     }
 }
 

@@ -5,7 +5,9 @@
 //! ```text
 //! μ = 0.7
 //! F_max = min(max(1.05 · max F_peak, 3.5 m g), 6 m g)    over the eligible stances
-//! χ_max = 1.5 L_leg,   χ_min = 0.5 L_leg                  (what a leg reaches)
+//! χ_max = 1.5 L_leg,   χ_min = 0.5 L_leg                  (what a leg reaches; a jump's
+//!                                                         χ_max stops at the body's reach,
+//!                                                         `query::limits::jump_limits`)
 //! source: `character` when its own stances set F_max, `size` when the floor did
 //! eligible: locomotion on the feet (no hand in the label, no `unsupported` boundary), and
 //! the clip's s_eff is null or within [0.9, 1.1]

@@ -15,7 +15,7 @@ use super::query_jump::JumpTarget;
 use crate::library::write::write_atomic;
 use crate::plot::{jump_map_png, write_png};
 use crate::query::feasibility::{LimitForm, Limits};
-use crate::query::limits::{absolute_limits, stance_limits};
+use crate::query::limits::{absolute_limits, jump_limits};
 use crate::query::map::{check_grid, jump_map, JumpMap};
 use crate::query::pairs::ranked_jump_pairs;
 use crate::query::pool::Prepared;
@@ -101,7 +101,7 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
     let (lib, pool) = load_pool(&q.lib, active)?;
     let pool = pool_without_left_out("map jumps", &lib, pool, q.keep_left_out);
     let absolute = absolute_limits(&lib);
-    let limits = |p: &Prepared| stance_limits(p, form, &absolute, mu);
+    let limits = |p: &Prepared| jump_limits(p, form, &absolute, mu, &lib.clips);
     let t0 = Instant::now();
     let map = jump_map(&pool, heights, speeds, &limits)
         .context("--heights × --speeds on this library")?;

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use super::queries::{load_pool, pool_without_left_out, query_kv, write_table, LimitOptions};
 use crate::query::feasibility::LimitForm;
 use crate::query::jump::recorded_jump;
-use crate::query::limits::{absolute_limits, stance_limits};
+use crate::query::limits::{absolute_limits, jump_limits};
 use crate::query::pairs::ranked_jump_pairs;
 use crate::query::pool::Prepared;
 use crate::query::run::check_scale;
@@ -148,7 +148,7 @@ pub fn jump_query(q: &JumpQuery) -> anyhow::Result<Vec<JumpLine>> {
     let (lib, pool) = load_pool(&q.lib, active)?;
     let pool = pool_without_left_out("query jump", &lib, pool, q.keep_left_out);
     let absolute = absolute_limits(&lib);
-    let lim = |p: &Prepared| stance_limits(p, form, &absolute, mu);
+    let lim = |p: &Prepared| jump_limits(p, form, &absolute, mu, &lib.clips);
     let rows = ranked_jump_pairs(&pool, |a, b| q.target.of(a, b), lim);
     let mut df = jump_table(&rows)?;
     let kv = query_kv(

@@ -7,7 +7,7 @@ use polars::prelude::*;
 use crate::error::{Error, Result};
 use crate::library::layout::sorted;
 use crate::library::schema::{
-    CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, STANCES_FILE,
+    ADDED_COLUMNS, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, STANCES_FILE,
 };
 use crate::library::stances::{errors_table, stances_table, ErrorRow};
 use crate::library::write::{clips_table, contacts_table, frames_table, joints_table};
@@ -26,12 +26,19 @@ pub(crate) fn combine(fresh: &DataFrame, old: DataFrame, name: &str) -> Result<D
     sorted(all, name)
 }
 
-/// `df`'s columns of `like`, cast to its types (rows read back from Parquet).
+/// `df`'s columns of `like`, cast to its types (rows read back from Parquet). A column
+/// added to the layout since `df` was written ([`ADDED_COLUMNS`]) reads as null.
 pub(crate) fn cast_like(df: DataFrame, like: &DataFrame, name: &str) -> Result<DataFrame> {
+    let n = df.height();
     let cols = like
         .columns()
         .iter()
-        .map(|c| df.column(c.name()).and_then(|p| p.cast(c.dtype())))
+        .map(|c| match df.column(c.name()) {
+            Err(_) if ADDED_COLUMNS.contains(&c.name().as_str()) => {
+                Ok(Column::full_null(c.name().clone(), n, c.dtype()))
+            }
+            found => found.and_then(|p| p.cast(c.dtype())),
+        })
         .collect::<PolarsResult<Vec<Column>>>()
         .map_err(|e| Error::io(name, "rows of another schema", e))?;
     DataFrame::new_infer_height(cols).map_err(|e| pe(name, e))
