@@ -334,3 +334,63 @@ fn frames_refuses_to_write_into_a_library() {
         "a second `frames` into its own folder"
     );
 }
+
+// See: `library::schema::ADDED_COLUMNS` — a library written before `clips.parquet` had
+// `reach_m` (issue 37's jump limits) is read as it is, and an incremental build over it
+// keeps its clips (their reach null) and adds the new clips with theirs; the jump query
+// answers on it, with the old limit for the clips without a reach.
+#[test]
+fn a_library_written_before_reach_m_is_read_and_grows() {
+    use polars::prelude::*;
+    let src = sources();
+    let d = tempfile::tempdir().unwrap();
+    let lib = d.path().join("lib");
+    copy_library(&src.lib, &lib);
+    // The clips table as a library before the column wrote it, and its manifest entry.
+    let clips = lib.join("clips.parquet");
+    let mut df = stancelib::library::table::read_parquet(&clips)
+        .unwrap()
+        .drop("reach_m")
+        .unwrap();
+    ParquetWriter::new(std::fs::File::create(&clips).unwrap())
+        .finish(&mut df)
+        .unwrap();
+    let bytes = std::fs::read(&clips).unwrap();
+    let p = lib.join("manifest.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+    let entry = &mut m["tables"]["clips.parquet"];
+    entry["bytes"] = bytes.len().into();
+    entry["sha256"] = stancelib::pipeline::engine::inputs::file_sha256(&clips)
+        .unwrap()
+        .into();
+    std::fs::write(&p, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+
+    let q = d.path().join("jumps.parquet");
+    let (code, _, err) = stancelib(&[
+        "query",
+        "jump",
+        "--lib",
+        &s(&lib),
+        "--height-scale",
+        "1.1",
+        "--out",
+        &s(&q),
+    ]);
+    assert_eq!(code, 0, "query jump on a library without reach_m: {err}");
+
+    let (mine, theirs) = clip_sets();
+    let all: Vec<String> = mine.iter().chain(&theirs).cloned().collect();
+    let (code, out, err) = build(&all, &lib, &["--incremental", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let summary: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    assert_eq!(summary["clips_reused"], mine.len(), "{out}\n{err}");
+    let t = stancelib::library::table::read_parquet(&clips).unwrap();
+    let reach = t.column("reach_m").unwrap().f64().unwrap().clone();
+    let nulls = reach.null_count();
+    assert_eq!(nulls, mine.len(), "the kept clips have no reach: {reach:?}");
+    assert!(
+        reach.iter().flatten().all(|r| (0.5..2.0).contains(&r)),
+        "a new clip's reach is a body's"
+    );
+}
