@@ -940,7 +940,7 @@ fn issue38_item1_edits_print_their_verdict_and_exit_by_it() {
     assert_eq!(code, 0, "{stdout}{err}");
     for needle in [
         "used jump_120hz_cmu_yup:LR:42 → jump_120hz_cmu_yup:LR:150",
-        "apex 1.346 m",
+        "apex 1.344 m",
         "feasible; tightest ",
     ] {
         assert!(stdout.contains(needle), "{needle:?} in {stdout}");
