@@ -8,7 +8,8 @@
 //! f_a(τ) = f_v(τ) q_a(τ) = Σ_m c_am cos(πmτ),   c_am = ½ Σ_{k±l=m} v_k r_al    (exact)   N
 //! K = clamp(n_st − 3, 2, vertical_degree),  L_h = ratio_degree_h,  L_p = ratio_degree_p
 //! v   = argmin ‖Φ v − s_v‖²  s.t.  ∫₀¹ f_v = v_0 = I_v  (edge targets),  f_v(τ_g) ≥ 0 on the
-//!       evaluation grid,  ∫₀¹∫₀ˢ f_v = Σ_k v_k D_k = T_2   (exact, as the ratio model)
+//!       evaluation grid,  ∫₀¹∫₀ˢ f_v = Σ_k v_k D_k = T_2   (exact, or soft with
+//!       EdgeTargets::position_tolerance_m: as the ratio model)
 //! r_a = the ratio model's load-weighted fit with φ_l = cos(πlτ) (leg line, impulse exact,
 //!       travel soft: super::ratio)
 //! D_0 = ½,  D_k = ∫₀¹ (1 − τ) cos(πkτ) dτ = (1 − (−1)^k)/(πk)²   (k ≥ 1)
@@ -39,8 +40,8 @@ use std::f64::consts::PI;
 use nalgebra::{DMatrix, DVector};
 
 use super::ratio::{
-    constrained_lsq, ratio_data, ratio_fit, rms, sample_grid, vertical_degree, EdgeTargets,
-    RatioOptions, TRAVEL_TOLERANCE_M,
+    constrained_lsq, ratio_data, ratio_fit, rms, sample_grid, vertical_degree, with_soft_row,
+    EdgeTargets, RatioOptions, TRAVEL_TOLERANCE_M,
 };
 use super::{AxisModel, ForceModel};
 use crate::Result;
@@ -123,13 +124,15 @@ fn non_negative_fit(
     constrained_lsq(design, s, eq, &le, "fourier model")
 }
 
-/// The vertical series under edge targets, both exact as in the ratio model: the impulse
-/// `v_0 = I_v` and the position `Σ_k v_k D_k = T_2`. Returns `v` and how many targets were
-/// met (2, 1 or 0).
+/// The vertical series under edge targets, as in the ratio model: the impulse `v_0 = I_v`
+/// exact, the position `Σ_k v_k D_k = T_2` exact or, with
+/// [`EdgeTargets::position_tolerance_m`], soft (weight `r₀/σ`, `σ = m · tol_m / Δt²`).
+/// Returns `v` and how many targets were applied (2, 1 or 0).
 fn vertical_series(
     design: &DMatrix<f64>,
     s: &[f64],
     targets: Option<&EdgeTargets>,
+    (mass_kg, dt_s): (f64, f64),
 ) -> Result<(Vec<f64>, usize)> {
     let Some(t) = targets else {
         return non_negative_fit(design, s, &[]);
@@ -138,11 +141,27 @@ fn vertical_series(
     let mut unit = vec![0.0; n];
     unit[0] = 1.0;
     let double: Vec<f64> = (0..n).map(double_integral).collect();
-    non_negative_fit(
-        design,
-        s,
-        &[(unit, t.impulse[2]), (double, t.vertical_double)],
-    )
+    let Some(tol_m) = t.position_tolerance_m else {
+        return non_negative_fit(
+            design,
+            s,
+            &[(unit, t.impulse[2]), (double, t.vertical_double)],
+        );
+    };
+    let impulse = [(unit, t.impulse[2])];
+    let (v0, met) = non_negative_fit(design, s, &impulse)?;
+    if met == 0 {
+        return Ok((v0, 0));
+    }
+    let sigma = mass_kg * tol_m / (dt_s * dt_s);
+    let Some((rows, rhs)) = with_soft_row(design, s, &v0, (&double, t.vertical_double, sigma))
+    else {
+        return Ok((v0, 1));
+    };
+    match non_negative_fit(&rows, &rhs, &impulse)? {
+        (v, 1) => Ok((v, 2)),
+        _ => Ok((v0, 1)),
+    }
 }
 
 /// Fits the half-range cosine model to stance-axis force samples on `τ_j = j/(N−1)`.
@@ -168,7 +187,7 @@ pub fn fit_cosine_with(
     let tau = sample_grid(n);
     let k_max = vertical_degree(n_st, opts.vertical_degree).min(n - 1);
     let design = DMatrix::from_fn(n, k_max + 1, |j, k| half_cosine(k, tau[j]));
-    let (v, met) = vertical_series(&design, &samples[2], targets)?;
+    let (v, met) = vertical_series(&design, &samples[2], targets, (mass_kg, dt_s))?;
     let fv: Vec<f64> = (&design * DVector::from_column_slice(&v))
         .iter()
         .copied()
@@ -313,6 +332,7 @@ mod tests {
             impulse: [i(0) + 30.0, i(1) - 5.0, 1.03 * i(2)],
             vertical_double: 1.01 * free.model.axes[2].f2(1.0),
             travel_double: [free.model.axes[0].f2(1.0), free.model.axes[1].f2(1.0)],
+            position_tolerance_m: None,
         };
         let fit = fit_cosine_with(&s, 20, (70.0, 0.25), Some(&t), None, &opts).unwrap();
         assert_eq!(fit.vertical_targets_met, 2);

@@ -36,6 +36,23 @@
 //! the vertical RMSE is lower than the soft fit's (ratio 0.127 → 0.117 BW, Fourier 0.129 →
 //! 0.121) and the apex mismatch 0.0 mm on every plate run (`docs/stance-model.md` §4.1, "Edge position").
 //!
+//! The position is exact only where the edge states are trustworthy: beside a flight whose
+//! own free curvature `a_z` is more than 3 m/s² from −g it stays the soft row above with
+//! [`POSITION_TOLERANCE_M`] (1 mm; [`EdgeTargets::position_tolerance_m`], chosen by the
+//! stance builder, `stances::build::EXACT_POSITION_MAX_CURVATURE_MISS_MPS2`):
+//! ```text
+//! exact  ⇔  every flight giving an edge state is untested or |a_z + g| ≤ 3 m/s²
+//! soft:  min_{b ≥ 0} ‖B b − s_v‖² + w² (e_2·b − T_2)²   s.t.  Σ_i b_i/(d+1) = I_v,
+//!        w = r₀/σ,  σ = m · POSITION_TOLERANCE_M / Δt²   (N; r₀: RMS residual of the
+//!        impulse-only fit, N; m kg, Δt s)
+//! ```
+//! On `cmu_09_01_run_mb` (120 Hz) a 102 ms flight curves at −5.6 m/s² (its neighbours −8.9,
+//! −9.6): its −g parabola is not its path, and the stances beside it, held to it exactly,
+//! bent their force until the run edit planned a COM beyond the leg's reach (one frame did
+//! not converge, support foot 2.3–5.2 mm off; a 31.6° joint step against a 30° bound). Every
+//! flight of the plate runs is too short for a free fit (untested), so they keep the exact
+//! position and its 0.0 mm apex mismatch.
+//!
 //! **Travel targets** (a departure, 2026-12-06): with edge targets the ratios `q_h`, `q_p`
 //! also get a soft row for the stance's travel along their axis, with tolerance
 //! [`TRAVEL_TOLERANCE_M`]:
@@ -134,6 +151,11 @@ pub const DEFAULT_RATIO_DEGREE_H: usize = 1;
 pub const DEFAULT_RATIO_DEGREE_P: usize = 2;
 /// Largest accepted ratio degree.
 pub const MAX_RATIO_DEGREE: usize = 6;
+/// Position tolerance of the soft target `∫₀¹∫₀ˢ f_v = T_2`, m, used where the edge states
+/// are not trusted to the millimetre ([`EdgeTargets::position_tolerance_m`]; module docs,
+/// "Edge position"): missing the target by this much costs as much as one sample's typical
+/// misfit.
+pub const POSITION_TOLERANCE_M: f64 = 0.001;
 /// Travel tolerance of the soft targets `∫₀¹∫₀ˢ f_a = T_a` of the travel axes (h, p), m
 /// (module docs, "Travel targets": chosen on the plate run and the jumps' round trip).
 pub const TRAVEL_TOLERANCE_M: f64 = 0.02;
@@ -242,6 +264,11 @@ pub struct EdgeTargets {
     /// `∫₀¹∫₀ˢ f_a` for the stance's travel axes (h, p), N:
     /// `m (Δp_a − v_a,TD Δt)/Δt²`.
     pub travel_double: [f64; 2],
+    /// How the vertical position `vertical_double` is held: `None` exactly (an equality
+    /// row, like the impulses), `Some(tol_m)` softly with tolerance `tol_m`, m (the stance
+    /// builder passes [`POSITION_TOLERANCE_M`] beside a flight whose own curvature is far
+    /// from −g; module docs, "Edge position").
+    pub position_tolerance_m: Option<f64>,
 }
 
 /// A fitted ratio model: the force model and the ratio polynomials.
@@ -253,8 +280,9 @@ pub struct RatioFit {
     pub ratio: [Vec<f64>; 2],
     /// Non-negative Bernstein coefficients `b_i` of `f_v` (N).
     pub bernstein_v: Vec<f64>,
-    /// How many of the vertical edge targets were met exactly (2: the impulse and the
-    /// position, 1: the impulse only, 0: none: `f_v ≥ 0` cannot meet them).
+    /// How many of the vertical edge targets were applied (2: the impulse exactly and the
+    /// position, exactly or softly as [`EdgeTargets::position_tolerance_m`] says, 1: the
+    /// impulse only, 0: none: `f_v ≥ 0` cannot meet them).
     pub vertical_targets_met: usize,
 }
 
@@ -370,22 +398,41 @@ fn nnls(basis: &DMatrix<f64>, s: &[f64], eq: &[(Vec<f64>, f64)]) -> Result<(Vec<
     Ok((b.into_iter().map(|v| v.max(0.0)).collect(), k))
 }
 
-/// The vertical fit under edge targets, both exact: the impulse `∫₀¹ f_v = I_v` and the
-/// position `∫₀¹∫₀ˢ f_v = T_2` (module docs, "Edge position"). Returns the Bernstein
-/// coefficients and how many targets were met (2; 1, the impulse only, or 0 when `f_v ≥ 0`
-/// cannot meet them).
-fn vertical_fit(basis: &DMatrix<f64>, s: &[f64], t: &EdgeTargets) -> Result<(Vec<f64>, usize)> {
+/// The vertical fit under edge targets: the impulse `∫₀¹ f_v = I_v` exact, the position
+/// `∫₀¹∫₀ˢ f_v = T_2` exact or, with [`EdgeTargets::position_tolerance_m`], a soft row of
+/// weight `w = r₀/σ`, `σ = m · tol_m / Δt²` (module docs, "Edge position"). Returns the
+/// Bernstein coefficients and how many targets were applied (2; 1, the impulse only, or 0
+/// when `f_v ≥ 0` cannot meet them).
+fn vertical_fit(
+    basis: &DMatrix<f64>,
+    s: &[f64],
+    t: &EdgeTargets,
+    (mass_kg, dt_s): (f64, f64),
+) -> Result<(Vec<f64>, usize)> {
     let d = basis.ncols() - 1;
     let df = d as f64;
     // ∫₀¹ B_i^d = 1/(d+1);  ∫₀¹∫₀ˢ B_i^d = ∫₀¹ (1−τ) B_i^d = (d+1−i)/((d+1)(d+2)).
     let double: Vec<f64> = (0..=d)
         .map(|i| (df + 1.0 - i as f64) / ((df + 1.0) * (df + 2.0)))
         .collect();
-    let rows = [
-        (vec![1.0 / (df + 1.0); d + 1], t.impulse[2]),
-        (double, t.vertical_double),
-    ];
-    nnls(basis, s, &rows)
+    let impulse = (vec![1.0 / (df + 1.0); d + 1], t.impulse[2]);
+    let Some(tol_m) = t.position_tolerance_m else {
+        return nnls(basis, s, &[impulse, (double, t.vertical_double)]);
+    };
+    let impulse = [impulse];
+    let (b0, met) = nnls(basis, s, &impulse)?;
+    if met == 0 {
+        return Ok((b0, 0));
+    }
+    let sigma = mass_kg * tol_m / (dt_s * dt_s);
+    let Some((rows, rhs)) = with_soft_row(basis, s, &b0, (&double, t.vertical_double, sigma))
+    else {
+        return Ok((b0, 1));
+    };
+    match nnls(&rows, &rhs, &impulse)? {
+        (b, 1) => Ok((b, 2)),
+        _ => Ok((b0, 1)),
+    }
 }
 
 /// The least-squares rows `x`, `s` with the soft row `w·(row·c) = w·target` appended, `w =
@@ -550,7 +597,7 @@ pub fn fit_ratio_with(
     let d = vertical_degree(n_st, opts.vertical_degree).min(n - 1);
     let basis = bernstein_basis(d, &tau);
     let (b, met) = match targets {
-        Some(t) => vertical_fit(&basis, &samples[2], t)?,
+        Some(t) => vertical_fit(&basis, &samples[2], t, (mass_kg, dt_s))?,
         None => nnls(&basis, &samples[2], &[])?,
     };
     let fv_poly = bernstein_to_power(&b);

@@ -49,6 +49,7 @@ fn travel_targets_bind_a_long_stance_more_than_a_short_one() {
             impulse: [h.integral(), p.integral(), v.integral()],
             vertical_double: v.f2(1.0),
             travel_double: [h.f2(1.0), p.f2(1.0)],
+            position_tolerance_m: None,
         };
         let farther = EdgeTargets {
             travel_double: [h.f2(1.0) + 70.0 * 0.02 / (dt * dt), p.f2(1.0)],
@@ -132,6 +133,7 @@ fn edge_targets_hold_impulses_and_the_position_exactly() {
         impulse: [i(0) + 30.0, i(1) - 5.0, 1.03 * i(2)],
         vertical_double: 1.01 * free.model.axes[2].f2(1.0),
         travel_double: [free.model.axes[0].f2(1.0), free.model.axes[1].f2(1.0)],
+        position_tolerance_m: None,
     };
     let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&t), &RatioOptions::default()).unwrap();
     assert_eq!(fit.vertical_targets_met, 2);
@@ -146,11 +148,30 @@ fn edge_targets_hold_impulses_and_the_position_exactly() {
     let miss_m = (fit.model.axes[2].f2(1.0) - t.vertical_double).abs() * 0.25 * 0.25 / 70.0;
     assert!(miss_m < 1e-9, "{miss_m} m");
     assert!(fit.model.min_f_v(&fit.model.grid()) >= -1e-6);
+    // Held softly (`position_tolerance_m`), the position row pulls harder as its tolerance
+    // shrinks, and the impulses stay exact.
+    let miss_m = |tol_m: f64| {
+        let soft = EdgeTargets {
+            position_tolerance_m: Some(tol_m),
+            ..t
+        };
+        let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&soft), &RatioOptions::default()).unwrap();
+        assert_eq!(fit.vertical_targets_met, 2);
+        let got = fit.model.axes[2].integral();
+        assert!((got - t.impulse[2]).abs() < 1e-6 * t.impulse[2], "{got}");
+        (fit.model.axes[2].f2(1.0) - t.vertical_double).abs() * 0.25 * 0.25 / 70.0
+    };
+    let (loose, tight) = (miss_m(POSITION_TOLERANCE_M), miss_m(1e-5));
+    assert!(
+        tight < loose && tight < 1e-4 && loose > 1e-9,
+        "{loose} {tight}"
+    );
     // An impossible target (negative impulse) falls back without f_v < 0.
     let bad = EdgeTargets {
         impulse: [0.0, 0.0, -100.0],
         vertical_double: -50.0,
         travel_double: [0.0, 0.0],
+        position_tolerance_m: None,
     };
     let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&bad), &RatioOptions::default()).unwrap();
     assert_eq!(fit.vertical_targets_met, 0);
