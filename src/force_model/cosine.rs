@@ -8,7 +8,8 @@
 //! f_a(τ) = f_v(τ) q_a(τ) = Σ_m c_am cos(πmτ),   c_am = ½ Σ_{k±l=m} v_k r_al    (exact)   N
 //! K = clamp(n_st − 3, 2, vertical_degree),  L_h = ratio_degree_h,  L_p = ratio_degree_p
 //! v   = argmin ‖Φ v − s_v‖²  s.t.  ∫₀¹ f_v = v_0 = I_v  (edge targets),  f_v(τ_g) ≥ 0 on the
-//!       evaluation grid,  soft: ∫₀¹∫₀ˢ f_v = Σ_k v_k D_k = T_2   (1 mm, as the ratio model)
+//!       evaluation grid,  ∫₀¹∫₀ˢ f_v = Σ_k v_k D_k = T_2   (exact, or soft with
+//!       EdgeTargets::position_tolerance_m: as the ratio model)
 //! r_a = the ratio model's load-weighted fit with φ_l = cos(πlτ) (leg line, impulse exact,
 //!       travel soft: super::ratio)
 //! D_0 = ½,  D_k = ∫₀¹ (1 − τ) cos(πkτ) dτ = (1 − (−1)^k)/(πk)²   (k ≥ 1)
@@ -39,11 +40,11 @@ use std::f64::consts::PI;
 use nalgebra::{DMatrix, DVector};
 
 use super::ratio::{
-    qp, ratio_data, ratio_fit, rms, sample_grid, vertical_degree, with_soft_row, EdgeTargets,
-    RatioOptions, POSITION_TOLERANCE_M, TRAVEL_TOLERANCE_M,
+    constrained_lsq, ratio_data, ratio_fit, rms, sample_grid, vertical_degree, with_soft_row,
+    EdgeTargets, RatioOptions, TRAVEL_TOLERANCE_M,
 };
 use super::{AxisModel, ForceModel};
-use crate::{Error, Result};
+use crate::Result;
 
 /// Points `τ_g = g/(n − 1)` where `f_v ≥ 0` is imposed: the evaluation grid's minimum size
 /// ([`super::model::GRID_MIN_SAMPLES`]), on which `min_f_v` and the unilateral flag are read.
@@ -105,42 +106,28 @@ pub fn series_axis(c: &[f64]) -> AxisModel {
     axis
 }
 
-/// `argmin ‖Φ v − s‖²` with `e·v = target` for the rows of `eq` and `f_v(τ_g) ≥ 0`, by the
-/// ratio model's QP; tries all equality rows, then none. Returns `v` and how many equality
-/// rows held.
+/// `argmin ‖Φ v − s‖²` with `e·v = target` for the rows of `eq` and `f_v(τ_g) ≥ 0`
+/// ([`constrained_lsq`]). Returns `v` and how many equality rows held.
 fn non_negative_fit(
     design: &DMatrix<f64>,
     s: &[f64],
     eq: &[(Vec<f64>, f64)],
 ) -> Result<(Vec<f64>, usize)> {
-    let n = design.ncols();
-    let gram = design.transpose() * design;
-    let c: Vec<f64> = (design.transpose() * DVector::from_column_slice(s))
-        .iter()
-        .map(|v| -v)
-        .collect();
     let last = (NON_NEGATIVE_POINTS - 1) as f64;
-    for k in [eq.len(), 0] {
-        let mut a: Vec<f64> = eq[..k].iter().flat_map(|(row, _)| row.clone()).collect();
-        let mut b: Vec<f64> = eq[..k].iter().map(|(_, t)| *t).collect();
-        // −f_v(τ_g) ≤ 0.
-        for g in 0..NON_NEGATIVE_POINTS {
+    // −f_v(τ_g) ≤ 0.
+    let le: Vec<Vec<f64>> = (0..NON_NEGATIVE_POINTS)
+        .map(|g| {
             let t = g as f64 / last;
-            a.extend((0..n).map(|i| -half_cosine(i, t)));
-            b.push(0.0);
-        }
-        if let Some(x) = qp(&gram, &c, &a, &b, k) {
-            return Ok((x, k));
-        }
-    }
-    Err(Error::numeric(
-        "fourier model: the non-negative fit of f_v failed",
-    ))
+            (0..design.ncols()).map(|i| -half_cosine(i, t)).collect()
+        })
+        .collect();
+    constrained_lsq(design, s, eq, &le, "fourier model")
 }
 
-/// The vertical series under edge targets: the impulse exact (`v_0 = I_v`), the position
-/// soft ([`POSITION_TOLERANCE_M`], weighted as in the ratio model). Returns `v` and how many
-/// targets were applied (2, 1 or 0).
+/// The vertical series under edge targets, as in the ratio model: the impulse `v_0 = I_v`
+/// exact, the position `Σ_k v_k D_k = T_2` exact or, with
+/// [`EdgeTargets::position_tolerance_m`], soft (weight `r₀/σ`, `σ = m · tol_m / Δt²`).
+/// Returns `v` and how many targets were applied (2, 1 or 0).
 fn vertical_series(
     design: &DMatrix<f64>,
     s: &[f64],
@@ -153,13 +140,20 @@ fn vertical_series(
     let n = design.ncols();
     let mut unit = vec![0.0; n];
     unit[0] = 1.0;
+    let double: Vec<f64> = (0..n).map(double_integral).collect();
+    let Some(tol_m) = t.position_tolerance_m else {
+        return non_negative_fit(
+            design,
+            s,
+            &[(unit, t.impulse[2]), (double, t.vertical_double)],
+        );
+    };
     let impulse = [(unit, t.impulse[2])];
     let (v0, met) = non_negative_fit(design, s, &impulse)?;
     if met == 0 {
         return Ok((v0, 0));
     }
-    let double: Vec<f64> = (0..n).map(double_integral).collect();
-    let sigma = mass_kg * POSITION_TOLERANCE_M / (dt_s * dt_s);
+    let sigma = mass_kg * tol_m / (dt_s * dt_s);
     let Some((rows, rhs)) = with_soft_row(design, s, &v0, (&double, t.vertical_double, sigma))
     else {
         return Ok((v0, 1));
@@ -329,7 +323,7 @@ mod tests {
     }
 
     #[test]
-    fn edge_targets_hold_the_impulses_exactly() {
+    fn edge_targets_hold_the_impulses_and_the_position_exactly() {
         let s = bell_samples(64, 70.0);
         let opts = RatioOptions::default();
         let free = fit_cosine_with(&s, 20, (70.0, 0.25), None, None, &opts).unwrap();
@@ -338,6 +332,7 @@ mod tests {
             impulse: [i(0) + 30.0, i(1) - 5.0, 1.03 * i(2)],
             vertical_double: 1.01 * free.model.axes[2].f2(1.0),
             travel_double: [free.model.axes[0].f2(1.0), free.model.axes[1].f2(1.0)],
+            position_tolerance_m: None,
         };
         let fit = fit_cosine_with(&s, 20, (70.0, 0.25), Some(&t), None, &opts).unwrap();
         assert_eq!(fit.vertical_targets_met, 2);
@@ -350,6 +345,9 @@ mod tests {
                 t.impulse[a]
             );
         }
+        // The position exactly too (1e-9 m: `Δt²/m` times the double integral).
+        let miss_m = (fit.model.axes[2].f2(1.0) - t.vertical_double).abs() * 0.25 * 0.25 / 70.0;
+        assert!(miss_m < 1e-9, "{miss_m} m");
         assert!(fit.model.min_f_v(&fit.model.grid()) >= -1e-6 * t.impulse[2]);
     }
 }

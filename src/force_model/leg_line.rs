@@ -32,7 +32,7 @@ use crate::math::v3::V3;
 /// Default roll fraction `φ` (fit option `roll_fraction`): at push-off the support point sits
 /// this far from the ankle towards the toe tip (the ball of the foot lies at about 0.7);
 /// chosen by leaving one plate run out (docs `stance-model.md` §4.4).
-pub const DEFAULT_ROLL_FRACTION: f64 = 0.6;
+pub const DEFAULT_ROLL_FRACTION: f64 = 0.5;
 /// Default weight `λ` of the leg line in the ratio data (fit option `leg_line_weight`);
 /// chosen by leaving one plate run out (docs `stance-model.md` §4.4).
 pub const DEFAULT_LEG_LINE_WEIGHT: f64 = 1.0;

@@ -8,6 +8,7 @@ use crate::contacts::flight::Flight;
 use crate::contacts::flight::FlightFit;
 use crate::contacts::timing::EVENT_MAX_SHIFT_S;
 use crate::contacts::EFFECTORS;
+use crate::force_model::ratio::POSITION_TOLERANCE_M;
 use crate::force_model::{
     fit_stance, EdgeTargets, FitOptions, FitWorkspace, LegLine, StanceFit, StanceForce, GRAVITY,
 };
@@ -182,6 +183,34 @@ pub const BALLISTIC_EDGE_FRAMES: usize = 2;
 /// Fewest interior frames of a flight for a ballistic edge state.
 pub const BALLISTIC_MIN_FRAMES: usize = 2;
 
+/// Largest distance of a flight's own free curvature `a_z` from −g, m/s², at which the
+/// stance beside it meets its edge position exactly ([`EdgeTargets::position_tolerance_m`]
+/// `None`; beyond it the position is a soft target of [`POSITION_TOLERANCE_M`]). The edge
+/// states come from a −g parabola ([`ballistic_fit`]); where the flight's COM itself curves
+/// far from −g that parabola is not its path, and forcing the stance through it bends the
+/// stance's force: on `cmu_09_01_run_mb` the 102 ms flight curves at −5.6 m/s² (4.2 m/s²
+/// from −g; the clip's other flights −8.9 and −9.6) and, held exactly, the stances beside it
+/// planned a COM beyond the leg's reach in the edit (a frame that did not converge, a
+/// 31.6° joint step; soft there: every frame converged, 16.5° at most). 3 m/s² is the
+/// scatter of the interior fit `a_z` on a 0.1 s flight ([`Flight::a_z_all`]): beyond it the
+/// flight's COM does not follow the −g parabola to the millimetre, whatever the cause. The
+/// all-frames curvature `a_z_all` does not tell the flights apart (−8.2 m/s² for that flight,
+/// −9.3 to −12.3 m/s² on the 4 m/s plate run, whose flights the plates join). A flight too
+/// short for a free fit (`tested` false: every flight of the three plate runs, 20–100 ms at
+/// 60–100 Hz) has no evidence against −g and keeps the exact position, on which the plates
+/// join the flights (docs `stance-model.md` §4.1, "Edge position").
+pub const EXACT_POSITION_MAX_CURVATURE_MISS_MPS2: f64 = 3.0;
+
+/// Whether a flight's own curvature allows the exact edge position
+/// ([`EXACT_POSITION_MAX_CURVATURE_MISS_MPS2`]): untested, or tested with `|a_z + g|` within it.
+fn curves_like_gravity(f: &Flight) -> bool {
+    match (f.tested, f.a_z) {
+        (false, _) => true,
+        (true, Some(a_z)) => (a_z + GRAVITY).abs() <= EXACT_POSITION_MAX_CURVATURE_MISS_MPS2,
+        (true, None) => false,
+    }
+}
+
 /// The flight whose last frame is `last_frame`.
 fn flight_ending_at(summary: &ClipSummary, last_frame: i64) -> Option<&Flight> {
     summary.flights.iter().find(|f| f.last_frame == last_frame)
@@ -243,7 +272,14 @@ fn ballistic_fit(fr: &ClipFrames, f: &Flight) -> Option<FlightFit> {
 
 /// The force integrals that join the touchdown state `(p, v)_TD` to the liftoff state
 /// `(p, v)_LO` over `Δt` (world states, stance frame `h`), see [`EdgeTargets`].
-fn edge_targets(h: &Heading, td: (V3, V3), lo: (V3, V3), dt: f64, m: f64) -> EdgeTargets {
+/// `exact`: the position is met exactly, else softly ([`POSITION_TOLERANCE_M`]).
+fn edge_targets(
+    h: &Heading,
+    (td, lo): ((V3, V3), (V3, V3)),
+    dt: f64,
+    m: f64,
+    exact: bool,
+) -> EdgeTargets {
     let dv = h.to_stance(std::array::from_fn(|i| lo.1[i] - td.1[i]));
     let impulse = std::array::from_fn(|a| {
         let g = if a == 2 { GRAVITY * dt } else { 0.0 };
@@ -256,6 +292,7 @@ fn edge_targets(h: &Heading, td: (V3, V3), lo: (V3, V3), dt: f64, m: f64) -> Edg
         impulse,
         vertical_double: m * (dz - td.1[2] * dt + 0.5 * GRAVITY * dt * dt) / (dt * dt),
         travel_double: [0, 1].map(|a| m * (dp[a] - v_td[a] * dt) / (dt * dt)),
+        position_tolerance_m: (!exact).then_some(POSITION_TOLERANCE_M),
     }
 }
 
@@ -346,6 +383,8 @@ struct EdgeStates {
     lo: (V3, V3),
     fit_before: bool,
     fit_after: bool,
+    /// Every flight that gave an edge state curves like −g ([`curves_like_gravity`]).
+    position_exact: bool,
 }
 
 /// The SG-smoothed COM of a clip; a failed note when the filter cannot be built or the
@@ -455,12 +494,14 @@ impl<'a> ClipData<'a> {
 
     /// The edge states of a stance (adjacent flights' ballistic fits, else the splines).
     fn edge_states(&self, seg: &Segment, t_td: f64, t_lo: f64) -> EdgeStates {
-        let fit_before = self
-            .flight_before(seg)
-            .and_then(|f| ballistic_fit(self.fr, f));
-        let fit_after = self
-            .flight_after(seg)
-            .and_then(|f| ballistic_fit(self.fr, f));
+        let fit = |f: Option<&Flight>| {
+            f.and_then(|f| Some((ballistic_fit(self.fr, f)?, curves_like_gravity(f))))
+        };
+        let (before, after) = (fit(self.flight_before(seg)), fit(self.flight_after(seg)));
+        let position_exact = [&before, &after]
+            .iter()
+            .all(|f| f.as_ref().is_none_or(|(_, exact)| *exact));
+        let (fit_before, fit_after) = (before.map(|f| f.0), after.map(|f| f.0));
         let td = fit_before
             .as_ref()
             .map_or((self.pos.at(t_td), self.vel.at(t_td)), |f| {
@@ -476,6 +517,7 @@ impl<'a> ClipData<'a> {
             lo,
             fit_before: fit_before.is_some(),
             fit_after: fit_after.is_some(),
+            position_exact,
         }
     }
 
@@ -533,8 +575,10 @@ impl<'a> ClipData<'a> {
     ) -> Result<(StanceFit, Option<EdgeTargets>), StanceNote> {
         let (t_td, t_lo) = times;
         let dt_s = t_lo - t_td;
-        let targets = (edges.fit_before || edges.fit_after)
-            .then(|| edge_targets(h, edges.td, edges.lo, dt_s, self.mass_kg));
+        let targets = (edges.fit_before || edges.fit_after).then(|| {
+            let states = (edges.td, edges.lo);
+            edge_targets(h, states, dt_s, self.mass_kg, edges.position_exact)
+        });
         let force = StanceForce {
             acc: &self.acc.0,
             t_td,
@@ -684,7 +728,10 @@ mod tests {
             e_h: [c, s, 0.0],
             from: HeadingFrom::Velocity,
         };
-        let t = edge_targets(&h, (p0, v0), lo, dt, m);
+        let t = edge_targets(&h, ((p0, v0), lo), dt, m, true);
+        assert_eq!(t.position_tolerance_m, None);
+        let soft = edge_targets(&h, ((p0, v0), lo), dt, m, false);
+        assert_eq!(soft.position_tolerance_m, Some(POSITION_TOLERANCE_M));
         let f = h.to_stance(std::array::from_fn(|i| {
             m * (a[i] + if i == 2 { GRAVITY } else { 0.0 })
         }));
@@ -699,5 +746,34 @@ mod tests {
                 "travel {got} against {want} / 2"
             );
         }
+    }
+
+    #[test]
+    fn the_edge_position_is_exact_beside_a_flight_that_curves_like_gravity() {
+        // The flights of `cmu_09_01_run_mb` (free a_z −8.9, −5.6, −9.6 m/s²) and an
+        // untested plate-run flight.
+        let flight = |tested: bool, a_z: Option<f64>| Flight {
+            first_frame: 0,
+            last_frame: 12,
+            duration_s: 0.1,
+            a_z,
+            a_x: None,
+            a_y: None,
+            rms_m: None,
+            s_eff: None,
+            a_z_all: None,
+            events_duration_s: None,
+            events_s: None,
+            a_z_mean: None,
+            ballistic: true,
+            tested,
+            airborne: tested,
+            fit: None,
+        };
+        assert!(curves_like_gravity(&flight(true, Some(-8.92))));
+        assert!(curves_like_gravity(&flight(true, Some(-9.61))));
+        assert!(!curves_like_gravity(&flight(true, Some(-5.60))));
+        assert!(!curves_like_gravity(&flight(true, Some(-13.0))));
+        assert!(curves_like_gravity(&flight(false, None)));
     }
 }

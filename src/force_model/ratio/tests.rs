@@ -49,6 +49,7 @@ fn travel_targets_bind_a_long_stance_more_than_a_short_one() {
             impulse: [h.integral(), p.integral(), v.integral()],
             vertical_double: v.f2(1.0),
             travel_double: [h.f2(1.0), p.f2(1.0)],
+            position_tolerance_m: None,
         };
         let farther = EdgeTargets {
             travel_double: [h.f2(1.0) + 70.0 * 0.02 / (dt * dt), p.f2(1.0)],
@@ -122,10 +123,9 @@ fn negative_samples_are_clipped_to_a_non_negative_force() {
 }
 
 #[test]
-fn edge_targets_hold_impulses_exactly_and_pull_the_position() {
+fn edge_targets_hold_impulses_and_the_position_exactly() {
     // Ask for 3 % more vertical impulse and a shifted centroid than the samples carry:
-    // the constrained fit meets every impulse to roundoff and moves the double
-    // integral towards its (soft) target, closer than the impulse-only fit.
+    // the constrained fit meets every impulse and the vertical double integral to roundoff.
     let s = bell_samples(64, 70.0);
     let free = fit_ratio(&s, 20, 70.0, 0.25, None, &RatioOptions::default()).unwrap();
     let i = |a: usize| free.model.axes[a].integral();
@@ -133,6 +133,7 @@ fn edge_targets_hold_impulses_exactly_and_pull_the_position() {
         impulse: [i(0) + 30.0, i(1) - 5.0, 1.03 * i(2)],
         vertical_double: 1.01 * free.model.axes[2].f2(1.0),
         travel_double: [free.model.axes[0].f2(1.0), free.model.axes[1].f2(1.0)],
+        position_tolerance_m: None,
     };
     let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&t), &RatioOptions::default()).unwrap();
     assert_eq!(fit.vertical_targets_met, 2);
@@ -143,30 +144,34 @@ fn edge_targets_hold_impulses_exactly_and_pull_the_position() {
             "axis {a}: {got}"
         );
     }
+    // The position in metres (`Δt²/m` times the double integral): to 1e-9 m.
+    let miss_m = (fit.model.axes[2].f2(1.0) - t.vertical_double).abs() * 0.25 * 0.25 / 70.0;
+    assert!(miss_m < 1e-9, "{miss_m} m");
     assert!(fit.model.min_f_v(&fit.model.grid()) >= -1e-6);
-    // The position row pulls harder as its tolerance shrinks (misfit in metres).
-    let d = vertical_degree(20, DEFAULT_VERTICAL_DEGREE);
-    let tau = sample_grid(64);
-    let basis = bernstein_basis(d, &tau);
-    let miss_m = |tol: Option<f64>| {
-        let (b, _) = vertical_fit(&basis, &s[2], &t, (70.0, 0.25), tol).unwrap();
-        let f2 = AxisModel {
-            poly: bernstein_to_power(&b),
-            ..Default::default()
-        }
-        .f2(1.0);
-        (f2 - t.vertical_double).abs() * 0.25 * 0.25 / 70.0
+    // Held softly (`position_tolerance_m`), the position row pulls harder as its tolerance
+    // shrinks, and the impulses stay exact.
+    let miss_m = |tol_m: f64| {
+        let soft = EdgeTargets {
+            position_tolerance_m: Some(tol_m),
+            ..t
+        };
+        let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&soft), &RatioOptions::default()).unwrap();
+        assert_eq!(fit.vertical_targets_met, 2);
+        let got = fit.model.axes[2].integral();
+        assert!((got - t.impulse[2]).abs() < 1e-6 * t.impulse[2], "{got}");
+        (fit.model.axes[2].f2(1.0) - t.vertical_double).abs() * 0.25 * 0.25 / 70.0
     };
-    let (none, loose, tight) = (miss_m(None), miss_m(Some(1e-3)), miss_m(Some(1e-5)));
+    let (loose, tight) = (miss_m(POSITION_TOLERANCE_M), miss_m(1e-5));
     assert!(
-        tight < loose && loose < none && tight < 1e-4,
-        "{none} {loose} {tight}"
+        tight < loose && tight < 1e-4 && loose > 1e-9,
+        "{loose} {tight}"
     );
     // An impossible target (negative impulse) falls back without f_v < 0.
     let bad = EdgeTargets {
         impulse: [0.0, 0.0, -100.0],
         vertical_double: -50.0,
         travel_double: [0.0, 0.0],
+        position_tolerance_m: None,
     };
     let fit = fit_ratio(&s, 20, 70.0, 0.25, Some(&bad), &RatioOptions::default()).unwrap();
     assert_eq!(fit.vertical_targets_met, 0);
