@@ -17,8 +17,8 @@
 //!                 │                   → query (solve, feasibility, run, jump, map)
 //!                 │                   → edit (select, plan, COM path, pose) → bvh::write (edited clip)
 //!                 │
-//!                 └─ twopac path:   kinematics (polytopes from contact samples) → library
-//!                                     (kinematics.parquet); twopac::clip (phases from a clip's
+//!                 └─ twopac path:   twopac::limb_reach (polytopes from contact samples) →
+//!                                     library (kinematics.parquet); twopac::clip (phases from a clip's
 //!                                     contact runs) or a phases JSON → twopac (contacts,
 //!                                     static region, transitions, trajectory, validation)
 //!
@@ -59,7 +59,6 @@ pub mod edit;
 pub mod error;
 pub mod force_model;
 pub mod ingest;
-pub mod kinematics;
 pub mod library;
 pub mod math;
 pub mod pipeline;

@@ -15,7 +15,7 @@
 //! sliding window (§6):     windows of 2 or 3 phases, switch at u    — trajectory.rs
 //! validation (§7):         s* = min s : G V β = w(c, c̈), β + s ≥ 0  — validate.rs
 //! why a sample fails:      off support / too fast / no force       — diagnose.rs
-//! kinematics (§3):         K c ≤ k from the convex hull of COM samples — hull.rs
+//! limb reach (§3):         K c ≤ k from the convex hull of COM samples — limb_reach.rs, hull.rs
 //! ```
 //!
 //! # Frames and units
@@ -53,7 +53,7 @@ pub mod contact;
 pub mod diagnose;
 pub mod equilibrium;
 pub mod hull;
-pub mod kinematic;
+pub mod limb_reach;
 pub mod phases;
 pub mod polytope;
 pub mod region;

@@ -54,7 +54,7 @@ use crate::library::stream::ROW_GROUP_ROWS;
 use crate::library::write::write_atomic;
 use crate::stances::limits::{group_facts, limits, ClipFacts, StanceFacts};
 use crate::twopac::hull::{HullOptions, StreamedHull};
-use crate::twopac::kinematic::OutlierRule;
+use crate::twopac::limb_reach::OutlierRule;
 
 /// The scratch file of a library's kinematic samples, in its temporary folder
 /// ([`SampleSpill`]; removed before the folder is swapped into place).
@@ -474,7 +474,7 @@ fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Re
 /// written into `dir`: per (character, effector) the outlier rules ([`OutlierRule`], three
 /// passes over the spilled group) and one more pass that streams the kept samples to the
 /// table and into the polytope's [`StreamedHull`] (bounded memory: see the module docs
-/// of [`crate::twopac::kinematic`]); a group with fewer than 4 non-coplanar points after
+/// of [`crate::twopac::limb_reach`]); a group with fewer than 4 non-coplanar points after
 /// the rules has points but no facets (an error at query time).
 ///
 /// The groups are reduced in parallel on the worker pool ([`reduce_group`]), each writing
