@@ -55,7 +55,7 @@ pub fn ratio_offsets(j: [f64; 3], req: &Request, beta_ref: [f64; 2]) -> [f64; 2]
 }
 
 /// The stance `p` with `f_h, f_p` leaned by [`ratio_offsets`] so that the closed form
-/// meets `req` at `β_h = β_ref[0]`, `β_p = β_ref[1]`; its tables and force coefficients
+/// meets `req` at `β_h = β_ref[0]`, `β_p = β_ref[1]`; its grids and force coefficients
 /// rebuilt (friction on the active fraction `active`). The recorded angular impulse and
 /// extension are kept: they are the targets and limits of the recorded stance.
 pub fn leaned(p: &Prepared, req: &Request, beta_ref: [f64; 2], active: f64) -> Prepared {
@@ -71,7 +71,7 @@ pub fn leaned(p: &Prepared, req: &Request, beta_ref: [f64; 2], active: f64) -> P
         }
     }
     let mut out = Prepared::with_active_fraction(stance, active);
-    let f = force_coefficients(&out.tables);
+    let f = force_coefficients(&out.grids);
     let c = &mut out.stance.coef;
     (c.a_f, c.min_f_v, c.unilateral_ok) = (f.a_f, f.min_f_v, f.unilateral_ok);
     (c.f_peak, c.mu_req_robust) = (f.f_peak, f.mu_req_robust);
@@ -117,7 +117,7 @@ mod tests {
                     vps: q.vps,
                     x: k * q.x,
                 };
-                let l = leaned(&p, &req, [k, 1.0], p.tables.active_fraction);
+                let l = leaned(&p, &req, [k, 1.0], p.grids.active_fraction);
                 let Ok(s) = solve(&l.shape, &req, &Refs::run(k), Some(q.t_e)) else {
                     continue;
                 };

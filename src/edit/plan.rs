@@ -51,7 +51,7 @@ pub struct EditStance {
     pub source: PoolStance,
     /// Its timing in the clip.
     pub timing: StanceTiming,
-    /// The character-scaled stance and tables.
+    /// The character-scaled stance and its sampled grids.
     pub prepared: Prepared,
     /// The request solved.
     pub request: Request,

@@ -71,14 +71,7 @@ fn edit_one_second(c: &mut Criterion) {
     let req = run_requests([&prep[0].stance, &prep[1].stance], 1.1);
     // As `edit run` plays them: each stance leaned to its periodic request (`edit::lean`).
     let leaned: Vec<Prepared> = (0..2)
-        .map(|n| {
-            leaned(
-                &prep[n],
-                &req[n],
-                [1.1, 1.0],
-                prep[n].tables.active_fraction,
-            )
-        })
+        .map(|n| leaned(&prep[n], &req[n], [1.1, 1.0], prep[n].grids.active_fraction))
         .collect();
     let stances: Vec<_> = (0..2)
         .map(|n| {
