@@ -11,7 +11,7 @@
 //!   (parse)  │   → contacts::tracks → contacts::detect → contacts::runs_and_flights          │
 //!            └─ ClipFrames, ClipSummary (flights), ContactRun ──────────────────────────────┘
 //!                 │
-//!                 ├─ stances path:  stances (segment, build_clip)
+//!                 ├─ stances path:  stances (segment, assemble_clip)
 //!                 │                   → force_model (fit per stance) → constraints (coefficients)
 //!                 │                   → library (stances.parquet, frames, contacts, clips, errors)
 //!                 │                   → query (solve, feasibility, run, jump, map)

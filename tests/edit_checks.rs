@@ -81,7 +81,7 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
             // ≤ 3°, root path ≤ 2 cm). Over the first cycle: 4.58° and 11.6 cm on
             // 2026-12-02; 4.52° and 4.06 cm with the periodic cycle leaned, not rescaled
             // (`edit::lean`); 1.80° and 3.02 cm with stance edges on −g flight parabolas
-            // (`stances::build`, 2026-12-03); 1.80° and 1.61 cm with the recording's COM
+            // (`stances::assemble`, 2026-12-03); 1.80° and 1.61 cm with the recording's COM
             // detail added to each planned stance (`edit::detail`) and the cycle's height
             // change split between its start and end (`edit::plan::run_requests`),
             // 2026-12-06 (2.12 cm with a cubic-shaped detail alone, 2.79 cm with the split

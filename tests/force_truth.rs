@@ -232,7 +232,7 @@ fn force_models_round_trip_through_parquet() {
     write_library(&lib, &report, &opts).unwrap();
     let df = read_parquet(&lib.join("stances.parquet")).unwrap();
 
-    // In process, independently of the pipeline: ingest and build_clip per fixture.
+    // In process, independently of the pipeline: ingest and assemble_clip per fixture.
     let mut in_process: Vec<Stance> = util::FIXTURES
         .iter()
         .flat_map(|c| load(c).stances)

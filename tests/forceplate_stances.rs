@@ -21,7 +21,7 @@
 use serde_json::Value;
 use stancelib::force_model::ratio::{DEFAULT_RATIO_DEGREE_H, DEFAULT_RATIO_DEGREE_P};
 use stancelib::ingest::IngestOptions;
-use stancelib::stances::{build_clip, Stance, StanceOptions};
+use stancelib::stances::{assemble_clip, Stance, StanceOptions};
 
 /// (clip, mean vertical RMSE target in BW): issue 12 (the Fourier model's floor,
 /// c0 + 3 harmonics fitted to the plate force itself, is 0.05 BW on the run and 0.17 on the
@@ -162,7 +162,7 @@ impl PlateClip {
         let (summary, frames, contacts) = util::ingest_body(&bvh, &ingest_opts, clip);
         // The force mapping below assumes the documented +Y-up file (SOURCES.md).
         assert_eq!(summary.up_axis.as_deref(), Some("+Y"), "{clip}: up axis");
-        let (stances, _) = build_clip(clip, &frames, &summary, &contacts, mass, opts);
+        let (stances, _) = assemble_clip(clip, &frames, &summary, &contacts, mass, opts);
         let (h, cols) = util::read_csv(&dir.join("grf.csv"));
         // Plate time on the kinematics' clock: the plates' own lag removed.
         let lag = plate_lag_s(

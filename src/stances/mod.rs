@@ -8,13 +8,13 @@
 //! # References
 //! spec stance-model §1–§5, §7.2, §8.1–§8.2, §11.
 
-pub mod build;
+pub mod assemble;
 pub mod ids;
 pub mod limits;
 pub mod params;
 pub mod segment;
 
-pub use build::{build_clip, StanceOptions};
+pub use assemble::{assemble_clip, StanceOptions};
 
 use crate::constraints::Coefficients;
 use crate::force_model::{ForceModel, ForceModelKind};

@@ -55,8 +55,8 @@ use crate::library::scratch::{scratch_name, Scratch};
 use crate::library::stances::{first_non_finite, ErrorRow};
 use crate::library::table::read_parquet;
 use crate::library::{ClipRecord, ClipStatus, Status};
-use crate::stances::build::StanceNote;
-use crate::stances::{build_clip, Stance, StanceOptions};
+use crate::stances::assemble::StanceNote;
+use crate::stances::{assemble_clip, Stance, StanceOptions};
 
 /// How a build runs: none of it changes the rows of a clip.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -160,7 +160,7 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions, bar: &Progress)
         .par_iter()
         .map(|(path, clip)| build_one(path, clip, opts, bar))
         .collect();
-    assemble(per_clip)
+    report_of(per_clip)
 }
 
 /// One clip ingested and its stances built, counted on `bar`.
@@ -172,7 +172,7 @@ fn build_one(
 ) -> (ClipRecord, ClipStances) {
     let r = ingest_file(path, clip.to_string(), &opts.ingest);
     let out = match (&r.frames, r.status) {
-        (Some(fr), Status::Ok) => build_clip(
+        (Some(fr), Status::Ok) => assemble_clip(
             &r.clip,
             fr,
             &r.summary,
@@ -210,7 +210,7 @@ fn refuse_non_finite(mut r: ClipRecord, out: ClipStances) -> (ClipRecord, ClipSt
 
 /// The report of a batch of built clips: records in clip order, their error rows (failed
 /// inputs, ingests and stance fits) and their stances sorted by (clip, first frame, label).
-fn assemble(mut per_clip: Vec<(ClipRecord, ClipStances)>) -> BuildReport {
+fn report_of(mut per_clip: Vec<(ClipRecord, ClipStances)>) -> BuildReport {
     per_clip.sort_by(|a, b| a.0.clip.cmp(&b.0.clip));
     let (mut records, per_clip): (Vec<ClipRecord>, Vec<ClipStances>) = per_clip.into_iter().unzip();
     let mut errors: Vec<ErrorRow> = records
@@ -519,7 +519,7 @@ pub fn build_into(
             &batches,
             |b| &b.todo,
             |(path, clip)| build_one(path, clip, opts, &bar),
-            |b, per_clip| write(assemble(per_clip), b.last),
+            |b, per_clip| write(report_of(per_clip), b.last),
         )?;
         bar.bar.finish_and_clear();
         sink.finish(&fingerprint, t0, shard_entry.clone(), plan.layout)

@@ -288,7 +288,7 @@ impl From<String> for StanceNote {
 /// A clip whose smoothing filter cannot be built (a frame time beyond
 /// `MAX_SAVGOL_WINDOW`) or that is shorter than the window gives no stances and one
 /// failed note (an `errors.parquet` row), never nothing silently.
-pub fn build_clip(
+pub fn assemble_clip(
     clip: &str,
     fr: &ClipFrames,
     summary: &ClipSummary,
