@@ -1,5 +1,5 @@
-//! Issue 11 item 6: bounded work from small inputs (every documented limit refused before
-//! any work, exit 2, the field and the limit named, nothing written): query ranges, map
+//! Issue 11 item 6: bounded work from small inputs (every documented work cap refused before
+//! any work, exit 2, the field and the cap named, nothing written): query ranges, map
 //! grids, threads, twopac inputs, `synth`. Items 10–12 are in `safety_options`.
 //!
 //! Everything runs on the committed fixtures (`fixtures/bvh`, `fixtures/twopac`).

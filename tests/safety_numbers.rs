@@ -7,8 +7,8 @@
 
 use std::path::Path;
 
+use crate::safety_caps::write_points;
 use crate::safety_inputs::{fixture_text, write_temp};
-use crate::safety_limits::write_points;
 use crate::util::{refused, root, s, stancelib};
 use stancelib::library::table::read_parquet;
 

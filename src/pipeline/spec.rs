@@ -582,7 +582,7 @@ pub const MAX_INPUT_PATTERNS: usize = 1_000;
 /// The limit error when the pipeline lists more than [`MAX_INPUT_PATTERNS`] globs.
 fn too_many_inputs(p: &PipelineFile) -> Option<Error> {
     (p.inputs.len() > MAX_INPUT_PATTERNS).then(|| {
-        Error::limit(
+        Error::cap(
             "inputs",
             "globs",
             p.inputs.len() as f64,

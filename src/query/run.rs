@@ -44,12 +44,12 @@ pub const MAX_RUN_ROWS: usize = 1_000_000;
 /// Checks a sweep of `n_cycles` cycles at `n_speeds` speeds against [`MAX_RUN_ROWS`].
 ///
 /// # Errors
-/// [`ErrorKind::Limit`](crate::error::ErrorKind::Limit) naming `field`.
+/// [`ErrorKind::Cap`](crate::error::ErrorKind::Cap) naming `field`.
 pub fn check_sweep(field: &str, n_cycles: usize, n_speeds: usize) -> Result<(), Error> {
     let n = n_cycles as f64 * n_speeds as f64;
     if n > MAX_RUN_ROWS as f64 {
         let what = "rows (run cycles × speeds)";
-        return Err(Error::limit(field, what, n, MAX_RUN_ROWS, "MAX_RUN_ROWS"));
+        return Err(Error::cap(field, what, n, MAX_RUN_ROWS, "MAX_RUN_ROWS"));
     }
     Ok(())
 }

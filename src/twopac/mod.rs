@@ -128,18 +128,18 @@ pub enum TwopacError {
         /// What is wrong.
         msg: String,
     },
-    /// An input asks for more work than a documented limit allows (checked before the
-    /// work starts; README "Limits").
-    #[error("{found} {what}, more than the limit of {max} ({limit})")]
-    Limit {
+    /// An input asks for more work than a documented work cap allows (checked before the
+    /// work starts; README "Work caps").
+    #[error("{found} {what}, more than the limit of {max} ({cap})")]
+    Cap {
         /// What is counted (`contact points`, `validation samples`).
         what: &'static str,
         /// The amount asked for (formatted: it may not fit an integer).
         found: String,
-        /// The limit.
+        /// The cap.
         max: usize,
         /// The name of the constant that defines it (`MAX_SAMPLES`).
-        limit: &'static str,
+        cap: &'static str,
     },
     /// A Bezier curve cannot be built from its inputs.
     #[error("bezier: {msg}")]

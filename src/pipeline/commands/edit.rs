@@ -377,7 +377,7 @@ fn check_frames(
             crate::error::count_text(frames),
             1.0 / frame_time_s
         );
-        return Err(crate::error::Error::limit(
+        return Err(crate::error::Error::cap(
             field,
             "frame-joints",
             n,

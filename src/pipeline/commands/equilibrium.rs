@@ -97,7 +97,7 @@ fn read_points(path: &Path, n_contacts: usize, slice_cells: usize) -> anyhow::Re
     let rows = table.rows()?;
     let work = n_contacts as f64 * (rows + slice_cells) as f64;
     let too_many = if rows > MAX_COM_STATES {
-        Some(Error::limit(
+        Some(Error::cap(
             "--points",
             "rows",
             rows as f64,
@@ -110,7 +110,7 @@ fn read_points(path: &Path, n_contacts: usize, slice_cells: usize) -> anyhow::Re
         } else {
             String::new()
         };
-        Some(Error::limit(
+        Some(Error::cap(
             format!("--points ({rows} rows{png}) × --contacts ({n_contacts} contacts)"),
             "contact-states",
             work,

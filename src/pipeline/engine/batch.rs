@@ -216,10 +216,10 @@ pub fn max_threads() -> usize {
 /// Checks a requested worker count (0 = all cores) against [`max_threads`].
 ///
 /// # Errors
-/// [`ErrorKind::Limit`] naming `field`.
+/// [`ErrorKind::Cap`] naming `field`.
 pub fn check_threads(field: &str, threads: usize) -> Result<()> {
     if threads > max_threads() {
-        return Err(Error::limit(
+        return Err(Error::cap(
             field,
             "threads",
             threads as f64,
