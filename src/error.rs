@@ -149,7 +149,7 @@ pub enum ErrorKind {
         cap: &'static str,
     },
     /// A library was replaced (rebuilt) while a command read it, twice
-    /// ([`crate::library::generation`]): what was read may mix two builds, so nothing
+    /// ([`crate::library::storage::generation`]): what was read may mix two builds, so nothing
     /// was answered.
     #[error("library {} changed while it was read (a build replaced it); retry", lib.display())]
     Changed {

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use polars::prelude::*;
 use stancelib::ingest::DEFAULT_MASS_KG;
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 use stancelib::pipeline::engine::streaming::{build, write_library, BuildOptions};
 use stancelib::stances::Stance;
 use stancelib::synth::{SynthClip, SynthMotion};

@@ -754,8 +754,8 @@ fn vertical_rmse(pc: &PlateClip) -> f64 {
 /// `running_stances_are_feasible_as_recorded`) and the median apex mismatch across a
 /// flight (height mm, velocity cm/s; as `consecutive_stances_describe_the_same_flight`).
 fn identity_and_apex(pc: &PlateClip) -> (f64, usize, f64, f64) {
-    use stancelib::library::read::{ClipInfo, StanceLibrary};
-    use stancelib::library::stances::PoolStance;
+    use stancelib::library::codec::stances::PoolStance;
+    use stancelib::library::readers::read::{ClipInfo, StanceLibrary};
     use stancelib::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
     use stancelib::query::limits::{absolute_limits, stance_limits};
     use stancelib::query::pool::Prepared;

@@ -8,7 +8,7 @@ use crate::util::{fixture_clips, fixture_library, ok, refused, root, s};
 use std::path::Path;
 
 use polars::prelude::*;
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 
 // ---------------------------------------------------------------- item 6: query ranges
 

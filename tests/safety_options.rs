@@ -8,7 +8,7 @@
 use crate::util::{fixture_clips, fixture_library, listing, ok, refused, root, s, snapshot};
 use std::path::Path;
 
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 
 use super::safety_caps::{phases_json, write_points};
 

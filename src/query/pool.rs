@@ -21,7 +21,7 @@ use crate::stances::params::StanceParams;
 use super::feasibility::ImpulseMoments;
 use super::solve::StanceShape;
 
-pub use crate::library::stances::PoolStance;
+pub use crate::library::codec::stances::PoolStance;
 
 impl PoolStance {
     /// The stance's own context `(vs, vps, t_TD, z_TD, cp)` (§7.3).

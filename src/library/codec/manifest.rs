@@ -8,7 +8,7 @@
 //!
 //! # Examples
 //! ```
-//! use stancelib::library::manifest::read_manifest;
+//! use stancelib::library::codec::manifest::read_manifest;
 //! let d = tempfile::tempdir().unwrap();
 //! std::fs::write(d.path().join("manifest.json"), r#"{"schema_version": "4"}"#).unwrap();
 //! assert_eq!(read_manifest(d.path()).unwrap()["schema_version"], "4");

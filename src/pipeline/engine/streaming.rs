@@ -16,7 +16,7 @@
 //! same, byte for byte, as a full rebuild (rows are re-sorted by the same keys and cast to
 //! the same schema). Nothing is taken from a table whose bytes are not those its manifest
 //! recorded, nor from a clip whose rows are not as many as recorded
-//! ([`crate::library::integrity`]): those clips are rebuilt and the summary says why.
+//! ([`crate::library::storage::integrity`]): those clips are rebuilt and the summary says why.
 //!
 //! With a [`Shard`], only the inputs of that shard are built, and the library also keeps
 //! its kinematic samples and a `shard` entry in its manifest for [`super::merge`].
@@ -24,7 +24,7 @@
 //! Layout of a library folder: `frames.parquet`, `contacts.parquet`, `clips.parquet`,
 //! `stances.parquet`, `errors.parquet`, `manifest.json` (spec stance-model §11); with
 //! [`Layout::Dataset`] each table is a hive-partitioned dataset instead
-//! ([`crate::library::layout`]). `incremental` reads the previous library in its layout.
+//! ([`crate::library::storage::layout`]). `incremental` reads the previous library in its layout.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -45,15 +45,15 @@ use super::sink::LibrarySink;
 use super::tables::{combine, strings, BuildReport, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
-use crate::library::integrity::{
+use crate::library::codec::provenance::library_layout;
+use crate::library::codec::schema::{clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION};
+use crate::library::codec::stances::{first_non_finite, ErrorRow};
+use crate::library::codec::table::read_parquet;
+use crate::library::storage::integrity::{
     check_clip_rows, check_table, recorded_clip_rows, recorded_digests, Mismatch,
 };
-use crate::library::layout::Layout;
-use crate::library::provenance::library_layout;
-use crate::library::schema::{clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION};
-use crate::library::scratch::{scratch_name, Scratch};
-use crate::library::stances::{first_non_finite, ErrorRow};
-use crate::library::table::read_parquet;
+use crate::library::storage::layout::Layout;
+use crate::library::storage::scratch::{scratch_name, Scratch};
 use crate::library::{ClipRecord, ClipStatus, Status};
 use crate::stances::assemble::StanceNote;
 use crate::stances::{assemble_clip, Stance, StanceOptions};
@@ -265,11 +265,11 @@ const REFUSED_CLIPS_NAMED: usize = 10;
 
 /// Clips of the previous library at `out` that can be reused for `named`: the library's
 /// options and layout are this build's, every table it gives rows from has the content
-/// hash its manifest recorded ([`crate::library::integrity`]), and per clip the input's
+/// hash its manifest recorded ([`crate::library::storage::integrity`]), and per clip the input's
 /// path and content are unchanged and its rows in every table are as many as recorded.
 /// Anything else is rebuilt, with a line in `refused` saying why.
 fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str, joints: bool) -> Reuse {
-    let Ok(manifest) = crate::library::manifest::read_manifest(out) else {
+    let Ok(manifest) = crate::library::codec::manifest::read_manifest(out) else {
         return Reuse::default();
     };
     let all = |why: String| Reuse {
