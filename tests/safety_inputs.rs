@@ -114,7 +114,7 @@ fn savgol_memory_bomb_short_frame_time_is_a_per_clip_error() {
 // See: issue 11 item 3 — assemble_clip returned no stances silently when the smoothing filter
 // could not be built; now that is a failed note (an errors.parquet row).
 #[test]
-fn savgol_memory_bomb_build_clip_reports_an_unbuildable_filter() {
+fn savgol_memory_bomb_assemble_clip_reports_an_unbuildable_filter() {
     let bvh = parse_file(&fixture("run_120hz_m_yup.bvh")).unwrap();
     let ClipOutcome::Body {
         mut summary,
