@@ -133,23 +133,23 @@ pub enum ErrorKind {
         #[source]
         problem: InputProblem,
     },
-    /// An input asks for more work or memory than a documented limit allows; checked
-    /// before the work starts (README "Limits").
-    #[error("{field}: {found} {what}, more than the limit of {max} ({limit})")]
-    Limit {
+    /// An input asks for more work or memory than a documented work cap allows; checked
+    /// before the work starts (README "Work caps").
+    #[error("{field}: {found} {what}, more than the limit of {max} ({cap})")]
+    Cap {
         /// The option, key or path that asks for it (`--speeds`, `[queries] map_heights`).
         field: String,
         /// What is counted (`grid values`, `rows`).
         what: &'static str,
         /// The amount asked for (formatted: it may not fit an integer).
         found: String,
-        /// The limit.
+        /// The cap.
         max: usize,
-        /// The name of the constant that defines the limit (`MAX_AXIS_VALUES`).
-        limit: &'static str,
+        /// The name of the constant that defines the cap (`MAX_AXIS_VALUES`).
+        cap: &'static str,
     },
     /// A library was replaced (rebuilt) while a command read it, twice
-    /// ([`crate::library::generation`]): what was read may mix two builds, so nothing
+    /// ([`crate::library::storage::generation`]): what was read may mix two builds, so nothing
     /// was answered.
     #[error("library {} changed while it was read (a build replaced it); retry", lib.display())]
     Changed {
@@ -240,21 +240,21 @@ impl Error {
         .into()
     }
 
-    /// A limit error: `found` of `what` asked for by `field`, above `max` (the constant
-    /// named `limit`).
-    pub fn limit(
+    /// A work-cap error: `found` of `what` asked for by `field`, above `max` (the constant
+    /// named `cap`).
+    pub fn cap(
         field: impl Into<String>,
         what: &'static str,
         found: f64,
         max: usize,
-        limit: &'static str,
+        cap: &'static str,
     ) -> Self {
-        ErrorKind::Limit {
+        ErrorKind::Cap {
             field: field.into(),
             what,
             found: count_text(found),
             max,
-            limit,
+            cap,
         }
         .into()
     }
@@ -319,15 +319,15 @@ pub enum InputProblem {
         /// Reached through a symbolic link.
         via_link: bool,
     },
-    /// Larger than the limit of its kind (`MAX_BVH_BYTES` for a clip, README "Inputs").
-    #[error("{bytes} bytes is more than the limit of {max} bytes ({limit})")]
+    /// Larger than the cap of its kind (`MAX_BVH_BYTES` for a clip, README "Inputs").
+    #[error("{bytes} bytes is more than the limit of {max} bytes ({cap})")]
     TooLarge {
-        /// Size of the file, bytes (or bytes read before the limit was passed).
+        /// Size of the file, bytes (or bytes read before the cap was passed).
         bytes: u64,
-        /// The limit, bytes.
+        /// The cap, bytes.
         max: u64,
-        /// The name of the constant that defines the limit (`MAX_BVH_BYTES`).
-        limit: &'static str,
+        /// The name of the constant that defines the cap (`MAX_BVH_BYTES`).
+        cap: &'static str,
     },
     /// Any other failure to inspect, open or read.
     #[error("cannot read: {0}")]

@@ -4,8 +4,8 @@
 
 use std::collections::BTreeMap;
 
-use stancelib::library::read::{open_library, read_stances};
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
+use stancelib::library::readers::read::{open_library, read_stances};
 use stancelib::pipeline::commands::catalogue::catalogue;
 use stancelib::query::jump::recorded_jump;
 

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use stancelib::library::schema::{CLIPS_COLUMNS, CONTACTS_COLUMNS};
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::schema::{CLIPS_COLUMNS, CONTACTS_COLUMNS};
+use stancelib::library::codec::table::read_parquet;
 
 pub(super) use crate::util::{root, stancelib};
 

@@ -559,13 +559,13 @@ fn clip_stances(
     name: &str,
     mass: f64,
 ) -> Vec<stancelib::stances::Stance> {
-    use stancelib::stances::{build_clip, StanceOptions};
+    use stancelib::stances::{assemble_clip, StanceOptions};
     let opts = IngestOptions {
         mass_kg: mass,
         ..Default::default()
     };
     let (summary, frames, contacts) = util::ingest_body(bvh, &opts, name);
-    build_clip(
+    assemble_clip(
         name,
         &frames,
         &summary,

@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use polars::prelude::*;
-use stancelib::library::layout::{read_table, table_name};
-use stancelib::library::schema::{
+use stancelib::library::codec::schema::{
     CLIPS_FILE, DATASET_PART_FILE, FRAMES_FILE, INPUTS_KEY, KINEMATICS_FILE, LIBRARY_MANIFEST_KEY,
     LIBRARY_PATH_KEY, LIMITS_KEY, OPTIONS_KEY, STANCES_FILE, TABLE_FILES,
 };
+use stancelib::library::storage::layout::{read_table, table_name};
 
 use crate::util::{files_below, fixture_clips, fixture_library, ok, s};
 
@@ -79,7 +79,7 @@ fn frame(path: &Path) -> DataFrame {
 /// The text of `path` with every string naming its library (`lib`, its manifest hash)
 /// replaced by a placeholder.
 fn neutral(text: &str, lib: &Path) -> String {
-    let sha = stancelib::library::provenance::manifest_sha256(lib).unwrap();
+    let sha = stancelib::library::codec::provenance::manifest_sha256(lib).unwrap();
     text.replace(&s(lib), "<lib>").replace(&sha, "<manifest>")
 }
 

@@ -113,7 +113,7 @@ fn written_since(
 /// NaN left out).
 fn table_numbers(path: &Path) -> Vec<f64> {
     use polars::prelude::DataType;
-    let t = stancelib::library::table::Table::open(path)
+    let t = stancelib::library::codec::table::Table::open(path)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut out = Vec::new();
     for c in t.df.columns() {
@@ -148,7 +148,7 @@ fn printed_numbers_are_the_numeric_words_of_the_output() {
 /// Whether a written table answers: the rows of its verdict column (`feasible`, or a jump
 /// map's `feasible_exact`), any of them true; `None` when it has no verdict column.
 fn any_feasible(path: &Path) -> Option<bool> {
-    let t = stancelib::library::table::Table::open(path).unwrap();
+    let t = stancelib::library::codec::table::Table::open(path).unwrap();
     ["feasible", "feasible_exact"]
         .iter()
         .find(|c| t.df.column(c).is_ok())
@@ -356,7 +356,8 @@ fn first_hour_walkthrough_commands_run() {
                         run |= any_feasible(out_file.unwrap()) == Some(true);
                     }
                     if c.starts_with("stancelib query jump") {
-                        let t = stancelib::library::table::Table::open(out_file.unwrap()).unwrap();
+                        let t = stancelib::library::codec::table::Table::open(out_file.unwrap())
+                            .unwrap();
                         let feasible = t.bools("feasible").unwrap();
                         let heights = t.f64s("height_m").unwrap();
                         jump |= feasible
@@ -627,7 +628,7 @@ fn manifest_records_date_command_line_and_tool_version_and_queries_name_their_li
     // RFC 3339 UTC, and today (the test's own clock, within a day).
     assert_eq!(date.len(), 20, "{date}");
     assert!(date.ends_with('Z') && &date[10..11] == "T", "{date}");
-    let now = stancelib::library::provenance::now_utc();
+    let now = stancelib::library::codec::provenance::now_utc();
     let days = |d: &str| -> i64 {
         let (y, mo, da): (i64, i64, i64) = (
             d[0..4].parse().unwrap(),
@@ -730,7 +731,8 @@ fn info_summarises_the_library_as_text_and_json() {
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(json.trim()).expect("one JSON object");
     // Against the tables, counted here independently.
-    let stances = stancelib::library::table::read_parquet(&lib.join("stances.parquet")).unwrap();
+    let stances =
+        stancelib::library::codec::table::read_parquet(&lib.join("stances.parquet")).unwrap();
     let labels = stances.column("label").unwrap().str().unwrap().clone();
     let mut by_label: BTreeMap<String, u64> = BTreeMap::new();
     for l in labels.iter().flatten() {
@@ -817,7 +819,7 @@ fn quiet_prints_nothing_and_json_prints_one_summary_object() {
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(out.trim()).expect("one JSON object");
     let stances =
-        stancelib::library::table::parquet_rows(&demo.dir.path().join("b/stances.parquet"))
+        stancelib::library::codec::table::parquet_rows(&demo.dir.path().join("b/stances.parquet"))
             .unwrap();
     assert_eq!(v["command"], "build");
     assert_eq!((v["clips"].as_u64(), v["ok"].as_u64()), (Some(1), Some(1)));
@@ -856,7 +858,7 @@ fn a_library_of_an_older_table_layout_is_refused_and_not_reused() {
         serde_json::from_str(&std::fs::read_to_string(&mpath).unwrap()).unwrap();
     let want = format!(
         "stancelib.library/{}",
-        stancelib::library::schema::SCHEMA_VERSION
+        stancelib::library::codec::schema::SCHEMA_VERSION
     );
     assert_eq!(again["schema"], want.as_str());
 }

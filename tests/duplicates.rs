@@ -2,7 +2,7 @@
 //! reported by `info` and enter every query answer once; the clips a query leaves out are
 //! named, and `--keep-left-out` keeps them.
 
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 
 use crate::util::{ok, s, stancelib};
 

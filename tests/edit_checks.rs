@@ -11,7 +11,7 @@ use super::edit_motion::{
     first_jump, fixture, library, measure, read_plan, recorded_jump_against_source,
 };
 use super::util::{ok, refused, s, shared_or_skip};
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 use std::path::{Path, PathBuf};
 
 // See: issue 14 item 3 — "iterate root correction and leg IK until the COM error is below
@@ -81,7 +81,7 @@ fn real_run_edit_support_foot_holds_still_and_lifts_on_time() {
             // ≤ 3°, root path ≤ 2 cm). Over the first cycle: 4.58° and 11.6 cm on
             // 2026-12-02; 4.52° and 4.06 cm with the periodic cycle leaned, not rescaled
             // (`edit::lean`); 1.80° and 3.02 cm with stance edges on −g flight parabolas
-            // (`stances::build`, 2026-12-03); 1.80° and 1.61 cm with the recording's COM
+            // (`stances::assemble`, 2026-12-03); 1.80° and 1.61 cm with the recording's COM
             // detail added to each planned stance (`edit::detail`) and the cycle's height
             // change split between its start and end (`edit::plan::run_requests`),
             // 2026-12-06 (2.12 cm with a cubic-shaped detail alone, 2.79 cm with the split
@@ -152,9 +152,10 @@ fn a_paired_jump_lands_in_the_liftoffs_heading() {
     let dir = tempfile::tempdir().unwrap();
     let src = data.join("bvh/jump/cmu_01_01_forward_jumps_mb.bvh");
     let lib = library(dir.path(), std::slice::from_ref(&src));
-    let l = stancelib::library::read::open_library(&lib).unwrap();
+    let l = stancelib::library::readers::read::open_library(&lib).unwrap();
     let timing =
-        stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+        stancelib::library::readers::read::read_stance_timing(&lib.join("stances.parquet"))
+            .unwrap();
     let id = |frame: &str| {
         let i = l
             .stances
@@ -199,7 +200,7 @@ fn a_pair_of_two_clips_is_refused() {
         dir.path(),
         &[fixture("jump_120hz_cmu_yup"), fixture("jump_100hz_m_zup")],
     );
-    let l = stancelib::library::read::open_library(&lib).unwrap();
+    let l = stancelib::library::readers::read::open_library(&lib).unwrap();
     let s = &l.stances;
     let up = s
         .iter()
@@ -256,7 +257,7 @@ fn real_forward_jumps_at_a_new_height_and_distance_round_trip() {
     for clip in ["cmu_13_32_forward_jump_daz", "cmu_01_01_forward_jumps_mb"] {
         let src = data.join(format!("bvh/jump/{clip}.bvh"));
         let lib = library(&dir.path().join(clip), std::slice::from_ref(&src));
-        let l = stancelib::library::read::open_library(&lib).unwrap();
+        let l = stancelib::library::readers::read::open_library(&lib).unwrap();
         let travel = measured_travel(&lib);
         let pairs: Vec<(usize, usize)> = (1..l.stances.len())
             .filter(|&i| {
@@ -303,7 +304,7 @@ fn real_forward_jumps_at_a_new_height_and_distance_round_trip() {
                 };
                 assert_bounds_except(&measure(&out), misses);
                 let rl = library(&dir.path().join(format!("rebuilt{cases}")), &[out]);
-                let r = stancelib::library::read::open_library(&rl).unwrap();
+                let r = stancelib::library::readers::read::open_library(&rl).unwrap();
                 let (a, b) = first_jump(&r.stances).expect("the rebuilt clip has a jump");
                 let (hr, dr) = stancelib::query::jump::recorded_jump(&r.stances[a], &r.stances[b]);
                 let rt = measured_travel(&rl);
@@ -555,7 +556,7 @@ fn issue37_item5_edit_run_contact_time_and_cadence_are_the_querys() {
             &s(&q),
             "--quiet",
         ]);
-        let t = stancelib::library::table::Table::open(&q).unwrap();
+        let t = stancelib::library::codec::table::Table::open(&q).unwrap();
         let row = super::util::first_stance_ids(&t)
             .iter()
             .position(|x| *x == id)

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use stancelib::bvh::parse_file;
 use stancelib::edit::rotation::{angle_deg, from_euler, Quat};
 use stancelib::ingest::{ClipFrames, ClipSummary, ContactRun, IngestOptions};
-use stancelib::library::read::open_library;
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
+use stancelib::library::readers::read::open_library;
 use stancelib::query::run::run_cycles;
 use stancelib::skeleton::Skeleton;
 use stancelib::stances::segment::Boundary;
@@ -506,7 +506,8 @@ fn identity_run_reproduces_the_recorded_motion() {
     // flight); it now stops at 10 µm and every bound holds.
     assert_bounds_except(&measure(&out), &[]);
     let (td, _, first) = first_window(&out);
-    let t = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+    let t = stancelib::library::readers::read::read_stance_timing(&lib.join("stances.parquet"))
+        .unwrap();
     let td_clip = t[stance_index(&lib, &first)].td_clip_s;
     let (rms, root) = against_source(&out, &src, 1.0, 0.0, td_clip - td, 10.0);
     eprintln!("identity run: joint-angle RMS {rms:.3}°, root path {root:.4} m");
@@ -579,14 +580,16 @@ fn a_jump_edit_starts_with_its_recorded_rest_on_the_planned_footprints() {
     let dir = tmp();
     let src = fixture("jump_120hz_cmu_yup");
     let lib = library(dir.path(), std::slice::from_ref(&src));
-    let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
+    let clips =
+        stancelib::library::readers::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
     let clip = &clips["jump_120hz_cmu_yup"];
     let source = parse_file(&src).unwrap();
     let dropped =
         stancelib::skeleton::leadin::leadin_frames(&Skeleton::from_bvh(&source), &source.motion);
     let first_kept_s = dropped as f64 * source.motion.frame_time_s;
     let timing =
-        stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+        stancelib::library::readers::read::read_stance_timing(&lib.join("stances.parquet"))
+            .unwrap();
     for (scale, fps) in [("1.0", None), ("0.7", None), ("0.7", Some("60"))] {
         let out = dir
             .path()
@@ -698,7 +701,8 @@ fn edited_jumps_reach_the_requested_apex_and_round_trip() {
         if scale == 1.0 {
             let (td, _, _) = first_window(&out);
             let tm =
-                stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+                stancelib::library::readers::read::read_stance_timing(&lib.join("stances.parquet"))
+                    .unwrap();
             let (rms, root) = against_source(&out, &src, 0.056444, 0.0, tm[i].td_clip_s - td, 10.0);
             eprintln!("identity jump: joint-angle RMS {rms:.3}°, root path {root:.4} m");
             assert!(
@@ -787,7 +791,8 @@ fn edited_run_of_a_longer_heavier_character_scales_by_dynamic_similarity() {
     // Stance durations scale by √L; the contact thresholds are absolute, so each re-detected
     // edge of the taller character's stances may move by the known miss above.
     let durations = |l: &Path| -> Vec<f64> {
-        let t = stancelib::library::read::read_stance_timing(&l.join("stances.parquet")).unwrap();
+        let t = stancelib::library::readers::read::read_stance_timing(&l.join("stances.parquet"))
+            .unwrap();
         t.iter().map(|s| s.lo_clip_s - s.td_clip_s).collect()
     };
     let d0 = durations(&lib);
@@ -891,9 +896,11 @@ fn against_source_from(
     (first, td): (&str, f64),
     span_s: f64,
 ) -> (f64, f64) {
-    let t = stancelib::library::read::read_stance_timing(&lib.join("stances.parquet")).unwrap();
+    let t = stancelib::library::readers::read::read_stance_timing(&lib.join("stances.parquet"))
+        .unwrap();
     let td_clip = t[stance_index(lib, first)].td_clip_s;
-    let clips = stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
+    let clips =
+        stancelib::library::readers::read::read_clip_sources(&lib.join("clips.parquet")).unwrap();
     let clip = first.split(':').next().unwrap();
     let unit_m = clips[clip].unit_scale.expect("unit scale");
     // After a jump's lead-in (its `rest` rows, the recording's own frames, which would only
@@ -965,7 +972,7 @@ fn edited_runs_follow_the_gait_law_of_the_query() {
             q.to_str().unwrap(),
             "--quiet",
         ]);
-        let t = stancelib::library::table::Table::open(&q).unwrap();
+        let t = stancelib::library::codec::table::Table::open(&q).unwrap();
         let row = super::util::first_stance_ids(&t)
             .iter()
             .position(|x| *x == id)

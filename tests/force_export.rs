@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use stancelib::force_model::export::StanceTimes;
 use stancelib::ingest::plates::PlateFoot;
-use stancelib::library::forces::{read_force_stances, read_up_axis, FORCES_COLUMNS};
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
+use stancelib::library::readers::forces::{read_force_stances, read_up_axis, FORCES_COLUMNS};
 use stancelib::pipeline::commands::plots::read_plates;
 use stancelib::plot::stance::STANCE_PLOT_PX;
 use stancelib::skeleton::units::UpAxis;

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use polars::prelude::*;
 use stancelib::ingest::DEFAULT_MASS_KG;
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 use stancelib::pipeline::engine::streaming::{build, write_library, BuildOptions};
 use stancelib::stances::Stance;
 use stancelib::synth::{SynthClip, SynthMotion};
@@ -232,7 +232,7 @@ fn force_models_round_trip_through_parquet() {
     write_library(&lib, &report, &opts).unwrap();
     let df = read_parquet(&lib.join("stances.parquet")).unwrap();
 
-    // In process, independently of the pipeline: ingest and build_clip per fixture.
+    // In process, independently of the pipeline: ingest and assemble_clip per fixture.
     let mut in_process: Vec<Stance> = util::FIXTURES
         .iter()
         .flat_map(|c| load(c).stances)

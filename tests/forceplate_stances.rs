@@ -21,7 +21,7 @@
 use serde_json::Value;
 use stancelib::force_model::ratio::{DEFAULT_RATIO_DEGREE_H, DEFAULT_RATIO_DEGREE_P};
 use stancelib::ingest::IngestOptions;
-use stancelib::stances::{build_clip, Stance, StanceOptions};
+use stancelib::stances::{assemble_clip, Stance, StanceOptions};
 
 /// (clip, mean vertical RMSE target in BW): issue 12 (the Fourier model's floor,
 /// c0 + 3 harmonics fitted to the plate force itself, is 0.05 BW on the run and 0.17 on the
@@ -282,7 +282,7 @@ impl PlateClip {
         let (summary, frames, contacts) = util::ingest_body(&bvh, &ingest_opts, clip);
         // The force mapping below assumes the documented +Y-up file (SOURCES.md).
         assert_eq!(summary.up_axis.as_deref(), Some("+Y"), "{clip}: up axis");
-        let (stances, _) = build_clip(clip, &frames, &summary, &contacts, mass, opts);
+        let (stances, _) = assemble_clip(clip, &frames, &summary, &contacts, mass, opts);
         let (h, cols) = util::read_csv(&dir.join("grf.csv"));
         // Plate time on the kinematics' clock: the plates' own lag removed.
         let lag = plate_lag_s(
@@ -876,8 +876,8 @@ fn vertical_rmse(pc: &PlateClip) -> f64 {
 /// `running_stances_are_feasible_as_recorded`) and the median apex mismatch across a
 /// flight (height mm, velocity cm/s; as `consecutive_stances_describe_the_same_flight`).
 fn identity_and_apex(pc: &PlateClip) -> (f64, usize, f64, f64) {
-    use stancelib::library::read::{ClipInfo, StanceLibrary};
-    use stancelib::library::stances::PoolStance;
+    use stancelib::library::codec::stances::PoolStance;
+    use stancelib::library::readers::read::{ClipInfo, StanceLibrary};
     use stancelib::query::feasibility::{LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
     use stancelib::query::limits::{absolute_limits, stance_limits};
     use stancelib::query::pool::Prepared;

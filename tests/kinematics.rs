@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 use stancelib::pipeline::commands::twopac::read_polytopes;
 use stancelib::pipeline::engine::inputs::discover;
 use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};

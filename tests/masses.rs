@@ -2,7 +2,7 @@
 //! pipeline `masses`), recorded in `clips.parquet` (`mass_kg`, `mass_source`) and `info`;
 //! the default mass is a warning.
 
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 
 use crate::util::{ok, s, stancelib};
 

@@ -21,7 +21,7 @@ use stancelib::contacts::detect::PointTrack;
 use stancelib::contacts::raw_speed;
 use stancelib::contacts::walking::{self, DEFAULT_WALK_LO_RATIO, DEFAULT_WALK_TD_RATIO};
 use stancelib::ingest::IngestOptions;
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 use stancelib::math::savgol::{window_for_rate, SavGol};
 
 use crate::forceplate::pearson;
@@ -710,7 +710,7 @@ fn per_contact_export_writes_parquet_csv_and_mot_and_refuses_what_cannot_act() {
     };
     assert_eq!(
         h.len() + 2,
-        stancelib::library::per_contact::per_contact_columns().len()
+        stancelib::library::readers::per_contact::per_contact_columns().len()
     );
     let parquet_fz = t.opt_f64("left_foot_fz_n").unwrap();
     let csv_fz = util::csv_col(&h, &cols, "left_foot_fz_n");

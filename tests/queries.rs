@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 use stancelib::pipeline::engine::inputs::discover;
 use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::query::jump::{is_landing, is_liftoff, recorded_jump};
@@ -182,8 +182,10 @@ fn jump_pair_row_with(
 #[test]
 fn recorded_jumps_are_feasible_at_their_own_height_and_distance() {
     let Some(lib) = shared_library() else { return };
-    let stances = stancelib::library::read::read_stances(&lib.join("stances.parquet")).unwrap();
-    let clips = stancelib::library::read::read_clip_info(&lib.join("clips.parquet")).unwrap();
+    let stances =
+        stancelib::library::readers::read::read_stances(&lib.join("stances.parquet")).unwrap();
+    let clips =
+        stancelib::library::readers::read::read_clip_info(&lib.join("clips.parquet")).unwrap();
     let recorded: Vec<(usize, usize)> = (1..stances.len())
         .filter(|&i| stances[i - 1].clip == stances[i].clip)
         .filter(|&i| is_liftoff(&stances[i - 1]) && is_landing(&stances[i]))
@@ -532,8 +534,10 @@ fn running_stances_are_feasible_as_recorded() {
 #[test]
 fn recorded_jumps_can_go_higher_under_a_persons_limits() {
     let Some(lib) = nightly_library() else { return };
-    let stances = stancelib::library::read::read_stances(&lib.join("stances.parquet")).unwrap();
-    let clips = stancelib::library::read::read_clip_info(&lib.join("clips.parquet")).unwrap();
+    let stances =
+        stancelib::library::readers::read::read_stances(&lib.join("stances.parquet")).unwrap();
+    let clips =
+        stancelib::library::readers::read::read_clip_info(&lib.join("clips.parquet")).unwrap();
     // Each stance's heading (unit, horizontal): a pair whose two headings differ by more
     // than 45° turned in the air, which the straight-jump model cannot compose.
     let t = Table::open(&lib.join("stances.parquet")).unwrap();
@@ -550,7 +554,7 @@ fn recorded_jumps_can_go_higher_under_a_persons_limits() {
         .collect();
     // The queries answer a copied clip once (issue 38 item 3): its pairs are not asked.
     let left_out = stancelib::query::limits::left_out_clips(
-        &stancelib::library::read::open_library(lib).unwrap(),
+        &stancelib::library::readers::read::open_library(lib).unwrap(),
     );
     let (mut own, mut higher, mut forward, mut failures) = (0, 0, 0, Vec::new());
     for i in 1..stances.len() {
@@ -692,7 +696,8 @@ fn every_recorded_cycle_is_feasible_at_its_own_speed() {
 #[test]
 fn fixture_jumps_are_feasible_as_recorded_under_both_limit_forms() {
     let lib = crate::util::fixture_library();
-    let stances = stancelib::library::read::read_stances(&lib.join("stances.parquet")).unwrap();
+    let stances =
+        stancelib::library::readers::read::read_stances(&lib.join("stances.parquet")).unwrap();
     let mut checked = 0;
     for i in 1..stances.len() {
         let (s1, s2) = (&stances[i - 1], &stances[i]);

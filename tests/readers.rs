@@ -67,7 +67,7 @@ assert len(s) == {n_stances} and isinstance(s["effectors"].iloc[0][0], str), s["
 print("ok", n, frames)
 "#,
         lib = lib.display().to_string(),
-        ver = stancelib::library::schema::SCHEMA_VERSION,
+        ver = stancelib::library::codec::schema::SCHEMA_VERSION,
         sid = first.stance_id,
         dt = first.dt_s,
         c0v = first.model.axes[2].c0,

@@ -2,7 +2,7 @@
 
 use stancelib::ingest::IngestOptions;
 use stancelib::stances::segment::Boundary;
-use stancelib::stances::{build_clip, StanceOptions};
+use stancelib::stances::{assemble_clip, StanceOptions};
 
 use crate::util;
 
@@ -72,7 +72,7 @@ fn a_walking_stance_is_supported_by_its_labelled_foot_only() {
     let bvh = stancelib::bvh::parse_file(&data.join("bvh/walk/cmu_07_01_walk_mb.bvh")).unwrap();
     let (summary, frames, contacts) =
         util::ingest_body(&bvh, &IngestOptions::default(), "cmu_07_01_walk_mb");
-    let (stances, _) = build_clip(
+    let (stances, _) = assemble_clip(
         "w",
         &frames,
         &summary,

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 
 use crate::util::{
     csv_col, first_stance_ids, forceplate_clip, ok, read_csv, shared_or_skip, ForcePlateClip,

@@ -12,7 +12,7 @@ use stancelib::error::ErrorKind;
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
 use stancelib::library::Status;
 use stancelib::math::savgol::MAX_SAVGOL_WINDOW;
-use stancelib::stances::{build_clip, StanceOptions};
+use stancelib::stances::{assemble_clip, StanceOptions};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -111,10 +111,10 @@ fn savgol_memory_bomb_short_frame_time_is_a_per_clip_error() {
     assert_eq!(by("run_30hz").status, Status::Ok);
 }
 
-// See: issue 11 item 3 — build_clip returned no stances silently when the smoothing filter
+// See: issue 11 item 3 — assemble_clip returned no stances silently when the smoothing filter
 // could not be built; now that is a failed note (an errors.parquet row).
 #[test]
-fn savgol_memory_bomb_build_clip_reports_an_unbuildable_filter() {
+fn savgol_memory_bomb_assemble_clip_reports_an_unbuildable_filter() {
     let bvh = parse_file(&fixture("run_120hz_m_yup.bvh")).unwrap();
     let ClipOutcome::Body {
         mut summary,
@@ -124,7 +124,7 @@ fn savgol_memory_bomb_build_clip_reports_an_unbuildable_filter() {
     else {
         panic!("fixture skipped")
     };
-    let (ok, notes) = build_clip(
+    let (ok, notes) = assemble_clip(
         "c",
         &frames,
         &summary,
@@ -134,7 +134,7 @@ fn savgol_memory_bomb_build_clip_reports_an_unbuildable_filter() {
     );
     assert!(!ok.is_empty() && notes.iter().all(|n| !n.failed));
     summary.frame_time_s = 1e-5;
-    let (stances, notes) = build_clip(
+    let (stances, notes) = assemble_clip(
         "c",
         &frames,
         &summary,
@@ -152,7 +152,7 @@ fn savgol_memory_bomb_build_clip_reports_an_unbuildable_filter() {
     );
     // A clip shorter than the window is a failed note too, not silence.
     summary.frame_time_s = 1.0 / 2000.0; // W = 201 > the fixture's 180 frames
-    let (stances, notes) = build_clip(
+    let (stances, notes) = assemble_clip(
         "c",
         &frames,
         &summary,
@@ -539,7 +539,7 @@ fn check_input(bytes: &[u8]) -> std::result::Result<Reached, String> {
             {
                 return Err(format!("clip ok with a non-finite COM at frame {f}"));
             }
-            let (_, notes) = build_clip(
+            let (_, notes) = assemble_clip(
                 "fuzz",
                 &frames,
                 &summary,

@@ -8,10 +8,10 @@
 use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
-use stancelib::library::layout::file_kv;
-use stancelib::library::manifest::MAX_MANIFEST_BYTES;
-use stancelib::library::table::read_parquet;
-use stancelib::library::write::write_atomic;
+use stancelib::library::codec::manifest::MAX_MANIFEST_BYTES;
+use stancelib::library::codec::table::read_parquet;
+use stancelib::library::codec::write::write_atomic;
+use stancelib::library::storage::layout::file_kv;
 
 use crate::util::{fixture_clips, fixture_library, ok, refused, reseal, root, s, stancelib};
 

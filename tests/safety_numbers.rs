@@ -7,10 +7,10 @@
 
 use std::path::Path;
 
+use crate::safety_caps::write_points;
 use crate::safety_inputs::{fixture_text, write_temp};
-use crate::safety_limits::write_points;
 use crate::util::{refused, root, s, stancelib};
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 
 /// `text` with the OFFSET of joint `joint` replaced by `offset`.
 fn with_joint_offset(text: &str, joint: &str, offset: &str) -> String {

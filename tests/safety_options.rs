@@ -1,16 +1,16 @@
 //! Issue 11 items 10, 11 and 12 (duplicate keys): the whole pipeline file validated before
 //! the library is touched, no option accepted and ignored, duplicate JSON and TOML keys
 //! refused (exit 2, the file, line or path named). Item 6 (work limits) is in
-//! `safety_limits`.
+//! `safety_caps`.
 //!
 //! Everything runs on the committed fixtures (`fixtures/bvh`, `fixtures/twopac`).
 
 use crate::util::{fixture_clips, fixture_library, listing, ok, refused, root, s, snapshot};
 use std::path::Path;
 
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 
-use super::safety_limits::{phases_json, write_points};
+use super::safety_caps::{phases_json, write_points};
 
 // ---------------------------------------------------------------- item 10: pipelines
 

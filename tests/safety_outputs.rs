@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 
 use super::cli::{fixture, good_fixtures, stancelib, strings, tmp};
 
@@ -262,7 +262,7 @@ fn an_existing_library_or_empty_folder_is_replaced() {
         serde_json::from_str(&std::fs::read_to_string(lib.join("manifest.json")).unwrap()).unwrap();
     let schema = format!(
         "stancelib.library/{}",
-        stancelib::library::schema::SCHEMA_VERSION
+        stancelib::library::codec::schema::SCHEMA_VERSION
     );
     assert_eq!(manifest["schema"], schema.as_str());
     let (code, _, err) = build(&[&clip], &lib, &[]);

@@ -335,7 +335,7 @@ fn frames_refuses_to_write_into_a_library() {
     );
 }
 
-// See: `library::schema::ADDED_COLUMNS` — a library written before `clips.parquet` had
+// See: `library::codec::schema::ADDED_COLUMNS` — a library written before `clips.parquet` had
 // `reach_m` (issue 37's jump limits) is read as it is, and an incremental build over it
 // keeps its clips (their reach null) and adds the new clips with theirs; the jump query
 // answers on it, with the old limit for the clips without a reach.
@@ -348,7 +348,7 @@ fn a_library_written_before_reach_m_is_read_and_grows() {
     copy_library(&src.lib, &lib);
     // The clips table as a library before the column wrote it, and its manifest entry.
     let clips = lib.join("clips.parquet");
-    let mut df = stancelib::library::table::read_parquet(&clips)
+    let mut df = stancelib::library::codec::table::read_parquet(&clips)
         .unwrap()
         .drop("reach_m")
         .unwrap();
@@ -385,7 +385,7 @@ fn a_library_written_before_reach_m_is_read_and_grows() {
     assert_eq!(code, 0, "{err}");
     let summary: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
     assert_eq!(summary["clips_reused"], mine.len(), "{out}\n{err}");
-    let t = stancelib::library::table::read_parquet(&clips).unwrap();
+    let t = stancelib::library::codec::table::read_parquet(&clips).unwrap();
     let reach = t.column("reach_m").unwrap().f64().unwrap().clone();
     let nulls = reach.null_count();
     assert_eq!(nulls, mine.len(), "the kept clips have no reach: {reach:?}");

@@ -12,7 +12,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::util::{fixture_clips, fixture_library, root, s};
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 use stancelib::pipeline::engine::inputs::{
     SideInput, MAX_BVH_BYTES, MAX_JSON_BYTES, MAX_PLATES_BYTES, MAX_POINTS_BYTES, MAX_TOML_BYTES,
 };

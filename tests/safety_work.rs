@@ -3,7 +3,7 @@
 //! named, nothing written): `equilibrium` contacts × COM states, `edit run` output frames
 //! × joints, a pipeline's `inputs` globs (repeats expanded once).
 
-use crate::safety_limits::{ring, write_points};
+use crate::safety_caps::{ring, write_points};
 use crate::util::{fixture_clips, fixture_library, ok, refused, root, s};
 
 use stancelib::edit::MAX_EDIT_FRAME_JOINTS;

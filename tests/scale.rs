@@ -216,7 +216,7 @@ fn a_streamed_frames_run_equals_one_batch_of_every_clip() {
     };
     let whole = d.path().join("whole");
     let all = ingest_all(&files, &opts);
-    stancelib::library::write::write_all(&whole, &all, true).unwrap();
+    stancelib::library::codec::write::write_all(&whole, &all, true).unwrap();
     let outcomes: Vec<_> = all.into_iter().map(|r| r.written()).collect();
     let tables = files_of(&whole);
     assert!(tables.len() >= 4, "{tables:?}");
@@ -246,7 +246,8 @@ fn row_groups_hold_64_ki_rows_whatever_the_batches() {
             .unwrap()
     };
     let mut w =
-        stancelib::library::stream::TableWriter::create(d.path(), "t.parquet", &df(0, 0)).unwrap();
+        stancelib::library::storage::stream::TableWriter::create(d.path(), "t.parquet", &df(0, 0))
+            .unwrap();
     for (a, b) in [
         (0, 1000),
         (1000, 70_000),
@@ -257,7 +258,7 @@ fn row_groups_hold_64_ki_rows_whatever_the_batches() {
     }
     w.finish(&[]).unwrap();
     let mut whole = df(0, 150_000);
-    stancelib::library::write::write_atomic(d.path(), "u.parquet", &mut whole, &[]).unwrap();
+    stancelib::library::codec::write::write_atomic(d.path(), "u.parquet", &mut whole, &[]).unwrap();
     let (x, y) = (
         std::fs::read(d.path().join("t.parquet")).unwrap(),
         std::fs::read(d.path().join("u.parquet")).unwrap(),
@@ -277,7 +278,7 @@ fn row_groups_hold_64_ki_rows_whatever_the_batches() {
 /// Per row group of `path`: the one value of each column of `names` (an error, so a
 /// failure, where a group holds more than one).
 fn group_values(path: &Path, names: &[&str]) -> Vec<Vec<String>> {
-    let mut r = stancelib::library::group_reader::GroupFileReader::open(path).unwrap();
+    let mut r = stancelib::library::storage::group_reader::GroupFileReader::open(path).unwrap();
     let mut out = Vec::new();
     loop {
         let values: Vec<Option<Vec<u8>>> = names.iter().map(|n| r.peek_value(n).unwrap()).collect();
@@ -316,7 +317,7 @@ fn per_clip_tables_hold_a_row_group_per_clip() {
     let d = tmp();
     let out = d.path().join("lib");
     streamed(&fixture_inputs(), &out, 2, 2);
-    let clips = stancelib::library::table::read_parquet(&out.join("clips.parquet")).unwrap();
+    let clips = stancelib::library::codec::table::read_parquet(&out.join("clips.parquet")).unwrap();
     let with_frames: Vec<String> = clips_with_frames(&clips)
         .into_iter()
         .map(|(_, c)| c)
@@ -397,13 +398,13 @@ fn two_fixture_shards() -> (tempfile::TempDir, PathBuf, PathBuf) {
 fn merge_refuses_frames_of_a_clip_the_shard_does_not_list() {
     let (d, a, b) = two_fixture_shards();
     let clips_path = b.join("clips.parquet");
-    let mut clips = stancelib::library::table::read_parquet(&clips_path).unwrap();
+    let mut clips = stancelib::library::codec::table::read_parquet(&clips_path).unwrap();
     let (last, name) = clips_with_frames(&clips)
         .pop()
         .expect("a clip with frames in shard 2");
     // The clips from it on are cut, so that no listed clip of this shard comes after it.
     clips = clips.slice(0, last);
-    stancelib::library::write::write_atomic(&b, "clips.parquet", &mut clips, &[]).unwrap();
+    stancelib::library::codec::write::write_atomic(&b, "clips.parquet", &mut clips, &[]).unwrap();
     // Its hashes recorded again: the check behind them is the one tested here.
     crate::util::reseal(&b);
     let out = d.path().join("merged");
@@ -684,7 +685,7 @@ fn an_incremental_shard_rebuilds_only_its_missing_clips() {
 #[test]
 fn the_manifest_limits_are_those_of_every_stance() {
     let lib = super::util::fixture_library();
-    let library = stancelib::library::read::open_library(lib).unwrap();
+    let library = stancelib::library::readers::read::open_library(lib).unwrap();
     let every = stancelib::query::limits::absolute_limits(&library);
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(lib.join("manifest.json")).unwrap()).unwrap();

@@ -61,7 +61,7 @@ fn shard_samples_over_several_row_groups_merge_to_the_single_build() {
     let merged = shard_and_merge(&inputs, &d.path().join("n1"), 1, &[]);
     let samples = rows(&d.path().join("n1/shard-1/kinematics_samples.parquet"));
     assert!(
-        samples > stancelib::library::stream::ROW_GROUP_ROWS,
+        samples > stancelib::library::storage::stream::ROW_GROUP_ROWS,
         "the shard's samples fill more than one row group ({samples} rows)"
     );
     assert_same_library(&single, &merged);

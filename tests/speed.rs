@@ -76,7 +76,7 @@ fn simd_fk_equals_the_scalar_fallback_and_the_libm_fk_on_real_clips() {
                 one[..] == batched[0][f * np..(f + 1) * np],
                 "{name} frame {f}: one frame differs from its batch"
             );
-            fk::forward_reference(&skel, &mut rot, row, &mut libm);
+            fk::forward_libm(&skel, &mut rot, row, &mut libm);
             for (p, q) in one.iter().zip(&libm) {
                 for k in 0..3 {
                     worst_m = worst_m.max((p[k] - q[k]).abs() * scale);

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use stancelib::ingest::{ClipFrames, ClipSummary, IngestOptions};
 use stancelib::stances::segment::Boundary;
-use stancelib::stances::{build_clip, Stance, StanceOptions};
+use stancelib::stances::{assemble_clip, Stance, StanceOptions};
 
 use crate::util;
 
@@ -29,7 +29,7 @@ fn stances_and_summary(rel: &str) -> Option<(Vec<Stance>, ClipSummary, ClipFrame
         .unwrap()
         .to_string_lossy()
         .into_owned();
-    let st = build_clip(
+    let st = assemble_clip(
         &clip,
         &frames,
         &summary,

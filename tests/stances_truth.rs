@@ -19,7 +19,7 @@ use stancelib::contacts::runs;
 use stancelib::ingest::DEFAULT_MASS_KG;
 use stancelib::math::savgol::{window_for_rate, SavGol, DEFAULT_ORDER};
 use stancelib::stances::segment::Boundary;
-use stancelib::stances::{build_clip, Stance, StanceOptions};
+use stancelib::stances::{assemble_clip, Stance, StanceOptions};
 
 use crate::util::{self, outln};
 use stancelib::synth::{generate, SynthClip, SynthMotion};
@@ -46,7 +46,7 @@ pub(super) fn load(c: &util::FixtureCase) -> Loaded {
     );
     let (summary, frames, contacts) = util::ingest_fixture(c);
     assert_eq!(frames.frame.len(), truth.com.len(), "{}", c.file);
-    let (stances, _) = build_clip(
+    let (stances, _) = assemble_clip(
         c.file,
         &frames,
         &summary,
@@ -496,7 +496,7 @@ fn run_stance_durations_are_within_a_frame_of_the_truth() {
     for (name, truth, bvh) in &cases {
         let (summary, frames, contacts) = util::ingest_body(bvh, &IngestOptions::default(), name);
         let dt = summary.frame_time_s;
-        let (stances, _) = build_clip(
+        let (stances, _) = assemble_clip(
             name,
             &frames,
             &summary,

@@ -86,8 +86,8 @@
 //! - `safety_inputs`: reader and numeric items: SG window bound, no silent NaN, 100k-joint
 //!   and 100k-deep files, and the mutation fuzzer (bounded; `make fuzz` runs it for a time budget).
 //! - `safety_messages`: escaped short error messages, the line bound, CR-only and empty files.
-//! - `safety_limits`: item 6: every documented work limit refused before work (exit 2,
-//!   field and limit named).
+//! - `safety_caps`: item 6: every documented work cap refused before work (exit 2,
+//!   field and cap named).
 //! - `safety_numbers`: issue 40 item 5: implausible segments, non-finite stance rows and
 //!   out-of-bound 2PAC inputs are errors, never inf or NaN written with status ok.
 //! - `safety_options`: items 10–12: pipelines validated before the library is touched, no
@@ -165,8 +165,8 @@ mod masses;
 mod pictures;
 mod verdicts;
 // Safety
+mod safety_caps;
 mod safety_inputs;
-mod safety_limits;
 mod safety_messages;
 mod safety_names;
 mod safety_numbers;

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
 
 use crate::util::{fails, ok};
 

@@ -540,7 +540,11 @@ pub fn parquet_kv(path: &Path) -> std::collections::BTreeMap<String, String> {
 }
 
 /// The string column `name` of `t` at `row` (`None` where null).
-pub fn string_at(t: &stancelib::library::table::Table, name: &str, row: usize) -> Option<String> {
+pub fn string_at(
+    t: &stancelib::library::codec::table::Table,
+    name: &str,
+    row: usize,
+) -> Option<String> {
     t.df.column(name)
         .unwrap_or_else(|_| panic!("no column {name}"))
         .str()
@@ -550,7 +554,7 @@ pub fn string_at(t: &stancelib::library::table::Table, name: &str, row: usize) -
 }
 
 /// The first stance id of each row of a `query run` table: the row's cycle.
-pub fn first_stance_ids(t: &stancelib::library::table::Table) -> Vec<String> {
+pub fn first_stance_ids(t: &stancelib::library::codec::table::Table) -> Vec<String> {
     let lists = t.df.column("stance_ids").unwrap().list().unwrap().clone();
     (0..t.height())
         .map(|i| {
@@ -561,13 +565,13 @@ pub fn first_stance_ids(t: &stancelib::library::table::Table) -> Vec<String> {
 }
 
 /// Record the present bytes of every table of the library `lib` in its manifest (the
-/// content hashes of `library::integrity`), as if the library had been written so: for
+/// content hashes of `library::storage::integrity`), as if the library had been written so: for
 /// tests of the checks behind the hashes, on tables changed on purpose.
 pub fn reseal(lib: &Path) {
     let p = lib.join("manifest.json");
     let mut m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
-    let digests = stancelib::library::integrity::library_digests(lib).unwrap();
-    m[stancelib::library::integrity::TABLES_KEY] = serde_json::to_value(digests).unwrap();
+    let digests = stancelib::library::storage::integrity::library_digests(lib).unwrap();
+    m[stancelib::library::storage::integrity::TABLES_KEY] = serde_json::to_value(digests).unwrap();
     std::fs::write(&p, serde_json::to_string_pretty(&m).unwrap()).unwrap();
 }

@@ -3,8 +3,8 @@
 //! each pair for its own recorded jump times a factor, and an unknown stance id gets the
 //! nearest ids.
 
-use stancelib::library::read::read_stances;
-use stancelib::library::table::Table;
+use stancelib::library::codec::table::Table;
+use stancelib::library::readers::read::read_stances;
 use stancelib::query::jump::recorded_jump;
 
 use crate::util::{first_stance_ids, fixture_library, ok, refused, s};

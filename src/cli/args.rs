@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::library::layout::Layout;
+use crate::library::storage::layout::Layout;
 use crate::pipeline::commands::queries::{speed_range, LimitOptions};
 use crate::pipeline::engine::shard::Shard;
 use crate::pipeline::spec::Overrides;

@@ -48,7 +48,7 @@ static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex
 /// terminal as a control sequence.
 pub fn print_line(args: std::fmt::Arguments<'_>) {
     use std::io::Write;
-    if STDOUT_DONE.load(Ordering::Relaxed) || !crate::library::generation::before_print() {
+    if STDOUT_DONE.load(Ordering::Relaxed) || !crate::library::storage::generation::before_print() {
         return;
     }
     let line = crate::error::escape_but(&args.to_string(), &['\n', '\t']);
@@ -108,7 +108,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
 /// Run one command. The commands that read a library read one generation of it
 /// ([`read_consistently`]).
 fn dispatch(command: Command) -> anyhow::Result<Outcome> {
-    use crate::library::generation::read_consistently;
+    use crate::library::storage::generation::read_consistently;
     fn on<A: Clone>(
         lib: &std::path::Path,
         a: A,

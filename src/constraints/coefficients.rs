@@ -33,7 +33,7 @@
 //!
 //! Pollard & Behmaram-Mosavat 2000, eq 9–12; spec stance-model §7.1 (active set).
 
-use super::tables::SampledTables;
+use super::grids::SampledGrids;
 use super::{ACTIVE_FRACTION, ROBUST_ACTIVE_FRACTION};
 use crate::force_model::UNILATERAL_FRACTION;
 
@@ -68,11 +68,11 @@ fn max_nan(a: f64, b: f64) -> f64 {
     }
 }
 
-/// Eq 9 and eq 11 coefficients, `F_peak`, `μ_req` and the unilateral test from the tables.
+/// Eq 9 and eq 11 coefficients, `F_peak`, `μ_req` and the unilateral test from the grids.
 ///
 /// An empty grid gives zeros, `unilateral_ok = true` and `μ_req = A^μ = +∞`.
-pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
-    let [fh, fp, fv] = &tables.f;
+pub fn force_coefficients(grids: &SampledGrids) -> ForceCoefficients {
+    let [fh, fp, fv] = &grids.f;
     let mut a_f = [0.0f64; 3];
     let mut f_peak = 0.0f64;
     let mut min_f_v = f64::INFINITY;
@@ -93,8 +93,8 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
     let unilateral_floor = -UNILATERAL_FRACTION * max_f_v;
     let unilateral_ok = fv.iter().all(|&v| v >= unilateral_floor);
 
-    let (a_mu, mu_req) = friction_demand(tables, max_f_v, ACTIVE_FRACTION);
-    let (_, mu_req_robust) = friction_demand(tables, max_f_v, ROBUST_ACTIVE_FRACTION);
+    let (a_mu, mu_req) = friction_demand(grids, max_f_v, ACTIVE_FRACTION);
+    let (_, mu_req_robust) = friction_demand(grids, max_f_v, ROBUST_ACTIVE_FRACTION);
 
     ForceCoefficients {
         a_f,
@@ -112,11 +112,11 @@ pub fn force_coefficients(tables: &SampledTables) -> ForceCoefficients {
 /// `A^μ_a = max (f_a/f_v)²` (h, p) and `μ_req = max √(f_h² + f_p²)/f_v`; `+∞` for both when
 /// `max f_v ≤ 0`. `λ` is the active fraction ([`super::ACTIVE_FRACTION`] for the stored
 /// columns; the queries' `--active-set`).
-pub fn friction_demand(tables: &SampledTables, max_f_v: f64, lambda: f64) -> ([f64; 2], f64) {
+pub fn friction_demand(grids: &SampledGrids, max_f_v: f64, lambda: f64) -> ([f64; 2], f64) {
     if max_f_v.is_nan() || max_f_v <= 0.0 {
         return ([f64::INFINITY; 2], f64::INFINITY);
     }
-    let [fh, fp, fv] = &tables.f;
+    let [fh, fp, fv] = &grids.f;
     let threshold = lambda * max_f_v;
     let (mut rh, mut rp, mut rt) = (0.0f64, 0.0f64, 0.0f64);
     for ((&h, &p), &v) in fh.iter().zip(fp).zip(fv) {

@@ -40,7 +40,7 @@
 //!
 //! Pollard & Behmaram-Mosavat 2000, eq 8 and Appendix B (eq 23–32).
 
-use super::tables::SampledTables;
+use super::grids::SampledGrids;
 use super::{PrecomputeOptions, StanceContext};
 use crate::force_model::{ForceModel, GRAVITY};
 
@@ -73,23 +73,23 @@ pub fn com_offset(model: &ForceModel, ctx: &StanceContext, beta: [f64; 3], tau: 
     r
 }
 
-/// `min_k |r(τ_k) − x_cp|` and `max_k |r(τ_k) − x_cp|` with β = 1 from the tables, m.
+/// `min_k |r(τ_k) − x_cp|` and `max_k |r(τ_k) − x_cp|` with β = 1 from the grids, m.
 ///
 /// An empty grid gives `(0, 0)`.
 pub fn extension_extremes(
     model: &ForceModel,
     ctx: &StanceContext,
-    tables: &SampledTables,
+    grids: &SampledGrids,
 ) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    let [sh, sp, sv] = &tables.s;
-    for (&t, ((&h, &p), &v)) in tables.tau.iter().zip(sh.iter().zip(sp).zip(sv)) {
+    let [sh, sp, sv] = &grids.s;
+    for (&t, ((&h, &p), &v)) in grids.tau.iter().zip(sh.iter().zip(sp).zip(sv)) {
         let u = unscaled_offset(model, ctx, t);
         let d2 = (u[0] + h).powi(2) + (u[1] + p).powi(2) + (u[2] + v).powi(2);
         lo = lo.min(d2);
         hi = hi.max(d2);
     }
-    if tables.is_empty() {
+    if grids.is_empty() {
         return (0.0, 0.0);
     }
     (lo.sqrt(), hi.sqrt())
@@ -115,7 +115,7 @@ pub struct EllipsoidBoxes {
 pub fn ellipsoid_boxes(
     model: &ForceModel,
     ctx: &StanceContext,
-    tables: &SampledTables,
+    grids: &SampledGrids,
     chi: [f64; 2],
     opts: &PrecomputeOptions,
 ) -> EllipsoidBoxes {
@@ -125,13 +125,13 @@ pub fn ellipsoid_boxes(
     let mut s_min = [f64::INFINITY; 3];
     let mut s_max = [f64::NEG_INFINITY; 3];
     let mut floor = [0.0f64; 3];
-    for (fl, s) in floor.iter_mut().zip(&tables.s) {
+    for (fl, s) in floor.iter_mut().zip(&grids.s) {
         *fl = opts.s_floor_rel * s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     }
-    for (k, &t) in tables.tau.iter().enumerate() {
+    for (k, &t) in grids.tau.iter().enumerate() {
         let u = unscaled_offset(model, ctx, t);
         for axis in 0..3 {
-            let Some(&s) = tables.s[axis].get(k) else {
+            let Some(&s) = grids.s[axis].get(k) else {
                 continue;
             };
             let mag = s.abs();

@@ -43,7 +43,7 @@
 //!
 //! Spec stance-model §8.2 (affine form), §8.3 ("Computing H_0").
 
-use super::tables::dc_term;
+use super::grids::dc_term;
 use super::StanceContext;
 use crate::force_model::{basis, ForceModel, GRAVITY};
 pub(crate) use crate::math::v3::cross;
@@ -83,7 +83,7 @@ impl AxisForm {
             _ => (-GRAVITY * ctx.t_td * dt, -0.5 * GRAVITY * dt * dt),
         };
         let d = dc_term(model, axis);
-        let terms: Vec<Term> = super::tables::harmonic_terms(model, axis)
+        let terms: Vec<Term> = super::grids::harmonic_terms(model, axis)
             .map(|(j, amp, phi)| {
                 let (sin_phi, cos_phi) = phi.sin_cos();
                 let m = basis::harmonic_power_moments(j, phi, 2);

@@ -24,7 +24,7 @@
 //! χ_max = 1.05 · ext_max,   χ_min = ext_min / 1.05,   boxes clipped to [0, β_max]³
 //! ```
 //!
-//! Submodules: [`tables`] (sampled `f_a`, `S_a`), [`coefficients`] (eq 9, 11, extremes),
+//! Submodules: [`grids`] (sampled `f_a`, `S_a`), [`coefficients`] (eq 9, 11, extremes),
 //! [`extension`] (`r(τ)`, eq 8, Appendix B), [`impulse`] (`H`, `H_0` in closed form).
 //!
 //! # Frames and units
@@ -68,8 +68,8 @@
 
 pub mod coefficients;
 pub mod extension;
+pub mod grids;
 pub mod impulse;
-pub mod tables;
 
 #[cfg(test)]
 mod tests;
@@ -78,8 +78,8 @@ pub use coefficients::{
     force_coefficients, force_filter_accepts, friction_filter_accepts, ForceCoefficients,
 };
 pub use extension::{com_offset, ellipsoid_boxes, extension_extremes, EllipsoidBoxes};
+pub use grids::SampledGrids;
 pub use impulse::{angular_impulse, contact_point_matrix, h0_closed_form, linear_impulse};
-pub use tables::SampledTables;
 
 use crate::force_model::ForceModel;
 
@@ -171,27 +171,27 @@ pub struct Coefficients {
     pub ell_s_max: [f64; 3],
 }
 
-/// Coefficients of one stance with the default options (allocates its own tables).
+/// Coefficients of one stance with the default options (allocates its own grids).
 pub fn precompute(model: &ForceModel, ctx: &StanceContext) -> Coefficients {
-    let mut tables = SampledTables::default();
-    precompute_with(model, ctx, &PrecomputeOptions::default(), &mut tables)
+    let mut grids = SampledGrids::default();
+    precompute_with(model, ctx, &PrecomputeOptions::default(), &mut grids)
 }
 
-/// Coefficients of one stance; `tables` is scratch, refilled with `f_a(τ_k)`, `S_a(τ_k)`.
+/// Coefficients of one stance; `grids` is scratch, refilled with `f_a(τ_k)`, `S_a(τ_k)`.
 ///
-/// Reuse one `tables` per thread across stances to avoid per-stance allocation of the grid
-/// tables. Never panics; non-finite inputs give non-finite outputs.
+/// Reuse one `grids` per thread across stances to avoid per-stance allocation of the
+/// grids. Never panics; non-finite inputs give non-finite outputs.
 pub fn precompute_with(
     model: &ForceModel,
     ctx: &StanceContext,
     opts: &PrecomputeOptions,
-    tables: &mut SampledTables,
+    grids: &mut SampledGrids,
 ) -> Coefficients {
-    tables.rebuild(model);
-    let force = force_coefficients(tables);
-    let (ext_min, ext_max) = extension_extremes(model, ctx, tables);
+    grids.rebuild(model);
+    let force = force_coefficients(grids);
+    let (ext_min, ext_max) = extension_extremes(model, ctx, grids);
     let chi = [ext_min / RELATIVE_MARGIN, RELATIVE_MARGIN * ext_max];
-    let boxes = ellipsoid_boxes(model, ctx, tables, chi, opts);
+    let boxes = ellipsoid_boxes(model, ctx, grids, chi, opts);
     let (ang_impulse, ang_impulse_h0) = angular_impulse(model, ctx);
     Coefficients {
         a_f: force.a_f,

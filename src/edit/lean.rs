@@ -16,17 +16,16 @@
 //!
 //! Why: (A1) alone makes `β_h = Δv_h / J_h`, and a running stance's net fore-aft impulse
 //! `J_h` is the small difference of a large braking and a large push-off impulse. A run
-//! cycle made periodic asks for a slightly different speed change than the recording (the
-//! CMU run `cmu_09_01_run_mb` decelerates 0.094 m/s per recorded cycle): its first stance
-//! had `J_h = 0.014 m/s` and was asked for 0.061 m/s, so `β_h = 4.5` quadrupled its braking
-//! and push-off, the planned COM dipped 1.2 m/s instead of the recorded 0.27 m/s and fell
-//! 10 cm behind the recording by liftoff (measured 2026-12-03). Now the first stance is the
-//! policy's own request and the second, which carries the cycle's 0.094 m/s, leans by
-//! `ε_h ≈ 0.027`. The first stance's request differs from the policy's only in `vps = 0`
-//! (the plan chains every stance with its heading along the incoming apex velocity,
-//! `edit::path`); a running stance's recorded `vps` is 0 by the same convention (a flight
-//! before it sets its heading), so its `ε = 0` too. A stance without a flight before it
-//! (recorded `vps ≠ 0`, e.g. the clip's first) would lean sideways by `ε_p = vps / J_v`.
+//! cycle made periodic asks for a slightly different speed change than the recording, and
+//! a stance with a small `J_h` asked for it gets a large `β_h`, which multiplies its braking
+//! and push-off (the measured case is in `docs/decisions.md`, "Measurements moved from
+//! module docs"). With the offset the first stance is the policy's own request and the one
+//! that carries the cycle's speed change leans by a small `ε_h`. The first stance's request
+//! differs from the policy's only in `vps = 0` (the plan chains every stance with its
+//! heading along the incoming apex velocity, `edit::path`); a running stance's recorded
+//! `vps` is 0 by the same convention (a flight before it sets its heading), so its `ε = 0`
+//! too. A stance without a flight before it (recorded `vps ≠ 0`, e.g. the clip's first)
+//! would lean sideways by `ε_p = vps / J_v`.
 //!
 //! # Frames and units
 //! Stance frame `h, p, v`; `Δv`, `J` in m/s; forces in N.
@@ -55,7 +54,7 @@ pub fn ratio_offsets(j: [f64; 3], req: &Request, beta_ref: [f64; 2]) -> [f64; 2]
 }
 
 /// The stance `p` with `f_h, f_p` leaned by [`ratio_offsets`] so that the closed form
-/// meets `req` at `β_h = β_ref[0]`, `β_p = β_ref[1]`; its tables and force coefficients
+/// meets `req` at `β_h = β_ref[0]`, `β_p = β_ref[1]`; its grids and force coefficients
 /// rebuilt (friction on the active fraction `active`). The recorded angular impulse and
 /// extension are kept: they are the targets and limits of the recorded stance.
 pub fn leaned(p: &Prepared, req: &Request, beta_ref: [f64; 2], active: f64) -> Prepared {
@@ -71,7 +70,7 @@ pub fn leaned(p: &Prepared, req: &Request, beta_ref: [f64; 2], active: f64) -> P
         }
     }
     let mut out = Prepared::with_active_fraction(stance, active);
-    let f = force_coefficients(&out.tables);
+    let f = force_coefficients(&out.grids);
     let c = &mut out.stance.coef;
     (c.a_f, c.min_f_v, c.unilateral_ok) = (f.a_f, f.min_f_v, f.unilateral_ok);
     (c.f_peak, c.mu_req_robust) = (f.f_peak, f.mu_req_robust);
@@ -117,7 +116,7 @@ mod tests {
                     vps: q.vps,
                     x: k * q.x,
                 };
-                let l = leaned(&p, &req, [k, 1.0], p.tables.active_fraction);
+                let l = leaned(&p, &req, [k, 1.0], p.grids.active_fraction);
                 let Ok(s) = solve(&l.shape, &req, &Refs::run(k), Some(q.t_e)) else {
                     continue;
                 };

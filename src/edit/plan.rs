@@ -42,7 +42,7 @@ use crate::query::tables::{tightest_detail, violation_detail, violation_name};
 
 use crate::math::v3::V3;
 
-pub use crate::library::stances::StanceTiming;
+pub use crate::library::codec::stances::StanceTiming;
 
 /// One solved stance of an edit.
 #[derive(Debug, Clone)]
@@ -51,7 +51,7 @@ pub struct EditStance {
     pub source: PoolStance,
     /// Its timing in the clip.
     pub timing: StanceTiming,
-    /// The character-scaled stance and tables.
+    /// The character-scaled stance and its sampled grids.
     pub prepared: Prepared,
     /// The request solved.
     pub request: Request,

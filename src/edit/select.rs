@@ -31,7 +31,7 @@ use super::plan::{
     StanceTiming,
 };
 use crate::error::{Error, Result};
-use crate::library::read::StanceLibrary;
+use crate::library::readers::read::StanceLibrary;
 use crate::query::feasibility::{LimitForm, Limits};
 use crate::query::gait::{GaitLaw, LawChoice, LawSource};
 use crate::query::jump::{is_landing, is_liftoff, jump, recorded_jump, Jump};

@@ -39,7 +39,7 @@
 //! The position is exact only where the edge states are trustworthy: beside a flight whose
 //! own free curvature `a_z` is more than 3 m/s² from −g it stays the soft row above with
 //! [`POSITION_TOLERANCE_M`] (1 mm; [`EdgeTargets::position_tolerance_m`], chosen by the
-//! stance builder, `stances::build::EXACT_POSITION_MAX_CURVATURE_MISS_MPS2`):
+//! stance builder, `stances::assemble::EXACT_POSITION_MAX_CURVATURE_MISS_MPS2`):
 //! ```text
 //! exact  ⇔  every flight giving an edge state is untested or |a_z + g| ≤ 3 m/s²
 //! soft:  min_{b ≥ 0} ‖B b − s_v‖² + w² (e_2·b − T_2)²   s.t.  Σ_i b_i/(d+1) = I_v,

@@ -54,7 +54,7 @@ impl BodyModel {
     /// chooses them.
     ///
     /// # Errors
-    /// More point samples than [`super::MAX_POINT_SAMPLES`] (`ErrorKind::Limit`); the
+    /// More point samples than [`super::MAX_POINT_SAMPLES`] (`ErrorKind::Cap`); the
     /// skeleton maps onto no body (`ErrorKind::Skeleton`).
     pub fn new(
         bvh: &Bvh,

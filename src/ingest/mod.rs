@@ -218,11 +218,11 @@ pub enum ClipOutcome {
 /// point samples (`n_points` × `n_frames`).
 ///
 /// # Errors
-/// [`crate::ErrorKind::Limit`] naming both counts and the limit.
+/// [`crate::ErrorKind::Cap`] naming both counts and the cap.
 pub fn check_point_samples(n_points: usize, n_frames: usize) -> Result<()> {
     let samples = n_points as f64 * n_frames as f64;
     if samples > MAX_POINT_SAMPLES as f64 {
-        return Err(crate::error::Error::limit(
+        return Err(crate::error::Error::cap(
             format!("{n_points} points (joints and End Sites) × {n_frames} frames"),
             "point samples (24 bytes each)",
             samples,
@@ -236,7 +236,7 @@ pub fn check_point_samples(n_points: usize, n_frames: usize) -> Result<()> {
 /// Ingest one parsed clip.
 ///
 /// # Errors
-/// More point samples than [`MAX_POINT_SAMPLES`] (`ErrorKind::Limit`, checked before the
+/// More point samples than [`MAX_POINT_SAMPLES`] (`ErrorKind::Cap`, checked before the
 /// skeleton is used); a segment far longer than the skeleton's others
 /// (`ErrorKind::Skeleton`, [`crate::skeleton::plausibility`]: before forward kinematics);
 /// a partial landmark mapping (spec com-from-bvh §1.1), a `[landmarks]` override that

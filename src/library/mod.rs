@@ -1,34 +1,22 @@
 //! The columnar outputs: one record per input clip, turned into `frames.parquet`,
 //! `clips.parquet`, `contacts.parquet` and (optionally) `joints.parquet`, written
-//! atomically (temporary name, then rename).
+//! atomically (temporary name, then rename); `stances.parquet` and the kinematics tables
+//! beside them.
+//!
+//! Three rooms:
+//! - [`codec`]: the table codecs: column names and keys (`schema`, the flat registry), each
+//!   table to and from Parquet, `manifest.json` and provenance.
+//! - [`storage`]: the Parquet engine, whatever the table: streamed row groups, scratch and
+//!   spill files, atomic replacement, layouts, one generation per read, integrity.
+//! - [`readers`]: what each command reads from a library (`info`, the queries' stance pool,
+//!   the plots' clip view, the force exports).
 //!
 //! # References
 //! spec com-from-bvh §8 (column tables); STYLE.md §5.6 (deterministic files).
 
-pub mod atomic;
-pub mod clip_view;
-pub(crate) mod columns;
-pub(crate) mod footer;
-pub mod forces;
-pub mod generation;
-pub mod group_reader;
-pub mod info;
-pub mod integrity;
-pub mod kinematics;
-pub mod layout;
-pub mod manifest;
-pub mod per_contact;
-pub mod provenance;
-#[doc(hidden)]
-pub mod read;
-pub mod row_groups;
-pub mod schema;
-pub mod scratch;
-pub mod spill;
-pub mod stances;
-pub mod stream;
-pub mod table;
-pub mod write;
+pub mod codec;
+pub mod readers;
+pub mod storage;
 
 use crate::ingest::{ClipFrames, ClipSummary, ContactRun};
 

@@ -20,7 +20,7 @@ use super::spec::{
     Overrides,
 };
 use crate::force_model::ForceModelKind;
-use crate::library::layout::Layout;
+use crate::library::storage::layout::Layout;
 use crate::pipeline::spec::{ConstraintsTable, QueriesTable};
 use crate::query::feasibility::LimitForm;
 use crate::query::map::{Axis, DEFAULT_HEIGHTS, DEFAULT_SPEEDS};

@@ -16,7 +16,7 @@ use crate::contacts::ContactOptions;
 use crate::error::{echo, Error, Result};
 use crate::force_model::fit::{MAX_SAMPLES, MIN_SAMPLES};
 use crate::ingest::{IngestOptions, DEFAULT_MASS_KG};
-use crate::library::layout::Layout;
+use crate::library::storage::layout::Layout;
 use crate::pipeline::engine::batch::check_threads;
 use crate::pipeline::engine::inputs::{read_side_text, SideInput};
 use crate::query::feasibility::check_mu;
@@ -582,7 +582,7 @@ pub const MAX_INPUT_PATTERNS: usize = 1_000;
 /// The limit error when the pipeline lists more than [`MAX_INPUT_PATTERNS`] globs.
 fn too_many_inputs(p: &PipelineFile) -> Option<Error> {
     (p.inputs.len() > MAX_INPUT_PATTERNS).then(|| {
-        Error::limit(
+        Error::cap(
             "inputs",
             "globs",
             p.inputs.len() as f64,

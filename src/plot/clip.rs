@@ -22,7 +22,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{err, register_font, titled, value_mesh, PlotError, Verdict};
 use crate::force_model::GRAVITY as G;
-use crate::library::clip_view::{ClipView, EFFECTORS};
+use crate::library::readers::clip_view::{ClipView, EFFECTORS};
 
 /// Pixel size of the clip plot.
 pub const CLIP_PLOT_PX: (u32, u32) = (1300, 1000);
@@ -201,7 +201,11 @@ fn height_panel(
         y0..y1,
     )?;
     value_mesh(&mut a, path, "clip time (s)", "COM height z (m)")?;
-    let flights: Vec<(Vec<f64>, Vec<f64>, &crate::library::clip_view::FlightView)> = view
+    let flights: Vec<(
+        Vec<f64>,
+        Vec<f64>,
+        &crate::library::readers::clip_view::FlightView,
+    )> = view
         .flights
         .iter()
         .map(|f| {

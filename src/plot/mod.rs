@@ -44,7 +44,7 @@ pub struct PlotError {
 
 /// Draws a PNG with `draw` under a temporary name beside `path`, then renames it into
 /// place, so a failed draw leaves no file and an earlier one survives
-/// ([`crate::library::atomic::write_file_atomic`]).
+/// ([`crate::library::storage::atomic::write_file_atomic`]).
 ///
 /// # Errors
 /// The drawing fails or the rename does.
@@ -52,7 +52,9 @@ pub fn write_png(
     path: &Path,
     draw: impl FnOnce(&Path) -> Result<(), PlotError>,
 ) -> anyhow::Result<()> {
-    crate::library::atomic::write_file_atomic(path, |tmp| draw(tmp).map_err(anyhow::Error::from))
+    crate::library::storage::atomic::write_file_atomic(path, |tmp| {
+        draw(tmp).map_err(anyhow::Error::from)
+    })
 }
 
 /// A picture's answer to its question, drawn as the line under its title: dark green when

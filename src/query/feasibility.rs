@@ -55,7 +55,7 @@
 //! # Examples
 //!
 //! ```
-//! use stancelib::constraints::{precompute, SampledTables, StanceContext};
+//! use stancelib::constraints::{precompute, SampledGrids, StanceContext};
 //! use stancelib::force_model::{AxisModel, ForceModel, GRAVITY};
 //! use stancelib::query::feasibility::{approx, exact, relative_limits};
 //!
@@ -69,15 +69,15 @@
 //! let coef = precompute(&model, &ctx);
 //! let lim = relative_limits(&coef);
 //! // The identity query is feasible under the stance's own relative limits.
-//! let verdict = exact(&SampledTables::new(&model), &model, &ctx, [1.0; 3], &lim);
+//! let verdict = exact(&SampledGrids::new(&model), &model, &ctx, [1.0; 3], &lim);
 //! assert!(verdict.feasible && approx(coef.a_f, coef.a_mu, [1.0; 3], &lim));
 //! ```
 
+use crate::constraints::grids::{dc_term, harmonic_terms};
 use crate::constraints::impulse::moment_integral;
-use crate::constraints::tables::{dc_term, harmonic_terms};
 use crate::constraints::{
     contact_point_matrix, force_filter_accepts, friction_filter_accepts, linear_impulse,
-    Coefficients, SampledTables, StanceContext, RELATIVE_MARGIN,
+    Coefficients, SampledGrids, StanceContext, RELATIVE_MARGIN,
 };
 use crate::force_model::{basis, ForceModel, GRAVITY};
 
@@ -138,7 +138,7 @@ pub struct Limits {
 impl Limits {
     /// The limits as the exact check applies them: `F_max`, `χ_max`, `μ` times
     /// `1 + LIMIT_REL_TOL`, `χ_min` times `1 − LIMIT_REL_TOL`, and `μ` also plus
-    /// [`MU_ABS_TOL`] (the margins the tables report are to these, so a margin ≥ 0 is
+    /// [`MU_ABS_TOL`] (the margins the output tables report are to these, so a margin ≥ 0 is
     /// exactly a limit met).
     pub fn effective(&self) -> Limits {
         let (up, down) = (1.0 + LIMIT_REL_TOL, 1.0 - LIMIT_REL_TOL);
@@ -311,13 +311,13 @@ struct Sample {
 
 impl Setup {
     fn new(
-        tables: &SampledTables,
+        grids: &SampledGrids,
         model: &ForceModel,
         ctx: &QueryContext,
         beta: [f64; 3],
         lim: &Limits,
     ) -> Self {
-        let (max_fv, unilateral_ok) = (tables.max_f_v, tables.unilateral_ok);
+        let (max_fv, unilateral_ok) = (grids.max_f_v, grids.unilateral_ok);
         let nan = max_fv.is_nan();
         let dt = model.dt_s;
         let lim = lim.effective();
@@ -328,7 +328,7 @@ impl Setup {
             chi_max: SqrtLe::new(lim.chi_max),
             mu: lim.mu,
             mu2_below: lim.mu * lim.mu * (1.0 - 8.0 * f64::EPSILON),
-            threshold: tables.active_fraction * max_fv,
+            threshold: grids.active_fraction * max_fv,
             loaded: !nan && max_fv > 0.0,
             unilateral_ok,
             lin: [ctx.vs * dt, ctx.vps * dt, -GRAVITY * ctx.t_td * dt],
@@ -338,9 +338,9 @@ impl Setup {
         }
     }
 
-    /// Sample `k` of the tables (`k < tables.len()`).
+    /// Sample `k` of the grids (`k < grids.len()`).
     #[inline(always)]
-    fn sample(&self, t: &SampledTables, k: usize) -> Sample {
+    fn sample(&self, t: &SampledGrids, k: usize) -> Sample {
         let [bh, bp, bv] = self.beta;
         let tau = t.tau[k];
         let (gh, gp, gv) = (bh * t.f[0][k], bp * t.f[1][k], bv * t.f[2][k]);
@@ -387,10 +387,10 @@ impl Setup {
     }
 }
 
-/// Exact sampled check (§7.4) on precomputed tables (no trig per query): eq 5–8 and the
+/// Exact sampled check (§7.4) on precomputed grids (no trig per query): eq 5–8 and the
 /// unilateral test.
 ///
-/// `tables` must be those of `model` ([`SampledTables::new`]); `ctx.cp` is the contact
+/// `grids` must be those of `model` ([`SampledGrids::new`]); `ctx.cp` is the contact
 /// point to test (the re-solved `u*` of [`contact_point`] for a query, CORRECTIONS Issue 4
 /// item 7). At β = 1 with the stance's own context it reproduces `constraints::precompute`'s
 /// `F_peak`, `μ_req`, `ext_min`, `ext_max`, and limits equal to them are met (every test is
@@ -398,20 +398,20 @@ impl Setup {
 /// [`exact_feasible`], so both always agree. Never panics: NaN inputs give an infeasible
 /// verdict; an empty grid gives zeros and `μ_req = +∞` (friction violated).
 pub fn exact(
-    tables: &SampledTables,
+    grids: &SampledGrids,
     model: &ForceModel,
     ctx: &QueryContext,
     beta: [f64; 3],
     lim: &Limits,
 ) -> Verdict {
-    let s = Setup::new(tables, model, ctx, beta, lim);
+    let s = Setup::new(grids, model, ctx, beta, lim);
     let (mut force_ok, mut friction_ok) = (true, s.loaded);
     let (mut ext_lo_ok, mut ext_hi_ok) = (true, true);
     let (mut f2_peak, mut mu_req) = (0.0f64, 0.0f64);
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     let mut nan = false;
-    for k in 0..tables.len() {
-        let x = s.sample(tables, k);
+    for k in 0..grids.len() {
+        let x = s.sample(grids, k);
         nan |= x.f2.is_nan() || x.d2.is_nan();
         force_ok &= s.force.holds(x.f2);
         f2_peak = f2_peak.max(x.f2);
@@ -426,7 +426,7 @@ pub fn exact(
         lo = lo.min(x.d2);
         hi = hi.max(x.d2);
     }
-    if tables.is_empty() {
+    if grids.is_empty() {
         (lo, hi) = (0.0, 0.0);
     }
     let out = |v: f64| if nan { f64::NAN } else { v };
@@ -452,7 +452,7 @@ pub fn exact(
 /// The verdict of [`exact`] alone, stopping at the first violating sample (the map's
 /// inner loop). Same per-sample predicates, so `exact_feasible(..) == exact(..).feasible`.
 pub fn exact_feasible(
-    tables: &SampledTables,
+    grids: &SampledGrids,
     model: &ForceModel,
     ctx: &QueryContext,
     beta: [f64; 3],
@@ -461,12 +461,12 @@ pub fn exact_feasible(
     if !beta.iter().all(|&b| b >= 0.0) {
         return false;
     }
-    let s = Setup::new(tables, model, ctx, beta, lim);
+    let s = Setup::new(grids, model, ctx, beta, lim);
     if !(s.unilateral_ok && s.loaded) {
         return false;
     }
-    (0..tables.len()).all(|k| {
-        let x = s.sample(tables, k);
+    (0..grids.len()).all(|k| {
+        let x = s.sample(grids, k);
         s.force.holds(x.f2)
             && (!x.active || s.friction_ok(&x))
             && s.chi_min.holds_above(x.d2)
@@ -480,7 +480,7 @@ pub fn exact_feasible(
 /// `x_cp = (u*, −z_TD)`. Returns the verdict and `u*` (m); when `u*` is undetermined
 /// (`I_v` ~ 0, see [`SINGULAR_REL`]) the check runs at `ctx.cp` and `u*` is `None`.
 pub fn exact_at_contact_point(
-    tables: &SampledTables,
+    grids: &SampledGrids,
     model: &ForceModel,
     moments: &ImpulseMoments,
     ctx: &QueryContext,
@@ -493,7 +493,7 @@ pub fn exact_at_contact_point(
         cp: u.unwrap_or(ctx.cp),
         ..*ctx
     };
-    (exact(tables, model, &at, beta, lim), u)
+    (exact(grids, model, &at, beta, lim), u)
 }
 
 /// `(∫₀¹ τ f_b dτ, ∫₀¹ τ² f_b dτ)` for whole- and half-cycle harmonics and the polynomial

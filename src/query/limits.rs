@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 
 use super::feasibility::{relative_limits, LimitForm, Limits};
 use super::pool::Prepared;
-use crate::library::read::{same_content, ClipInfo, StanceLibrary};
+use crate::library::readers::read::{same_content, ClipInfo, StanceLibrary};
 use crate::stances::limits::{limits, ClipFacts, StanceFacts, S_EFF_RANGE};
 use crate::stances::segment::Boundary;
 

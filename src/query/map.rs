@@ -56,7 +56,7 @@ impl Axis {
     ///
     /// # Errors
     /// [`ErrorKind::Invalid`](crate::error::ErrorKind::Invalid): not three finite numbers,
-    /// a step ≤ 0 or stop < start; [`ErrorKind::Limit`](crate::error::ErrorKind::Limit):
+    /// a step ≤ 0 or stop < start; [`ErrorKind::Cap`](crate::error::ErrorKind::Cap):
     /// more than [`MAX_AXIS_VALUES`] values.
     pub fn parse(field: &str, s: &str) -> Result<Axis> {
         let nums: Option<Vec<f64>> = s.split(':').map(|p| p.trim().parse().ok()).collect();
@@ -80,7 +80,7 @@ impl Axis {
         };
         let n = axis.count_f64();
         if n > MAX_AXIS_VALUES as f64 {
-            return Err(Error::limit(
+            return Err(Error::cap(
                 field,
                 "grid values",
                 n,
@@ -127,11 +127,11 @@ impl Axis {
 /// Checks a grid of `n_heights × n_speeds` cells against [`MAX_GRID_CELLS`].
 ///
 /// # Errors
-/// [`ErrorKind::Limit`](crate::error::ErrorKind::Limit) naming `field`.
+/// [`ErrorKind::Cap`](crate::error::ErrorKind::Cap) naming `field`.
 pub fn check_grid(field: &str, n_heights: usize, n_speeds: usize) -> Result<()> {
     let n = n_heights as f64 * n_speeds as f64;
     if n > MAX_GRID_CELLS as f64 {
-        return Err(Error::limit(
+        return Err(Error::cap(
             field,
             "grid cells (heights × speeds)",
             n,
@@ -335,7 +335,7 @@ fn pair_map(
 /// distinct height offset (level ground, the common case, shares one grid per stance).
 ///
 /// # Errors
-/// [`ErrorKind::Limit`](crate::error::ErrorKind::Limit) before any work when the grid
+/// [`ErrorKind::Cap`](crate::error::ErrorKind::Cap) before any work when the grid
 /// has more than [`MAX_GRID_CELLS`] cells or the map more than [`MAX_MAP_CELLS`]
 /// (cells × (pairs + stance grids)).
 pub fn jump_map(
@@ -373,7 +373,7 @@ pub fn jump_map(
     let cells = heights.len() as f64 * speeds.len() as f64;
     let n = cells * (pair_list.len() + liftoffs.len() + keys.len()) as f64;
     if n > MAX_MAP_CELLS as f64 {
-        return Err(Error::limit(
+        return Err(Error::cap(
             format!(
                 "jump map ({} pairs and {} stance grids of {} × {} cells)",
                 pair_list.len(),

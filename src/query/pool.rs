@@ -1,4 +1,4 @@
-//! The stances a query draws from: one library row with the per-stance tables every query
+//! The stances a query draws from: one library row with the per-stance grids every query
 //! reuses, and the new-character map of dynamic similarity (spec stance-model §9).
 //!
 //! # Model
@@ -15,13 +15,13 @@
 //! spec stance-model §9 (table), §7.2 (what is stored per stance), §11 (columns).
 
 use crate::constraints::coefficients::friction_demand;
-use crate::constraints::{Coefficients, SampledTables, StanceContext};
+use crate::constraints::{Coefficients, SampledGrids, StanceContext};
 use crate::stances::params::StanceParams;
 
 use super::feasibility::ImpulseMoments;
 use super::solve::StanceShape;
 
-pub use crate::library::stances::PoolStance;
+pub use crate::library::codec::stances::PoolStance;
 
 impl PoolStance {
     /// The stance's own context `(vs, vps, t_TD, z_TD, cp)` (§7.3).
@@ -110,7 +110,7 @@ impl PoolStance {
     }
 }
 
-/// A stance with the tables every query of it reuses (built once, O(N_s)).
+/// A stance with the grids every query of it reuses (built once, O(N_s)).
 #[derive(Debug, Clone)]
 pub struct Prepared {
     /// The library row.
@@ -118,13 +118,13 @@ pub struct Prepared {
     /// Solver view: `J`, `K`, `Δt`, boundary rules, reference centroid signs.
     pub shape: StanceShape,
     /// `f_a(τ_k)`, `S_a(τ_k)` on the stance's grid (§7.4).
-    pub tables: SampledTables,
+    pub grids: SampledGrids,
     /// Context-free moments of the contact point (§8.3).
     pub moments: ImpulseMoments,
 }
 
 impl Prepared {
-    /// Builds the tables of `stance`.
+    /// Builds the grids of `stance`.
     pub fn new(stance: PoolStance) -> Self {
         let shape = StanceShape::from_boundaries(
             &stance.model,
@@ -133,20 +133,20 @@ impl Prepared {
             &stance.params,
         );
         Prepared {
-            tables: SampledTables::new(&stance.model),
+            grids: SampledGrids::new(&stance.model),
             moments: ImpulseMoments::new(&stance.model),
             shape,
             stance,
         }
     }
 
-    /// Builds the tables of `stance` with the friction check's active set at `λ_act`
+    /// Builds the grids of `stance` with the friction check's active set at `λ_act`
     /// (`f_v ≥ λ_act · max f_v`): the exact check uses it, and the stance's `A^μ` and
     /// `μ_req` (eq 11 filter, relative limits) are recomputed on it.
     pub fn with_active_fraction(stance: PoolStance, active_fraction: f64) -> Self {
         let mut p = Prepared::new(stance);
-        p.tables.active_fraction = active_fraction;
-        let (a_mu, mu_req) = friction_demand(&p.tables, p.tables.max_f_v, active_fraction);
+        p.grids.active_fraction = active_fraction;
+        let (a_mu, mu_req) = friction_demand(&p.grids, p.grids.max_f_v, active_fraction);
         p.stance.coef.a_mu = a_mu;
         p.stance.coef.mu_req = mu_req;
         p

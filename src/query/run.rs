@@ -44,12 +44,12 @@ pub const MAX_RUN_ROWS: usize = 1_000_000;
 /// Checks a sweep of `n_cycles` cycles at `n_speeds` speeds against [`MAX_RUN_ROWS`].
 ///
 /// # Errors
-/// [`ErrorKind::Limit`](crate::error::ErrorKind::Limit) naming `field`.
+/// [`ErrorKind::Cap`](crate::error::ErrorKind::Cap) naming `field`.
 pub fn check_sweep(field: &str, n_cycles: usize, n_speeds: usize) -> Result<(), Error> {
     let n = n_cycles as f64 * n_speeds as f64;
     if n > MAX_RUN_ROWS as f64 {
         let what = "rows (run cycles × speeds)";
-        return Err(Error::limit(field, what, n, MAX_RUN_ROWS, "MAX_RUN_ROWS"));
+        return Err(Error::cap(field, what, n, MAX_RUN_ROWS, "MAX_RUN_ROWS"));
     }
     Ok(())
 }
@@ -316,7 +316,7 @@ pub fn verdicts(p: &Prepared, req: &Request, sol: &Solution, lim: &Limits) -> (b
     }
     (
         approx_ok(p, sol.beta, lim),
-        exact_feasible(&p.tables, &s.model, &ctx, sol.beta, lim),
+        exact_feasible(&p.grids, &s.model, &ctx, sol.beta, lim),
     )
 }
 
@@ -327,7 +327,7 @@ pub fn check_solution(p: &Prepared, req: &Request, sol: &Solution, lim: &Limits)
     let beta = sol.beta;
     let feasible_approx = approx_ok(p, beta, lim);
     let (verdict, u) = exact_at_contact_point(
-        &p.tables,
+        &p.grids,
         &s.model,
         &p.moments,
         &ctx,
@@ -507,7 +507,7 @@ pub fn run_at_speed(
             return std::borrow::Cow::Borrowed(p);
         }
         let s = p.stance.time_scaled(timing.sigma_c);
-        let mut t = Prepared::with_active_fraction(s, p.tables.active_fraction);
+        let mut t = Prepared::with_active_fraction(s, p.grids.active_fraction);
         // The law sets every time; the flight rule becomes "a flight exists" (below).
         (t.shape.before_flight, t.shape.after_flight) = (false, false);
         std::borrow::Cow::Owned(t)

@@ -12,8 +12,8 @@ use super::jump::Jump;
 use super::map::{Agreement, JumpMap};
 use super::pool::Prepared;
 use super::run::{RunCandidate, ScaledStance};
-use crate::library::columns::{col, list_col};
-use crate::library::schema::stances as S;
+use crate::library::codec::columns::{col, list_col};
+use crate::library::codec::schema::stances as S;
 
 /// Name of a violated constraint in the `violated` columns.
 pub fn violation_name(v: Violation) -> &'static str {

@@ -1,4 +1,4 @@
-//! Stance ids (`<clip>:<label>:<frame>`, written by [`super::build`]) and the ids nearest to
+//! Stance ids (`<clip>:<label>:<frame>`, written by [`super::assemble`]) and the ids nearest to
 //! one a library does not hold, for the suggestion of an error message.
 //!
 //! # Model

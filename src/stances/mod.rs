@@ -3,18 +3,19 @@
 //! of each stance (one `stances.parquet` row each).
 //!
 //! Data flow: `ingest::ClipFrames` → [`segment`] → per stance: heading and touchdown state
-//! ([`params`]) → `force_model::fit_stage_a` → `constraints::precompute` → [`Stance`].
+//! ([`params`]) → `force_model::fit_stage_a` → `constraints::precompute` → [`Stance`];
+//! [`assemble_clip`] runs it for every stance of one clip.
 //!
 //! # References
 //! spec stance-model §1–§5, §7.2, §8.1–§8.2, §11.
 
-pub mod build;
+pub mod assemble;
 pub mod ids;
 pub mod limits;
 pub mod params;
 pub mod segment;
 
-pub use build::{build_clip, StanceOptions};
+pub use assemble::{assemble_clip, StanceOptions};
 
 use crate::constraints::Coefficients;
 use crate::force_model::{ForceModel, ForceModelKind};

@@ -165,7 +165,7 @@ impl EqualityForm {
     /// # Errors
     ///
     /// [`TwopacError::InvalidMass`] for a non-positive or non-finite mass;
-    /// [`TwopacError::Limit`] for more than [`MAX_CONTACT_POINTS`] points.
+    /// [`TwopacError::Cap`] for more than [`MAX_CONTACT_POINTS`] points.
     pub fn from_points(
         points: Vec<ContactPoint>,
         mass_kg: f64,
@@ -174,11 +174,11 @@ impl EqualityForm {
             return Err(TwopacError::InvalidMass { mass_kg });
         }
         if points.len() > MAX_CONTACT_POINTS {
-            return Err(TwopacError::Limit {
+            return Err(TwopacError::Cap {
                 what: "contact points in one contact set",
                 found: points.len().to_string(),
                 max: MAX_CONTACT_POINTS,
-                limit: "MAX_CONTACT_POINTS",
+                cap: "MAX_CONTACT_POINTS",
             });
         }
         let generators = generators(&points);

@@ -15,7 +15,7 @@
 //! sliding window (§6):     windows of 2 or 3 phases, switch at u    — trajectory.rs
 //! validation (§7):         s* = min s : G V β = w(c, c̈), β + s ≥ 0  — validate.rs
 //! why a sample fails:      off support / too fast / no force       — diagnose.rs
-//! kinematics (§3):         K c ≤ k from the convex hull of COM samples — hull.rs
+//! limb reach (§3):         K c ≤ k from the convex hull of COM samples — limb_reach.rs, hull.rs
 //! ```
 //!
 //! # Frames and units
@@ -53,7 +53,7 @@ pub mod contact;
 pub mod diagnose;
 pub mod equilibrium;
 pub mod hull;
-pub mod kinematic;
+pub mod limb_reach;
 pub mod phases;
 pub mod polytope;
 pub mod region;
@@ -128,18 +128,18 @@ pub enum TwopacError {
         /// What is wrong.
         msg: String,
     },
-    /// An input asks for more work than a documented limit allows (checked before the
-    /// work starts; README "Limits").
-    #[error("{found} {what}, more than the limit of {max} ({limit})")]
-    Limit {
+    /// An input asks for more work than a documented work cap allows (checked before the
+    /// work starts; README "Work caps").
+    #[error("{found} {what}, more than the limit of {max} ({cap})")]
+    Cap {
         /// What is counted (`contact points`, `validation samples`).
         what: &'static str,
         /// The amount asked for (formatted: it may not fit an integer).
         found: String,
-        /// The limit.
+        /// The cap.
         max: usize,
         /// The name of the constant that defines it (`MAX_SAMPLES`).
-        limit: &'static str,
+        cap: &'static str,
     },
     /// A Bezier curve cannot be built from its inputs.
     #[error("bezier: {msg}")]

@@ -104,15 +104,9 @@ fn fail<T>(path: &str, msg: impl Into<String>) -> Result<T, JsonError> {
     })
 }
 
-/// `Err` at `path` when `found` exceeds `max` (the constant named `limit`): checked
+/// `Err` at `path` when `found` exceeds `max` (the constant named `cap`): checked
 /// before the work the count stands for.
-fn check_limit(
-    path: &str,
-    what: &str,
-    found: f64,
-    max: usize,
-    limit: &str,
-) -> Result<(), JsonError> {
+fn check_cap(path: &str, what: &str, found: f64, max: usize, cap: &str) -> Result<(), JsonError> {
     if found <= max as f64 {
         return Ok(());
     }
@@ -123,7 +117,7 @@ fn check_limit(
     };
     fail(
         path,
-        format!("{found} {what}, more than the limit of {max} ({limit})"),
+        format!("{found} {what}, more than the limit of {max} ({cap})"),
     )
 }
 
@@ -302,14 +296,14 @@ fn check_vector(
     path: &str,
     v: [f64; 3],
     max: f64,
-    limit: &str,
+    cap: &str,
     unit: &str,
 ) -> Result<[f64; 3], JsonError> {
     match v.iter().find(|c| !within(**c, max)) {
         None => Ok(v),
         Some(c) => fail(
             path,
-            format!("component {c} is beyond ±{max} {unit} ({limit})"),
+            format!("component {c} is beyond ±{max} {unit} ({cap})"),
         ),
     }
 }
@@ -388,7 +382,7 @@ fn contact(v: &Value, path: &str) -> Result<Contact, JsonError> {
 
 fn contacts(list: &[Value], path: &str) -> Result<Vec<Contact>, JsonError> {
     let n = list.len() as f64;
-    check_limit(path, "contacts", n, MAX_CONTACTS, "MAX_CONTACTS")?;
+    check_cap(path, "contacts", n, MAX_CONTACTS, "MAX_CONTACTS")?;
     list.iter()
         .enumerate()
         .map(|(k, v)| contact(v, &format!("{path}[{k}]")))
@@ -481,7 +475,7 @@ fn kinematics(v: &Value, path: &str) -> Result<KinematicsRef, JsonError> {
                 return fail(&format!("{path}.A"), "no rows");
             }
             let n = k.a.len() as f64;
-            check_limit(&format!("{path}.A"), "rows", n, MAX_ROWS, "MAX_ROWS")?;
+            check_cap(&format!("{path}.A"), "rows", n, MAX_ROWS, "MAX_ROWS")?;
             if let Some(i) = k.a.iter().position(|r| norm(*r) == 0.0) {
                 return fail(&format!("{path}.A[{i}]"), "zero row");
             }
@@ -541,7 +535,7 @@ pub fn parse_phases(text: &str) -> Result<PhasesFile, JsonError> {
         return fail("phases", "empty: give at least one phase");
     }
     let n = raw.phases.len() as f64;
-    check_limit("phases", "phases", n, MAX_PHASES, "MAX_PHASES")?;
+    check_cap("phases", "phases", n, MAX_PHASES, "MAX_PHASES")?;
     let mut phases: Vec<PhaseSpec> = Vec::with_capacity(raw.phases.len());
     let mut total_s = 0.0;
     for (j, p) in raw.phases.iter().enumerate() {
@@ -566,7 +560,7 @@ pub fn parse_phases(text: &str) -> Result<PhasesFile, JsonError> {
             )?;
         }
         total_s += p.duration_s.unwrap_or(0.0);
-        check_limit(
+        check_cap(
             &format!("{path}.duration_s"),
             &format!("validation samples (the phases up to here last {total_s} s, one sample every {DEFAULT_STEP_S} s)"),
             sample_count(0.0, total_s, DEFAULT_STEP_S),

@@ -272,11 +272,11 @@ fn check_phases(phases: &[Phase]) -> Result<[f64; 3], TwopacError> {
         return Err(bad(0, "no phases"));
     }
     if n > MAX_PHASES {
-        return Err(TwopacError::Limit {
+        return Err(TwopacError::Cap {
             what: "phases",
             found: n.to_string(),
             max: MAX_PHASES,
-            limit: "MAX_PHASES",
+            cap: "MAX_PHASES",
         });
     }
     for (j, p) in phases.iter().enumerate() {

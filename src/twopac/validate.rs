@@ -77,7 +77,7 @@ pub fn sample_count(t0: f64, t1: f64, step_s: f64) -> f64 {
 /// Checks the samples of a span `[t0, t1]` at `step_s` against [`MAX_SAMPLES`].
 ///
 /// # Errors
-/// [`TwopacError::Limit`] (a span that is not finite counts as too long).
+/// [`TwopacError::Cap`] (a span that is not finite counts as too long).
 pub fn check_span(t0: f64, t1: f64, step_s: f64) -> Result<(), TwopacError> {
     let n = sample_count(t0, t1, step_s);
     if n > MAX_SAMPLES as f64 {
@@ -86,11 +86,11 @@ pub fn check_span(t0: f64, t1: f64, step_s: f64) -> Result<(), TwopacError> {
         } else {
             format!("{n:.3e}")
         };
-        return Err(TwopacError::Limit {
+        return Err(TwopacError::Cap {
             what: "validation samples",
             found: format!("{found} (span {:.6e} s at {step_s} s)", t1 - t0),
             max: MAX_SAMPLES,
-            limit: "MAX_SAMPLES",
+            cap: "MAX_SAMPLES",
         });
     }
     Ok(())

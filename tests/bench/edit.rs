@@ -39,7 +39,7 @@ use stancelib::edit::plan::{place, run_requests, solve_stance, PlanKind};
 use stancelib::edit::pose::{pose_motion, Reference};
 use stancelib::edit::EditOptions;
 use stancelib::ingest::body::BodyModel;
-use stancelib::library::read::{open_library, read_stance_timing};
+use stancelib::library::readers::read::{open_library, read_stance_timing};
 use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::query::feasibility::relative_limits;
 use stancelib::query::pool::Prepared;
@@ -71,14 +71,7 @@ fn edit_one_second(c: &mut Criterion) {
     let req = run_requests([&prep[0].stance, &prep[1].stance], 1.1);
     // As `edit run` plays them: each stance leaned to its periodic request (`edit::lean`).
     let leaned: Vec<Prepared> = (0..2)
-        .map(|n| {
-            leaned(
-                &prep[n],
-                &req[n],
-                [1.1, 1.0],
-                prep[n].tables.active_fraction,
-            )
-        })
+        .map(|n| leaned(&prep[n], &req[n], [1.1, 1.0], prep[n].grids.active_fraction))
         .collect();
     let stances: Vec<_> = (0..2)
         .map(|n| {
@@ -96,8 +89,8 @@ fn edit_one_second(c: &mut Criterion) {
         })
         .collect();
     let bvh = parse_file(&clip).expect("clip");
-    let info =
-        stancelib::library::read::read_clip_sources(&lib.join("clips.parquet")).expect("clips");
+    let info = stancelib::library::readers::read::read_clip_sources(&lib.join("clips.parquet"))
+        .expect("clips");
     let src = &info[&l.stances[cy.stances[0]].clip];
     let up = UpAxis::parse(src.up_axis.as_deref().unwrap()).unwrap();
     let body = BodyModel::new(

@@ -7,7 +7,7 @@
 //!   force fits, coefficients, five Parquet tables and the manifest), wall time with the
 //!   default rayon pool. Target: under 2 s on 2 cores. Skipped with a message when
 //!   `../shared` is absent.
-//! - `stances_10k`: `stances::build_clip` on the 120 Hz fixture run (4 stances) 2,500 times:
+//! - `stances_10k`: `stances::assemble_clip` on the 120 Hz fixture run (4 stances) 2,500 times:
 //!   segmentation, Stage A (spline, DFT, dominant terms), closed-form integrals, coefficient
 //!   tables and `H_0`, no I/O (CORRECTIONS issue 3 item 7). Target: under 1 s, one thread.
 //!
@@ -22,7 +22,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use stancelib::ingest::{ingest, ClipOutcome, IngestOptions};
 use stancelib::pipeline::engine::inputs::discover;
 use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
-use stancelib::stances::{build_clip, StanceOptions};
+use stancelib::stances::{assemble_clip, StanceOptions};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -64,7 +64,7 @@ fn stances_10k(c: &mut Criterion) {
         panic!("fixture skipped")
     };
     let opts = StanceOptions::default();
-    let per_clip = build_clip("run", &frames, &summary, &contacts, 70.0, &opts)
+    let per_clip = assemble_clip("run", &frames, &summary, &contacts, 70.0, &opts)
         .0
         .len();
     let reps = 10_000 / per_clip.max(1);
@@ -75,9 +75,11 @@ fn stances_10k(c: &mut Criterion) {
         b.iter(|| {
             let mut n = 0;
             for _ in 0..reps {
-                n += black_box(build_clip("run", &frames, &summary, &contacts, 70.0, &opts))
-                    .0
-                    .len();
+                n += black_box(assemble_clip(
+                    "run", &frames, &summary, &contacts, 70.0, &opts,
+                ))
+                .0
+                .len();
             }
             n
         })

@@ -21,7 +21,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use stancelib::library::read::read_stances;
+use stancelib::library::readers::read::read_stances;
 use stancelib::pipeline::engine::inputs::discover;
 use stancelib::pipeline::engine::streaming::{build_and_write, BuildOptions};
 use stancelib::query::feasibility::{approx, relative_limits};

@@ -19,7 +19,7 @@
 //!   `units_com_only` (given the points), `trig_only` (libm `sin_cos`, one per rotation
 //!   channel) and `trig_only_poly` (`math::trig::sincos_deg`, scalar) split the cost;
 //!   `full_batched` is what the ingest runs (`fk::forward_frames`, four frames per SIMD
-//!   batch) and `full_libm_reference` the libm FK it replaced. The `full_proposal_*`
+//!   batch) and `full_libm` the libm FK it replaced. The `full_proposal_*`
 //!   prototypes of the results below were removed once issue 15 put proposal 4 in the
 //!   library (`skeleton::fk::simd`): the bench no longer keeps a copy of the FK.
 //! - `ingest`: `ingest::ingest` of the whole clip (lead-in, units, FK, COM, SG filter,
@@ -63,7 +63,7 @@
 //!
 //! ```text
 //! fk_com/full_batched                     1.40 ms   1.96 M frames/s   what the ingest runs
-//! fk_com/full_libm_reference              3.09 ms    890 k frames/s   the FK before issue 15
+//! fk_com/full_libm                        3.09 ms    890 k frames/s   the FK before issue 15 (then `full_libm_reference`)
 //! fk_com/full                             3.19 ms    863 k frames/s   one frame per call
 //! fk_com/full_proposal_4_four_frames_per_lane  1.36 ms  2.03 M frames/s   (prototype, since removed)
 //! ```
@@ -409,15 +409,15 @@ fn bench_fk_com(c: &mut Criterion) {
             black_box((&out, &contacts));
         })
     });
-    // The libm FK `fk::forward` ran before issue 15 (`fk::forward_reference`).
+    // The libm FK `fk::forward` ran before issue 15 (`fk::forward_libm`).
     let mut rot = vec![fk::IDENTITY; p.skel.n_joints()];
-    g.bench_function(BenchmarkId::new("full_libm_reference", &label), |b| {
+    g.bench_function(BenchmarkId::new("full_libm", &label), |b| {
         b.iter(|| {
             let m = &p.bvh.motion;
             out.clear();
             contacts.clear();
             for f in 0..n {
-                fk::forward_reference(&p.skel, &mut rot, black_box(m.row(f)), &mut pts);
+                fk::forward_libm(&p.skel, &mut rot, black_box(m.row(f)), &mut pts);
                 out.push(units_com(&p, &pts, &mut pts_m));
                 contacts.push(contact_points(&p, &pts_m));
             }

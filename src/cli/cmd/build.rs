@@ -82,7 +82,7 @@ pub fn report_build(report: &BuildSummary, out: &Path, plan: &BuildPlan) -> Outc
     summary["reuse_refused"] = report.not_reused.clone().into();
     // A library that cannot be read back here has said why already (the build's own
     // errors); the duplicates are then not reported.
-    let duplicates = crate::library::info::duplicate_clips(out).unwrap_or_default();
+    let duplicates = crate::library::readers::info::duplicate_clips(out).unwrap_or_default();
     if !duplicates.is_empty() {
         let named: Vec<String> = duplicates
             .iter()

@@ -30,7 +30,7 @@ fn target(c: &EditCommon) -> EditTarget {
 /// Bad options, an unreadable library or source, no solvable cycle, an infeasible request
 /// (without `--allow-infeasible`), an unwritable output.
 pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.common.lib, &a.common.out)?;
+    crate::library::storage::layout::check_output_outside(&a.common.lib, &a.common.out)?;
     let e = RunEdit {
         target: target(&a.common),
         run: RunTarget {
@@ -52,7 +52,7 @@ pub fn run(a: EditRunArgs) -> anyhow::Result<Outcome> {
 /// Bad options, an unreadable library or source, no solvable pair, an infeasible request
 /// (without `--allow-infeasible`), an unwritable output.
 pub fn run_jump(a: EditJumpArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.common.lib, &a.common.out)?;
+    crate::library::storage::layout::check_output_outside(&a.common.lib, &a.common.out)?;
     let e = JumpEdit {
         target: target(&a.common),
         jump: JumpTarget {
@@ -110,7 +110,7 @@ fn report(r: &EditReport) -> Outcome {
             r.unconverged,
             r.n_frames,
             crate::edit::DEFAULT_COM_TOL_M,
-            crate::library::schema::edit_plan::CONVERGED
+            crate::library::codec::schema::edit_plan::CONVERGED
         );
     }
     if !r.feasible {

@@ -8,12 +8,12 @@ use anyhow::Context;
 use super::super::args::{ForcesArgs, ForcesFormat};
 use super::super::Outcome;
 use crate::force_model::per_contact::SplitOptions;
-use crate::library::atomic::write_text_atomic;
-use crate::library::forces::{forces_table, read_force_stances, select_stances};
-use crate::library::per_contact::{
+use crate::library::codec::schema::STANCES_FILE;
+use crate::library::readers::forces::{forces_table, read_force_stances, select_stances};
+use crate::library::readers::per_contact::{
     contact_rows, per_contact_csv, per_contact_mot, per_contact_table, read_contact_clip,
 };
-use crate::library::schema::STANCES_FILE;
+use crate::library::storage::atomic::write_text_atomic;
 use crate::pipeline::commands::queries::{query_kv, write_table};
 
 /// The output format: `--format`, else the `--out` extension, else Parquet.
@@ -55,10 +55,10 @@ fn format_of(a: &ForcesArgs) -> anyhow::Result<ForcesFormat> {
 /// Bad options (each named), an unreadable library, an unknown `--stance` id or clip
 /// (nothing is written), an unwritable output.
 pub fn run(a: ForcesArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
+    crate::library::storage::layout::check_output_outside(&a.lib, &a.out)?;
     let format = format_of(&a)?;
     // Once for both paths (`read_contact_clip` leaves it to its caller).
-    crate::library::provenance::check_layout(&a.lib)?;
+    crate::library::codec::provenance::check_layout(&a.lib)?;
     if a.per_contact {
         return run_per_contact(&a, format);
     }

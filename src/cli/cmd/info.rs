@@ -5,7 +5,7 @@ use anyhow::Context;
 
 use super::super::args::InfoArgs;
 use super::super::Outcome;
-use crate::library::info::library_info;
+use crate::library::readers::info::library_info;
 
 /// Run `info`.
 ///

@@ -11,7 +11,7 @@ use crate::pipeline::commands::map_jumps::{map_jumps, MapQuery, MapReport, HIGHE
 /// # Errors
 /// Bad grid options, an unreadable library, an unwritable output folder.
 pub fn run(a: MapJumpsArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
+    crate::library::storage::layout::check_output_outside(&a.lib, &a.out)?;
     let q = MapQuery {
         lib: a.lib.clone(),
         heights: a.heights()?.values(),

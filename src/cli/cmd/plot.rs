@@ -11,7 +11,7 @@ use crate::pipeline::commands::plots::{plot_clip, plot_stance, StancePlotJob};
 /// An `--active-set` outside [0, 1], an unreadable library or plate file, an unknown
 /// stance id (nothing is written), an unwritable output.
 pub fn run_stance(a: PlotStanceArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
+    crate::library::storage::layout::check_output_outside(&a.lib, &a.out)?;
     let job = StancePlotJob {
         lib: a.lib,
         stance: a.stance,
@@ -33,7 +33,7 @@ pub fn run_stance(a: PlotStanceArgs) -> anyhow::Result<Outcome> {
 /// An unreadable library, a clip it does not hold (nothing is written), an unwritable
 /// output.
 pub fn run_clip(a: PlotClipArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
+    crate::library::storage::layout::check_output_outside(&a.lib, &a.out)?;
     let view = plot_clip(&a.lib, &a.clip, &a.out)?;
     crate::say!(
         "plot clip: {} ({} frames, {} flights) → {}",

@@ -15,7 +15,7 @@ use crate::pipeline::commands::query_run::{run_query, RunQuery, RunReport};
 /// # Errors
 /// Bad options, an unreadable library, an unwritable output.
 pub fn run(a: RunQueryArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
+    crate::library::storage::layout::check_output_outside(&a.lib, &a.out)?;
     let q = RunQuery {
         lib: a.lib.clone(),
         speeds: a.speeds()?,
@@ -93,7 +93,7 @@ pub fn print_run(report: &RunReport, out: &Path) {
 /// # Errors
 /// Bad options, an unreadable library, an unwritable output.
 pub fn run_jump(a: JumpArgs) -> anyhow::Result<Outcome> {
-    crate::library::layout::check_output_outside(&a.lib, &a.out)?;
+    crate::library::storage::layout::check_output_outside(&a.lib, &a.out)?;
     anyhow::ensure!(
         a.distance_scale.is_none() || a.height_scale.is_some(),
         "--distance-scale goes with --height-scale (with --height give --distance in m)"

@@ -6,7 +6,7 @@ use anyhow::Context;
 
 use super::super::args::SynthArgs;
 use super::super::Outcome;
-use crate::library::atomic::write_text_atomic;
+use crate::library::storage::atomic::write_text_atomic;
 use crate::skeleton::units::parse_unit;
 use crate::synth::{
     generate, SynthMotion, SynthOptions, SynthUp, MAX_DURATION_S, MAX_FRAME_RATE_HZ, MAX_UNIT_M,

@@ -4,7 +4,7 @@
 use super::{force_at, random_context, random_model, Rng};
 use crate::constraints::extension::unscaled_offset;
 use crate::constraints::{
-    com_offset, ellipsoid_boxes, precompute, PrecomputeOptions, SampledTables, DEFAULT_BETA_MAX,
+    com_offset, ellipsoid_boxes, precompute, PrecomputeOptions, SampledGrids, DEFAULT_BETA_MAX,
     RELATIVE_MARGIN,
 };
 use crate::force_model::GRAVITY;
@@ -78,7 +78,7 @@ fn identity_extension_extremes_equal_ext_min_and_ext_max() {
             lo = lo.min(d);
             hi = hi.max(d);
         }
-        // Same formula, tables vs direct trig: ~1e-15 m apart.
+        // Same formula, grids vs direct trig: ~1e-15 m apart.
         assert!((c.ext_min - lo).abs() < 1e-12 && (c.ext_max - hi).abs() < 1e-12);
         let at_td = (x_cp[0].powi(2) + x_cp[1].powi(2) + x_cp[2].powi(2)).sqrt();
         assert!(c.ext_min <= at_td && at_td <= c.ext_max);
@@ -115,9 +115,9 @@ fn boxes_match_their_definition() {
     for _ in 0..50 {
         let model = random_model(&mut rng);
         let ctx = random_context(&mut rng);
-        let tables = SampledTables::new(&model);
+        let grids = SampledGrids::new(&model);
         let chi = [rng.uniform(0.5, 0.9), rng.uniform(1.0, 1.5)];
-        let b = ellipsoid_boxes(&model, &ctx, &tables, chi, &opts);
+        let b = ellipsoid_boxes(&model, &ctx, &grids, chi, &opts);
         let grid = model.grid();
         let (mut r_min, mut r_max) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
         let (mut s_min, mut s_max) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
@@ -137,7 +137,7 @@ fn boxes_match_their_definition() {
             }
         }
         let clip = |x: f64| x.clamp(0.0, opts.beta_max);
-        // Bounds are (χ ∓ U_a·sgn S_a)/|S_a|; tables and direct trig differ by ~1e-13 in
+        // Bounds are (χ ∓ U_a·sgn S_a)/|S_a|; grids and direct trig differ by ~1e-13 in
         // S_a, i.e. ~1e-9 relative where |S_a| is smallest; values are ≤ β_max = 3.
         let close = |x: f64, y: f64| (x - y).abs() <= 1e-7;
         for a in 0..3 {
@@ -167,9 +167,9 @@ fn relative_limits_use_the_margin() {
     let model = random_model(&mut rng);
     let ctx = random_context(&mut rng);
     let c = precompute(&model, &ctx);
-    let tables = SampledTables::new(&model);
+    let grids = SampledGrids::new(&model);
     let chi = [c.ext_min / RELATIVE_MARGIN, RELATIVE_MARGIN * c.ext_max];
-    let b = ellipsoid_boxes(&model, &ctx, &tables, chi, &PrecomputeOptions::default());
+    let b = ellipsoid_boxes(&model, &ctx, &grids, chi, &PrecomputeOptions::default());
     assert_eq!(
         [b.r_min, b.r_max, b.s_min, b.s_max],
         [c.ell_r_min, c.ell_r_max, c.ell_s_min, c.ell_s_max]

@@ -2,7 +2,7 @@
 
 use super::{force_at, random_model, random_model_with, Rng};
 use crate::constraints::{
-    force_coefficients, force_filter_accepts, friction_filter_accepts, precompute, SampledTables,
+    force_coefficients, force_filter_accepts, friction_filter_accepts, precompute, SampledGrids,
     StanceContext, ACTIVE_FRACTION,
 };
 use crate::force_model::{AxisModel, ForceModel};
@@ -13,15 +13,15 @@ fn tables_match_the_models_evaluators() {
         let mut rng = Rng::new(1);
         for _ in 0..50 {
             let model = random_model_with(&mut rng, halves);
-            let tables = SampledTables::new(&model);
-            assert_eq!(tables.tau, model.grid());
+            let grids = SampledGrids::new(&model);
+            assert_eq!(grids.tau, model.grid());
             for axis in 0..3 {
-                let f_scale = tables.f[axis].iter().fold(1.0f64, |m, v| m.max(v.abs()));
-                let s_scale = tables.s[axis].iter().fold(1e-6f64, |m, v| m.max(v.abs()));
-                for (k, &t) in tables.tau.iter().enumerate() {
+                let f_scale = grids.f[axis].iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                let s_scale = grids.s[axis].iter().fold(1e-6f64, |m, v| m.max(v.abs()));
+                for (k, &t) in grids.tau.iter().enumerate() {
                     // Unit-circle table vs direct cos of 2πjτ + φ: a few ulps of the scale.
-                    let ef = (tables.f[axis][k] - model.axes[axis].eval(t)).abs();
-                    let es = (tables.s[axis][k] - model.s(axis, t)).abs();
+                    let ef = (grids.f[axis][k] - model.axes[axis].eval(t)).abs();
+                    let es = (grids.s[axis][k] - model.s(axis, t)).abs();
                     assert!(ef <= 1e-12 * f_scale, "f axis {axis} k {k}: {ef}");
                     assert!(es <= 1e-12 * s_scale, "S axis {axis} k {k}: {es}");
                 }
@@ -140,7 +140,7 @@ fn a_stance_without_load_needs_infinite_friction() {
         dt_s: 0.2,
         axes: [axis(50.0), axis(0.0), axis(-100.0)],
     };
-    let c = force_coefficients(&SampledTables::new(&model));
+    let c = force_coefficients(&SampledGrids::new(&model));
     assert!(!c.unilateral_ok);
     assert_eq!(c.a_mu, [f64::INFINITY; 2]);
     assert_eq!(c.mu_req, f64::INFINITY);

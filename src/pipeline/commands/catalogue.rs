@@ -33,9 +33,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::library::read::{open_library, StanceLibrary};
-use crate::library::schema::{clips, CLIPS_FILE};
-use crate::library::table::Table;
+use crate::library::codec::schema::{clips, CLIPS_FILE};
+use crate::library::codec::table::Table;
+use crate::library::readers::read::{open_library, StanceLibrary};
 use crate::math::stats::median;
 use crate::query::feasibility::{LimitForm, Limits, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::gait::{GaitLaw, LawChoice};

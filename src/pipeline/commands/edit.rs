@@ -22,9 +22,9 @@ use crate::edit::{
     RUN_KNEE_SLACK_DEG,
 };
 use crate::ingest::body::BodyModel;
-use crate::library::provenance::library_body;
-use crate::library::read::{read_clip_sources, read_stance_timing};
-use crate::library::schema::{CLIPS_FILE, STANCES_FILE};
+use crate::library::codec::provenance::library_body;
+use crate::library::codec::schema::{CLIPS_FILE, STANCES_FILE};
+use crate::library::readers::read::{read_clip_sources, read_stance_timing};
 use crate::pipeline::engine::inputs::file_sha256;
 use crate::plot::edit::edit_png;
 use crate::plot::write_png;
@@ -189,7 +189,7 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
 /// ([`crate::edit::swing`]): from the recorded speed to the planned one, on a character
 /// `length_scale` times the source's size.
 fn swing_plan(
-    lib: &crate::library::read::StanceLibrary,
+    lib: &crate::library::readers::read::StanceLibrary,
     times: &[StanceTiming],
     chosen: &ChosenRun,
     length_scale: f64,
@@ -377,7 +377,7 @@ fn check_frames(
             crate::error::count_text(frames),
             1.0 / frame_time_s
         );
-        return Err(crate::error::Error::limit(
+        return Err(crate::error::Error::cap(
             field,
             "frame-joints",
             n,
@@ -507,7 +507,7 @@ fn finish(
         warnings: Vec::new(),
     };
     // The BVH writer is below the library's; the read's generation is checked here.
-    crate::library::generation::before_output()?;
+    crate::library::storage::generation::before_output()?;
     write_file(&t.out, &out)?;
     let (plan, png) = sidecars(&t.out);
     write_table(&plan, &mut df, &kv)?;

@@ -1,5 +1,5 @@
 //! What an edit writes besides the BVH: the plan table `FILE.plan.parquet` (one row per
-//! output frame, columns in [`crate::library::schema::edit_plan`]) and the plot data of
+//! output frame, columns in [`crate::library::codec::schema::edit_plan`]) and the plot data of
 //! `FILE.png` (planned COM path, footprints, [`PLOT_POSES`] sampled poses, the body's
 //! facing and the verdicts).
 
@@ -12,7 +12,7 @@ use crate::edit::fidelity::{Fidelity, Gauge};
 use crate::edit::path::Phase;
 use crate::edit::plan::EditStance;
 use crate::edit::pose::{EditedMotion, Reference};
-use crate::library::schema::edit_plan as col;
+use crate::library::codec::schema::edit_plan as col;
 use crate::plot::edit::{EditPlot, Pose};
 use crate::skeleton::fk::FkWorkspace;
 

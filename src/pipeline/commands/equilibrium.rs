@@ -20,9 +20,9 @@ use rayon::prelude::*;
 use super::split_out;
 use super::twopac_tables::equilibrium_table;
 use crate::error::Error;
-use crate::library::schema::com_state::{ACCELERATION, POSITION};
-use crate::library::table::OpenedParquet;
-use crate::library::write::write_atomic;
+use crate::library::codec::schema::com_state::{ACCELERATION, POSITION};
+use crate::library::codec::table::OpenedParquet;
+use crate::library::codec::write::write_atomic;
 use crate::pipeline::engine::batch::progress;
 use crate::pipeline::engine::inputs::{open_side_input, read_side_text, SideInput};
 use crate::plot::write_png;
@@ -97,7 +97,7 @@ fn read_points(path: &Path, n_contacts: usize, slice_cells: usize) -> anyhow::Re
     let rows = table.rows()?;
     let work = n_contacts as f64 * (rows + slice_cells) as f64;
     let too_many = if rows > MAX_COM_STATES {
-        Some(Error::limit(
+        Some(Error::cap(
             "--points",
             "rows",
             rows as f64,
@@ -110,7 +110,7 @@ fn read_points(path: &Path, n_contacts: usize, slice_cells: usize) -> anyhow::Re
         } else {
             String::new()
         };
-        Some(Error::limit(
+        Some(Error::cap(
             format!("--points ({rows} rows{png}) × --contacts ({n_contacts} contacts)"),
             "contact-states",
             work,
@@ -196,7 +196,10 @@ pub fn run_equilibrium(job: &EquilibriumJob) -> anyhow::Result<EquilibriumReport
         "n_contact_points": points.len(),
         "min_mu": min_mu(&points),
     });
-    let kv = crate::library::schema::command_kv(crate::library::schema::EQUILIBRIUM_KEY, &options);
+    let kv = crate::library::codec::schema::command_kv(
+        crate::library::codec::schema::EQUILIBRIUM_KEY,
+        &options,
+    );
     let (dir, name) = split_out(&job.out)?;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     write_atomic(dir, &name, &mut equilibrium_table(&com, &verdicts)?, &kv)?;

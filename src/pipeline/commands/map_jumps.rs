@@ -12,7 +12,7 @@ use anyhow::Context;
 
 use super::queries::{file_safe, load_pool, pool_without_left_out, query_kv, LimitOptions};
 use super::query_jump::JumpTarget;
-use crate::library::write::write_atomic;
+use crate::library::codec::write::write_atomic;
 use crate::plot::{jump_map_png, write_png};
 use crate::query::feasibility::{LimitForm, Limits};
 use crate::query::limits::{absolute_limits, jump_limits};
@@ -132,7 +132,7 @@ pub fn map_jumps(q: &MapQuery) -> anyhow::Result<MapReport> {
         &mut jump_pairs_table(&map, &pool)?,
         &kv,
     )?;
-    crate::library::atomic::write_text_atomic(
+    crate::library::storage::atomic::write_text_atomic(
         &q.out.join("jump_map.json"),
         &(serde_json::to_string_pretty(&summary)? + "\n"),
     )?;

@@ -8,11 +8,11 @@ use anyhow::Context;
 
 use crate::force_model::export::{kinematic_force, sample_forces};
 use crate::ingest::plates::{parse_plates, PlateFoot, PlateSample};
-use crate::library::clip_view::{read_clip_view, ClipView};
-use crate::library::forces::{
+use crate::library::codec::schema::{CLIPS_FILE, FRAMES_FILE, STANCES_FILE};
+use crate::library::readers::clip_view::{read_clip_view, ClipView};
+use crate::library::readers::forces::{
     read_clip_accelerations, read_force_stances, read_up_axis, select_stances,
 };
-use crate::library::schema::{CLIPS_FILE, FRAMES_FILE, STANCES_FILE};
 use crate::pipeline::engine::inputs::{read_side_text, SideInput};
 use crate::plot::stance::{stance_png, time_window, StancePlot, WorldForces};
 use crate::plot::write_png;
@@ -78,7 +78,7 @@ pub fn plot_stance(job: &StancePlotJob) -> anyhow::Result<StancePlotReport> {
 
 /// The data of a stance plot, with warnings.
 fn stance_plot(job: &StancePlotJob) -> anyhow::Result<(StancePlot, Vec<String>)> {
-    crate::library::provenance::check_layout(&job.lib)?;
+    crate::library::codec::provenance::check_layout(&job.lib)?;
     let lib = |name: &str| job.lib.join(name);
     let stances = read_force_stances(&lib(STANCES_FILE))
         .with_context(|| format!("library {}", job.lib.display()))?;

@@ -15,8 +15,8 @@ use anyhow::Context;
 use polars::prelude::DataFrame;
 use rayon::prelude::*;
 
-use crate::library::read::{open_library, StanceLibrary};
-use crate::library::write::write_atomic;
+use crate::library::codec::write::write_atomic;
+use crate::library::readers::read::{open_library, StanceLibrary};
 use crate::query::feasibility::{check_mu, LimitForm, DEFAULT_QUERY_ACTIVE_FRACTION};
 use crate::query::gait::LawChoice;
 use crate::query::limits::{left_out_clips, left_out_line, LeftOut};
@@ -158,8 +158,10 @@ pub fn write_table(out: &Path, df: &mut DataFrame, kv: &[(String, String)]) -> a
 /// # Errors
 /// The library's manifest cannot be read.
 pub fn query_kv(lib: &Path, options: serde_json::Value) -> anyhow::Result<Vec<(String, String)>> {
-    use crate::library::provenance::manifest_sha256;
-    use crate::library::schema::{command_kv, LIBRARY_MANIFEST_KEY, LIBRARY_PATH_KEY, QUERY_KEY};
+    use crate::library::codec::provenance::manifest_sha256;
+    use crate::library::codec::schema::{
+        command_kv, LIBRARY_MANIFEST_KEY, LIBRARY_PATH_KEY, QUERY_KEY,
+    };
     let hash = manifest_sha256(lib).with_context(|| format!("library {}", lib.display()))?;
     let mut kv = command_kv(QUERY_KEY, &options);
     kv.push((LIBRARY_PATH_KEY.into(), lib.display().to_string()));

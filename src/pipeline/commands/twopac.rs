@@ -51,7 +51,7 @@ pub const REPEATS_VALIDATION: usize = 3;
 pub fn read_polytopes(
     lib_dir: &Path,
 ) -> crate::error::Result<BTreeMap<(String, String), Polytope>> {
-    Ok(crate::library::kinematics::read_facets(lib_dir)?
+    Ok(crate::library::codec::kinematics::read_facets(lib_dir)?
         .into_iter()
         .map(|(k, (a, b))| (k, Polytope::new(a, b)))
         .collect())
@@ -424,8 +424,8 @@ pub fn clip_character(
 ) -> Option<String> {
     let has = |id: &str| all.keys().any(|(c, _)| c == id);
     let sha = crate::pipeline::engine::inputs::file_sha256(clip);
-    let clips = crate::library::table::Table::open_columns(
-        &lib.join(crate::library::schema::CLIPS_FILE),
+    let clips = crate::library::codec::table::Table::open_columns(
+        &lib.join(crate::library::codec::schema::CLIPS_FILE),
         &["content_sha256", "character_id"],
     )
     .ok();
@@ -493,9 +493,9 @@ mod tests {
             Column::new("character_id".into(), ["sk-b", "sk-c"]),
         ])
         .unwrap();
-        crate::library::write::write_atomic(
+        crate::library::codec::write::write_atomic(
             dir.path(),
-            crate::library::schema::CLIPS_FILE,
+            crate::library::codec::schema::CLIPS_FILE,
             &mut df,
             &[],
         )

@@ -13,8 +13,8 @@ use super::twopac_tables::{
     form_name, phases_table, trajectory_table, transitions_table, validation_table, windows_table,
     TrajectoryRow,
 };
-use crate::library::atomic::write_text_atomic;
-use crate::library::write::write_atomic;
+use crate::library::codec::write::write_atomic;
+use crate::library::storage::atomic::write_text_atomic;
 use crate::pipeline::engine::inputs::{read_side_text, SideInput};
 use crate::plot::trajectory::trajectory_png;
 use crate::plot::trajectory::{curve_verdict, CurveSample};
@@ -281,7 +281,10 @@ pub fn write_outputs(
         "form": form_name(form),
         "step_s": DEFAULT_STEP_S,
     });
-    let kv = crate::library::schema::command_kv(crate::library::schema::TWOPAC_KEY, &options);
+    let kv = crate::library::codec::schema::command_kv(
+        crate::library::codec::schema::TWOPAC_KEY,
+        &options,
+    );
     let p = &r.p;
     let validations = [("2pac", &r.v_curve), ("quasi_static", &r.v_qs)];
     for (name, mut df) in [

@@ -5,8 +5,8 @@
 
 use polars::prelude::*;
 
-use crate::library::columns::{col, list_col};
-use crate::library::schema::com_state::{ACCELERATION, POSITION, VELOCITY};
+use crate::library::codec::columns::{col, list_col};
+use crate::library::codec::schema::com_state::{ACCELERATION, POSITION, VELOCITY};
 use crate::twopac::bezier::ComState;
 use crate::twopac::equilibrium::Verdict;
 use crate::twopac::trajectory::{Phase, PhaseDiagnostic, Plan};

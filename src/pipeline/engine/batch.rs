@@ -13,7 +13,7 @@ use super::inputs::{bvh_too_large, hex, open_input, InputProblem, MAX_BVH_BYTES}
 use super::names::clip_names;
 use crate::error::{Error, ErrorKind, Result};
 use crate::ingest::{ingest, ClipOutcome, ClipSummary, IngestOptions, MASS_SOURCE_DEFAULT};
-use crate::library::write::FramesWriter;
+use crate::library::codec::write::FramesWriter;
 use crate::library::{ClipRecord, ClipStatus, Status};
 
 /// A reader that hashes and counts what passes through it (one pass over a large file).
@@ -216,10 +216,10 @@ pub fn max_threads() -> usize {
 /// Checks a requested worker count (0 = all cores) against [`max_threads`].
 ///
 /// # Errors
-/// [`ErrorKind::Limit`] naming `field`.
+/// [`ErrorKind::Cap`] naming `field`.
 pub fn check_threads(field: &str, threads: usize) -> Result<()> {
     if threads > max_threads() {
-        return Err(Error::limit(
+        return Err(Error::cap(
             field,
             "threads",
             threads as f64,

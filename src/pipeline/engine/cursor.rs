@@ -8,11 +8,11 @@ use polars::prelude::*;
 
 use super::tables::strings;
 use crate::error::{Error, Result};
-use crate::library::layout::{locate_path, read_source, TableSource};
-use crate::library::schema::frames;
-use crate::library::stream::read_rows;
-use crate::library::stream::ROW_GROUP_ROWS;
-use crate::library::table::parquet_rows;
+use crate::library::codec::schema::frames;
+use crate::library::codec::table::parquet_rows;
+use crate::library::storage::layout::{locate_path, read_source, TableSource};
+use crate::library::storage::stream::read_rows;
+use crate::library::storage::stream::ROW_GROUP_ROWS;
 
 /// A table sorted by clip, read forward in clip order: the rows of a range of clips at a
 /// time, never the whole file (the last row group read is kept, as the next range of
@@ -170,7 +170,7 @@ fn index_clips(path: &Path, add: &mut dyn FnMut(&DataFrame)) -> Result<()> {
 #[cfg(test)]
 mod cursor_tests {
     use super::*;
-    use crate::library::stream::TableWriter;
+    use crate::library::storage::stream::TableWriter;
 
     // See: issue 16 item 3 — a merge decoded a row group again for every batch of clips
     // that touched it; the cursor keeps the last one, and must still give the same rows.

@@ -170,16 +170,16 @@ pub fn check_input(path: &Path) -> std::result::Result<u64, InputProblem> {
     check_bounded(path, BVH_BOUND)
 }
 
-/// A size limit: bytes, and the name of the constant that defines it.
+/// A size cap: bytes, and the name of the constant that defines it.
 #[derive(Debug, Clone, Copy)]
 struct Bound {
     max: u64,
-    limit: &'static str,
+    cap: &'static str,
 }
 
 const BVH_BOUND: Bound = Bound {
     max: MAX_BVH_BYTES,
-    limit: "MAX_BVH_BYTES",
+    cap: "MAX_BVH_BYTES",
 };
 
 impl Bound {
@@ -187,7 +187,7 @@ impl Bound {
         InputProblem::TooLarge {
             bytes,
             max: self.max,
-            limit: self.limit,
+            cap: self.cap,
         }
     }
 }
@@ -347,7 +347,7 @@ impl SideInput {
     }
 
     fn bound(self) -> Bound {
-        let (max, limit) = match self {
+        let (max, cap) = match self {
             SideInput::Pipeline | SideInput::Body => (MAX_TOML_BYTES, "MAX_TOML_BYTES"),
             SideInput::Phases | SideInput::Contacts => (MAX_JSON_BYTES, "MAX_JSON_BYTES"),
             SideInput::Points => (MAX_POINTS_BYTES, "MAX_POINTS_BYTES"),
@@ -355,7 +355,7 @@ impl SideInput {
             SideInput::Masses => (MAX_MASSES_BYTES, "MAX_MASSES_BYTES"),
             SideInput::Clip => return BVH_BOUND,
         };
-        Bound { max, limit }
+        Bound { max, cap }
     }
 
     fn error(self, path: &Path, problem: InputProblem) -> Error {

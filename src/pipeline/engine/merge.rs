@@ -6,14 +6,14 @@
 //! check:  every shard is a finished shard library; same schema, tool version, options,
 //!         shard count and input list (manifest `shard.inputs_sha256`); indices 1..N once each;
 //!         every table of every shard has the bytes its manifest recorded
-//!         (`library::integrity`), before anything is written
+//!         (`library::storage::integrity`), before anything is written
 //! rows:   every row of a shard belongs to one of the shard's clips, keys unique (checked
 //!         as the rows are read; a failure leaves the previous library in place)
 //! rows:   per-clip tables read forward in clip order from every shard, a batch of clips
 //!         (about one row group of frames) at a time, sorted by the table's keys, appended;
 //!         the per-frame tables (one row group per clip, `schema::group_column`) are not
 //!         decoded: each clip's row groups are copied from its shard, compressed pages and
-//!         all (`library::row_groups`), on a thread of their own beside everything else
+//!         all (`library::storage::row_groups`), on a thread of their own beside everything else
 //! limits: recomputed from the stance and clip facts of the merged rows
 //! polytopes: recomputed from the shards' kinematic samples (`kinematics_samples.parquet`)
 //!         on the worker pool while the row groups are still being copied
@@ -32,18 +32,18 @@ use super::sink::{Defer, Detached, LibrarySink};
 use super::streaming::replace_library;
 use super::tables::Tables;
 use crate::error::{Error, Result};
-use crate::library::group_reader::GroupFileReader;
-use crate::library::integrity::{check_table, recorded_digests, Digests};
-use crate::library::layout::sorted;
-use crate::library::layout::{locate, table_exists, Layout};
-use crate::library::schema::sort_keys;
-use crate::library::schema::{
+use crate::library::codec::schema::sort_keys;
+use crate::library::codec::schema::{
     group_column, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
     KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, STANCES_FILE,
 };
-use crate::library::stream::TableWriter;
-use crate::library::stream::ROW_GROUP_ROWS;
-use crate::library::table::read_parquet;
+use crate::library::codec::table::read_parquet;
+use crate::library::storage::group_reader::GroupFileReader;
+use crate::library::storage::integrity::{check_table, recorded_digests, Digests};
+use crate::library::storage::layout::sorted;
+use crate::library::storage::layout::{locate, table_exists, Layout};
+use crate::library::storage::stream::TableWriter;
+use crate::library::storage::stream::ROW_GROUP_ROWS;
 
 /// What a merge wrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -87,7 +87,7 @@ fn open_shard(dir: &Path) -> Result<ShardLib> {
             format!("no stancelib {MANIFEST_FILE}: the build of this shard did not finish"),
         ));
     }
-    let manifest = crate::library::manifest::read_manifest(dir)?;
+    let manifest = crate::library::codec::manifest::read_manifest(dir)?;
     let Some(index) = manifest
         .pointer("/shard/index")
         .and_then(serde_json::Value::as_u64)
@@ -124,7 +124,7 @@ fn open_shard(dir: &Path) -> Result<ShardLib> {
 }
 
 /// Check every table the merge reads of every shard against its shard's manifest
-/// (content hashes, `library::integrity`), in parallel; the error names the shard and the
+/// (content hashes, `library::storage::integrity`), in parallel; the error names the shard and the
 /// table.
 fn verify_shards(libs: &[ShardLib]) -> Result<()> {
     use rayon::prelude::*;
@@ -404,7 +404,7 @@ fn copy_groups(
     stop: &AtomicBool,
     out: &Path,
 ) -> Result<Detached> {
-    let mut clip_rows = crate::library::integrity::ClipRows::new();
+    let mut clip_rows = crate::library::storage::integrity::ClipRows::new();
     for (clip, _, k) in plan {
         if stop.load(Ordering::Relaxed) {
             return Err(side_ended(out, "the row group copy was stopped"));
@@ -416,7 +416,7 @@ fn copy_groups(
                 .map(|(_, w)| w)
                 .ok_or_else(|| bad(&libs[*k].dir, format!("{}: no writer", g.table)))?;
             let n = g.copy_clip(clip, w, &libs[*k].dir)?;
-            crate::library::integrity::add_clip_rows(&mut clip_rows, clip, g.table, n);
+            crate::library::storage::integrity::add_clip_rows(&mut clip_rows, clip, g.table, n);
         }
     }
     // Every shard's per-clip groups were copied: one left holds a clip its shard's clips
@@ -434,10 +434,10 @@ fn copy_groups(
 /// A `dataset` shard's samples are read partition by partition.
 fn push_samples(sink: &mut LibrarySink, lib: &Path) -> Result<()> {
     for path in locate(lib, KINEMATICS_SAMPLES_FILE)?.files() {
-        let total = crate::library::table::parquet_rows(&path)?;
+        let total = crate::library::codec::table::parquet_rows(&path)?;
         let mut at = 0;
         while at < total {
-            let rows = crate::library::stream::read_rows(&path, at, ROW_GROUP_ROWS)?;
+            let rows = crate::library::storage::stream::read_rows(&path, at, ROW_GROUP_ROWS)?;
             if rows.height() == 0 {
                 break;
             }

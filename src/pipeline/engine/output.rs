@@ -14,17 +14,17 @@
 //!   same folder stops at once with the holder's process id. The file is removed when the
 //!   build ends; one left by a killed build holds no lock and is reused.
 //! - Temporaries `.<name>.tmp-<pid>` of dead processes beside `--out` are removed before
-//!   the build (see [`crate::library::scratch`]); so is `.<name>.old-<pid>` once `--out` is a
+//!   the build (see [`crate::library::storage::scratch`]); so is `.<name>.old-<pid>` once `--out` is a
 //!   library again.
 
 use std::path::{Component, Path, PathBuf};
 
 use super::inputs::file_kind;
 use crate::error::{Error, Result};
-use crate::library::schema::{MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX};
-use crate::library::scratch::{remove_stale, scratch_name, Scratch};
+use crate::library::codec::schema::{MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX};
+use crate::library::storage::scratch::{remove_stale, scratch_name, Scratch};
 
-pub use crate::library::manifest::MAX_MANIFEST_BYTES;
+pub use crate::library::codec::manifest::MAX_MANIFEST_BYTES;
 
 /// Whether a JSON value has the expected type.
 type JsonTypeCheck = fn(&serde_json::Value) -> bool;
@@ -107,7 +107,7 @@ fn refused(out: &Path, why: impl std::fmt::Display) -> Error {
 /// [`MAX_MANIFEST_BYTES`]) has `schema` = `stancelib.library/…`, or every key of the
 /// manifests written before that key.
 pub fn is_library(dir: &Path) -> bool {
-    crate::library::manifest::read_manifest(dir).is_ok_and(|m| manifest_says_library(&m))
+    crate::library::codec::manifest::read_manifest(dir).is_ok_and(|m| manifest_says_library(&m))
 }
 
 /// Refuse a folder of tables `out` (`frames --out`) that holds a stancelib library
@@ -417,7 +417,7 @@ mod lock {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::library::schema::SCHEMA_VERSION;
+    use crate::library::codec::schema::SCHEMA_VERSION;
 
     #[test]
     fn the_manifest_schema_names_the_table_schema_version() {

@@ -14,7 +14,7 @@
 //! manifest:    per clip (content hash, status, rows per table); errors rows
 //! ```
 //! Once the tables are written, the manifest records every file's SHA-256 and each clip's
-//! rows per table ([`crate::library::integrity`]), what an incremental build and a merge
+//! rows per table ([`crate::library::storage::integrity`]), what an incremental build and a merge
 //! check before they take rows from the library.
 //! The samples are the kinematic summary a shard writes (`kinematics_samples.parquet`) and
 //! a merge reads back instead of the frames. Every table is sorted by its keys before it is
@@ -30,37 +30,37 @@ use rayon::prelude::*;
 
 use super::tables::{cast_like, pe, strings, Tables};
 use crate::error::{Error, Result};
-use crate::library::group_reader::GroupFileReader;
-use crate::library::integrity::{
-    add_clip_rows, library_digests, ClipRows, CLIP_ROWS_KEY, TABLES_KEY,
-};
-use crate::library::kinematics::{
+use crate::library::codec::kinematics::{
     add_character_legs, facets_table, points_frame, samples_table, Facet, PointRows, Sample,
 };
-use crate::library::layout::{convert_to_dataset, Layout};
-use crate::library::schema::{
+use crate::library::codec::schema::{
     clips, frames, stances as S, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, KINEMATICS_FILE,
     KINEMATICS_POINTS_FILE, KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, MANIFEST_SCHEMA_PREFIX,
     SCHEMA_VERSION, STANCES_FILE,
 };
-use crate::library::schema::{
+use crate::library::codec::schema::{
     INPUTS_KEY, LAYOUT_MANIFEST_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION,
     TOOL_VERSION_KEY,
 };
-use crate::library::scratch::{scratch_name, Scratch};
-use crate::library::spill::SampleSpill;
-use crate::library::stream::TableWriter;
-use crate::library::stream::ROW_GROUP_ROWS;
-use crate::library::write::write_atomic;
+use crate::library::codec::write::write_atomic;
+use crate::library::storage::group_reader::GroupFileReader;
+use crate::library::storage::integrity::{
+    add_clip_rows, library_digests, ClipRows, CLIP_ROWS_KEY, TABLES_KEY,
+};
+use crate::library::storage::layout::{convert_to_dataset, Layout};
+use crate::library::storage::scratch::{scratch_name, Scratch};
+use crate::library::storage::spill::SampleSpill;
+use crate::library::storage::stream::TableWriter;
+use crate::library::storage::stream::ROW_GROUP_ROWS;
 use crate::stances::limits::{group_facts, limits, ClipFacts, StanceFacts};
 use crate::twopac::hull::{HullOptions, StreamedHull};
-use crate::twopac::kinematic::OutlierRule;
+use crate::twopac::limb_reach::OutlierRule;
 
 /// The scratch file of a library's kinematic samples, in its temporary folder
 /// ([`SampleSpill`]; removed before the folder is swapped into place).
 const SPILL_FILE: &str = "kinematics_samples.spill";
 
-use crate::library::layout::sorted;
+use crate::library::storage::layout::sorted;
 
 fn floats(df: &DataFrame, col: &str) -> Vec<Option<f64>> {
     df.column(col)
@@ -354,8 +354,8 @@ impl LibrarySink {
             "schema_version": SCHEMA_VERSION,
             "tool_version": TOOL_VERSION,
             // Not in the Parquet metadata: these change from run to run (the tables do not).
-            "created_utc": crate::library::provenance::now_utc(),
-            "command_line": crate::library::provenance::command_line(),
+            "created_utc": crate::library::codec::provenance::now_utc(),
+            "command_line": crate::library::codec::provenance::command_line(),
             "options": serde_json::from_str::<serde_json::Value>(fingerprint).unwrap_or_default(),
             "inputs": self.inputs,
             "limits": lim,
@@ -377,7 +377,7 @@ impl LibrarySink {
             }
         }
         let text = serde_json::to_string_pretty(&manifest).unwrap_or_default();
-        crate::library::atomic::write_text_atomic(&dir.join(MANIFEST_FILE), &text)
+        crate::library::storage::atomic::write_text_atomic(&dir.join(MANIFEST_FILE), &text)
     }
 
     /// The footers of the sink's own tables, `errors.parquet`, the samples (a shard's) and
@@ -474,7 +474,7 @@ fn write_samples(spill: &SampleSpill, dir: &Path, kv: &[(String, String)]) -> Re
 /// written into `dir`: per (character, effector) the outlier rules ([`OutlierRule`], three
 /// passes over the spilled group) and one more pass that streams the kept samples to the
 /// table and into the polytope's [`StreamedHull`] (bounded memory: see the module docs
-/// of [`crate::twopac::kinematic`]); a group with fewer than 4 non-coplanar points after
+/// of [`crate::twopac::limb_reach`]); a group with fewer than 4 non-coplanar points after
 /// the rules has points but no facets (an error at query time).
 ///
 /// The groups are reduced in parallel on the worker pool ([`reduce_group`]), each writing

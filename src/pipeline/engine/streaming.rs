@@ -16,7 +16,7 @@
 //! same, byte for byte, as a full rebuild (rows are re-sorted by the same keys and cast to
 //! the same schema). Nothing is taken from a table whose bytes are not those its manifest
 //! recorded, nor from a clip whose rows are not as many as recorded
-//! ([`crate::library::integrity`]): those clips are rebuilt and the summary says why.
+//! ([`crate::library::storage::integrity`]): those clips are rebuilt and the summary says why.
 //!
 //! With a [`Shard`], only the inputs of that shard are built, and the library also keeps
 //! its kinematic samples and a `shard` entry in its manifest for [`super::merge`].
@@ -24,7 +24,7 @@
 //! Layout of a library folder: `frames.parquet`, `contacts.parquet`, `clips.parquet`,
 //! `stances.parquet`, `errors.parquet`, `manifest.json` (spec stance-model §11); with
 //! [`Layout::Dataset`] each table is a hive-partitioned dataset instead
-//! ([`crate::library::layout`]). `incremental` reads the previous library in its layout.
+//! ([`crate::library::storage::layout`]). `incremental` reads the previous library in its layout.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -45,18 +45,18 @@ use super::sink::LibrarySink;
 use super::tables::{combine, strings, BuildReport, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
-use crate::library::integrity::{
+use crate::library::codec::provenance::library_layout;
+use crate::library::codec::schema::{clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION};
+use crate::library::codec::stances::{first_non_finite, ErrorRow};
+use crate::library::codec::table::read_parquet;
+use crate::library::storage::integrity::{
     check_clip_rows, check_table, recorded_clip_rows, recorded_digests, Mismatch,
 };
-use crate::library::layout::Layout;
-use crate::library::provenance::library_layout;
-use crate::library::schema::{clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION};
-use crate::library::scratch::{scratch_name, Scratch};
-use crate::library::stances::{first_non_finite, ErrorRow};
-use crate::library::table::read_parquet;
+use crate::library::storage::layout::Layout;
+use crate::library::storage::scratch::{scratch_name, Scratch};
 use crate::library::{ClipRecord, ClipStatus, Status};
-use crate::stances::build::StanceNote;
-use crate::stances::{build_clip, Stance, StanceOptions};
+use crate::stances::assemble::StanceNote;
+use crate::stances::{assemble_clip, Stance, StanceOptions};
 
 /// How a build runs: none of it changes the rows of a clip.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -160,7 +160,7 @@ fn build_named(named: &[(PathBuf, String)], opts: &BuildOptions, bar: &Progress)
         .par_iter()
         .map(|(path, clip)| build_one(path, clip, opts, bar))
         .collect();
-    assemble(per_clip)
+    report_of(per_clip)
 }
 
 /// One clip ingested and its stances built, counted on `bar`.
@@ -172,7 +172,7 @@ fn build_one(
 ) -> (ClipRecord, ClipStances) {
     let r = ingest_file(path, clip.to_string(), &opts.ingest);
     let out = match (&r.frames, r.status) {
-        (Some(fr), Status::Ok) => build_clip(
+        (Some(fr), Status::Ok) => assemble_clip(
             &r.clip,
             fr,
             &r.summary,
@@ -210,7 +210,7 @@ fn refuse_non_finite(mut r: ClipRecord, out: ClipStances) -> (ClipRecord, ClipSt
 
 /// The report of a batch of built clips: records in clip order, their error rows (failed
 /// inputs, ingests and stance fits) and their stances sorted by (clip, first frame, label).
-fn assemble(mut per_clip: Vec<(ClipRecord, ClipStances)>) -> BuildReport {
+fn report_of(mut per_clip: Vec<(ClipRecord, ClipStances)>) -> BuildReport {
     per_clip.sort_by(|a, b| a.0.clip.cmp(&b.0.clip));
     let (mut records, per_clip): (Vec<ClipRecord>, Vec<ClipStances>) = per_clip.into_iter().unzip();
     let mut errors: Vec<ErrorRow> = records
@@ -265,11 +265,11 @@ const REFUSED_CLIPS_NAMED: usize = 10;
 
 /// Clips of the previous library at `out` that can be reused for `named`: the library's
 /// options and layout are this build's, every table it gives rows from has the content
-/// hash its manifest recorded ([`crate::library::integrity`]), and per clip the input's
+/// hash its manifest recorded ([`crate::library::storage::integrity`]), and per clip the input's
 /// path and content are unchanged and its rows in every table are as many as recorded.
 /// Anything else is rebuilt, with a line in `refused` saying why.
 fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str, joints: bool) -> Reuse {
-    let Ok(manifest) = crate::library::manifest::read_manifest(out) else {
+    let Ok(manifest) = crate::library::codec::manifest::read_manifest(out) else {
         return Reuse::default();
     };
     let all = |why: String| Reuse {
@@ -519,7 +519,7 @@ pub fn build_into(
             &batches,
             |b| &b.todo,
             |(path, clip)| build_one(path, clip, opts, &bar),
-            |b, per_clip| write(assemble(per_clip), b.last),
+            |b, per_clip| write(report_of(per_clip), b.last),
         )?;
         bar.bar.finish_and_clear();
         sink.finish(&fingerprint, t0, shard_entry.clone(), plan.layout)

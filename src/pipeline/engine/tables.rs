@@ -5,12 +5,12 @@
 use polars::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::library::layout::sorted;
-use crate::library::schema::{
+use crate::library::codec::schema::{
     ADDED_COLUMNS, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE, STANCES_FILE,
 };
-use crate::library::stances::{errors_table, stances_table, ErrorRow};
-use crate::library::write::{clips_table, contacts_table, frames_table, joints_table};
+use crate::library::codec::stances::{errors_table, stances_table, ErrorRow};
+use crate::library::codec::write::{clips_table, contacts_table, frames_table, joints_table};
+use crate::library::storage::layout::sorted;
 use crate::library::ClipRecord;
 use crate::stances::Stance;
 

@@ -34,7 +34,7 @@ fn approx_never_accepts_what_exact_rejects() {
     for _ in 0..30 {
         let model = random_model(&mut rng);
         let ctx = random_context(&mut rng);
-        let tables = SampledTables::new(&model);
+        let grids = SampledGrids::new(&model);
         let coef = precompute(&model, &ctx);
         let base = relative_limits(&coef);
         for _ in 0..100 {
@@ -44,7 +44,7 @@ fn approx_never_accepts_what_exact_rejects() {
                 ..base
             };
             let beta = beta_in(&mut rng, 0.0, 3.0);
-            let v = exact(&tables, &model, &ctx, beta, &lim);
+            let v = exact(&grids, &model, &ctx, beta, &lim);
             let exact_ok = v.f_peak <= lim.f_max && v.mu_req <= lim.mu;
             if approx(coef.a_f, coef.a_mu, beta, &lim) {
                 accepted += 1;
@@ -91,10 +91,10 @@ fn identity_query_is_feasible_and_reports_original_extremes() {
     for _ in 0..40 {
         let model = random_model(&mut rng);
         let ctx = random_context(&mut rng);
-        let tables = SampledTables::new(&model);
+        let grids = SampledGrids::new(&model);
         let coef = precompute(&model, &ctx);
-        let v = exact(&tables, &model, &ctx, [1.0; 3], &relative_limits(&coef));
-        // Same tables and the same operation order as precompute: 1e-9 relative is loose.
+        let v = exact(&grids, &model, &ctx, [1.0; 3], &relative_limits(&coef));
+        // Same grids and the same operation order as precompute: 1e-9 relative is loose.
         assert!(close(v.f_peak, coef.f_peak, 1e-9), "{v:?} {coef:?}");
         assert!(close(v.mu_req, coef.mu_req, 1e-9));
         assert!(close(v.ext_min, coef.ext_min, 1e-9));
@@ -109,7 +109,7 @@ fn identity_query_is_feasible_and_reports_original_extremes() {
                 chi_min: coef.ext_min,
                 chi_max: coef.ext_max,
             };
-            assert!(exact(&tables, &model, &ctx, [1.0; 3], &tight).feasible);
+            assert!(exact(&grids, &model, &ctx, [1.0; 3], &tight).feasible);
         } else {
             assert_eq!(v.violated, Some(Violation::Unilateral));
         }
@@ -151,7 +151,7 @@ fn pulling_dip_is_infeasible_for_every_beta() {
     };
     let coef = precompute(&model, &ctx);
     assert!(!coef.unilateral_ok);
-    let tables = SampledTables::new(&model);
+    let grids = SampledGrids::new(&model);
     let generous = Limits {
         mu: 1e12,
         f_max: 1e12,
@@ -162,7 +162,7 @@ fn pulling_dip_is_infeasible_for_every_beta() {
     let mut betas = vec![[0.0; 3], [1.0; 3], [0.0, 0.0, 1.0], [3.0, 0.0, 0.0]];
     betas.extend((0..500).map(|_| beta_in(&mut rng, 0.0, 3.0)));
     for beta in betas {
-        let v = exact(&tables, &model, &ctx, beta, &generous);
+        let v = exact(&grids, &model, &ctx, beta, &generous);
         assert!(!v.feasible, "β = {beta:?}");
         if beta.iter().all(|&b| b > 0.0) {
             assert_eq!(v.violated, Some(Violation::Unilateral));
@@ -180,7 +180,7 @@ fn exact_never_panics_on_bad_input() {
     };
     let ctx = QueryContext::default();
     let empty = exact(
-        &SampledTables::default(),
+        &SampledGrids::default(),
         &ForceModel::default(),
         &ctx,
         [1.0; 3],
@@ -189,19 +189,19 @@ fn exact_never_panics_on_bad_input() {
     assert_eq!(empty.violated, Some(Violation::Friction));
     let mut rng = Rng::new(5);
     let model = random_model(&mut rng);
-    let tables = SampledTables::new(&model);
-    let nan = exact(&tables, &model, &ctx, [f64::NAN, 1.0, 1.0], &lim);
+    let grids = SampledGrids::new(&model);
+    let nan = exact(&grids, &model, &ctx, [f64::NAN, 1.0, 1.0], &lim);
     assert_eq!(nan.violated, Some(Violation::Beta));
     let nan_lim = Limits {
         mu: f64::NAN,
         ..lim
     };
-    assert!(!exact(&tables, &model, &ctx, [1.0; 3], &nan_lim).feasible);
+    assert!(!exact(&grids, &model, &ctx, [1.0; 3], &nan_lim).feasible);
     let bad = ForceModel {
         mass_kg: f64::NAN,
         ..model.clone()
     };
-    assert!(!exact(&SampledTables::new(&bad), &bad, &ctx, [1.0; 3], &lim).feasible);
+    assert!(!exact(&SampledGrids::new(&bad), &bad, &ctx, [1.0; 3], &lim).feasible);
     assert!(contact_point(&bad, [1.0; 3], &ctx, [0.0; 3]).is_none());
     // No vertical impulse: u* is undetermined.
     assert!(contact_point(&model, [1.0, 1.0, 0.0], &ctx, [0.0; 3]).is_none());
@@ -344,7 +344,7 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
             z_td: ctx.z_td * l,
             cp: ctx.cp.map(|c| c * l),
         };
-        let (tables, s_tables) = (SampledTables::new(&model), SampledTables::new(&s_model));
+        let (grids, s_grids) = (SampledGrids::new(&model), SampledGrids::new(&s_model));
         let h_des = coef.ang_impulse;
         let s_h_des = h_des.map(|h| h * m * l.powf(1.5));
         for _ in 0..25 {
@@ -361,8 +361,8 @@ fn verdicts_are_invariant_under_dynamic_similarity() {
                 chi_min: lim.chi_min * l,
                 chi_max: lim.chi_max * l,
             };
-            let v = exact(&tables, &model, &ctx, beta, &lim);
-            let s = exact(&s_tables, &s_model, &s_ctx, beta, &s_lim);
+            let v = exact(&grids, &model, &ctx, beta, &lim);
+            let s = exact(&s_grids, &s_model, &s_ctx, beta, &s_lim);
             assert_eq!(v.violated, s.violated, "{v:?} vs {s:?}");
             // Same grid, scaled inputs: only round-off differs (1e-9 relative is loose).
             assert!(close(s.f_peak, v.f_peak * m, 1e-9));
@@ -398,24 +398,24 @@ fn exact_at_resolved_contact_point() {
         let model = random_model(&mut rng);
         let ctx = random_context(&mut rng);
         let coef = precompute(&model, &ctx);
-        let (tables, moments) = (SampledTables::new(&model), ImpulseMoments::new(&model));
+        let (grids, moments) = (SampledGrids::new(&model), ImpulseMoments::new(&model));
         let lim = relative_limits(&coef);
         let h = coef.ang_impulse;
         // Identity: u* = cp (to ~1e-12 m), so the extremes match precompute's; 1e-9 relative.
-        let (v, u) = exact_at_contact_point(&tables, &model, &moments, &ctx, [1.0; 3], h, &lim);
+        let (v, u) = exact_at_contact_point(&grids, &model, &moments, &ctx, [1.0; 3], h, &lim);
         assert!(u.is_some() && close(v.ext_max, coef.ext_max, 1e-9));
         assert!(close(v.ext_min, coef.ext_min, 1e-9));
         // A scaled query is checked at its own u*, not at the data contact point.
         let beta = beta_in(&mut rng, 0.5, 2.0);
-        let (v, u) = exact_at_contact_point(&tables, &model, &moments, &ctx, beta, h, &lim);
+        let (v, u) = exact_at_contact_point(&grids, &model, &moments, &ctx, beta, h, &lim);
         let u = u.unwrap();
         assert_eq!(
             v,
-            exact(&tables, &model, &QueryContext { cp: u, ..ctx }, beta, &lim)
+            exact(&grids, &model, &QueryContext { cp: u, ..ctx }, beta, &lim)
         );
         // No vertical impulse: falls back to ctx.cp and reports no u*.
         let flat = [1.0, 1.0, 0.0];
-        let (v, u) = exact_at_contact_point(&tables, &model, &moments, &ctx, flat, h, &lim);
-        assert!(u.is_none() && v == exact(&tables, &model, &ctx, flat, &lim));
+        let (v, u) = exact_at_contact_point(&grids, &model, &moments, &ctx, flat, h, &lim);
+        assert!(u.is_none() && v == exact(&grids, &model, &ctx, flat, &lim));
     }
 }

@@ -138,7 +138,7 @@ fn axis_parse_refuses_bad_and_huge_ranges() {
     assert!(
         matches!(
             e.kind,
-            ErrorKind::Limit {
+            ErrorKind::Cap {
                 max: MAX_AXIS_VALUES,
                 ..
             }

@@ -198,12 +198,12 @@ pub fn forward_frames(
 }
 
 /// Forward kinematics of one frame with libm's `sin_cos` per channel ([`rotate_right`]):
-/// what [`forward`] computed before the batched sines and cosines, kept as the reference
-/// the tests and benchmarks compare against (within 1e-12, see module `simd`).
+/// what [`forward`] computed before the batched sines and cosines, kept for the tests and
+/// benchmarks to compare against (within 1e-12, see module `simd`).
 ///
 /// # Panics
 /// As [`forward`]; `rot` is per-joint scratch of `skel.n_joints()` rotations.
-pub fn forward_reference(skel: &Skeleton, rot: &mut [Mat3], row: &[f64], points: &mut [[f64; 3]]) {
+pub fn forward_libm(skel: &Skeleton, rot: &mut [Mat3], row: &[f64], points: &mut [[f64; 3]]) {
     assert!(row.len() >= skel.n_channels && points.len() >= skel.n_points());
     for j in 0..skel.n_joints() {
         let t = local_translation(skel, j, row);
@@ -399,7 +399,7 @@ mod tests {
                 );
                 // Points within about 40 units of the root through up to 15 rotations, each
                 // sine and cosine within 1e-15 of libm's: well under 1e-12.
-                forward_reference(&skel, &mut rot, b.motion.row(f), &mut libm);
+                forward_libm(&skel, &mut rot, b.motion.row(f), &mut libm);
                 for (p, q) in one.iter().zip(&libm) {
                     for a in 0..3 {
                         let d = (p[a] - q[a]).abs();

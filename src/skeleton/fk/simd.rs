@@ -19,7 +19,7 @@
 //! exactly reduced angle up to ±10⁶ degrees (angles beyond 2⁴⁴ degrees take libm).
 //! Through a chain of rotations a point moves by at most a few ulp of its distance from
 //! the root: well under 1e-12 m for a human skeleton (the tests check 1e-12 against the
-//! libm FK, [`super::forward_reference`]).
+//! libm FK, [`super::forward_libm`]).
 //!
 //! # Same bits on every path
 //! Rust never contracts a multiply and an add into an FMA on its own (no fast-math), and
@@ -39,7 +39,7 @@ type Lanes<const L: usize> = [f64; L];
 /// The instruction set of [`super::forward_frames`]' batches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Simd {
-    /// Plain code (SSE2 on x86_64): the fallback, and the reference of the tests.
+    /// Plain code (SSE2 on x86_64): the fallback, and what the tests check AVX2 against.
     Scalar,
     /// AVX2 with FMA, when the CPU reports both (x86_64 only).
     Avx2,

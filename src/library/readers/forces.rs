@@ -18,13 +18,13 @@ use std::path::Path;
 
 use polars::prelude::*;
 
-use super::columns::col;
 use super::read::read_stances;
-use super::schema::{clips, frames, stances};
-use super::stances::PoolStance;
-use super::table::Table;
 use crate::error::{Error, Result};
 use crate::force_model::export::{sample_forces, StanceTimes};
+use crate::library::codec::columns::col;
+use crate::library::codec::schema::{clips, frames, stances};
+use crate::library::codec::stances::PoolStance;
+use crate::library::codec::table::Table;
 use crate::skeleton::units::UpAxis;
 use crate::stances::params::{Heading, HeadingFrom};
 

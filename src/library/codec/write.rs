@@ -2,7 +2,7 @@
 //!
 //! Rows are sorted by stable keys (`clip`, then frame or effector) before writing, with
 //! fixed writer settings (zstd, statistics on, row groups of exactly 64 Ki rows, the last
-//! one shorter: [`super::stream`]), so the files
+//! one shorter: [`crate::library::storage::stream`]), so the files
 //! do not depend on thread count or input order.
 
 use std::path::{Path, PathBuf};
@@ -13,11 +13,11 @@ use rayon::prelude::*;
 use super::columns::col;
 
 use super::schema::*;
-use super::scratch::{remove_stale, Scratch};
-use super::stream::TableWriter;
-use super::ClipRecord;
 use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
+use crate::library::storage::scratch::{remove_stale, Scratch};
+use crate::library::storage::stream::TableWriter;
+use crate::library::ClipRecord;
 
 fn polars_err(path: &Path, e: PolarsError) -> Error {
     Error::io(path, "cannot build table", e)
@@ -350,7 +350,7 @@ pub fn joints_table(records: &[ClipRecord]) -> PolarsResult<DataFrame> {
 
 /// Write a table to `dir/name` atomically: a temporary file in `dir`, then a rename, so a
 /// reader never sees a half-written file and an earlier file survives a failed write. The
-/// layout is that of [`TableWriter`] (row groups of [`ROW_GROUP_ROWS`](super::stream::ROW_GROUP_ROWS) rows), so a table
+/// layout is that of [`TableWriter`] (row groups of [`ROW_GROUP_ROWS`](crate::library::storage::stream::ROW_GROUP_ROWS) rows), so a table
 /// written whole equals the same rows written in batches, byte for byte.
 ///
 /// # Errors
@@ -391,7 +391,7 @@ impl FramesWriter {
             .map_err(|e| Error::io(dir, "cannot create output folder", e))?;
         let scratch: Vec<String> = FRAMES_RUN_FILES
             .iter()
-            .flat_map(|t| super::row_groups::scratch_stems(t))
+            .flat_map(|t| crate::library::storage::row_groups::scratch_stems(t))
             .collect();
         let mut names: Vec<&str> = FRAMES_RUN_FILES.to_vec();
         names.extend(scratch.iter().map(String::as_str));
@@ -494,7 +494,7 @@ mod base64_tests {
             ("foobar", "Zm9vYmFy"),
         ] {
             assert_eq!(
-                crate::library::stream::base64(plain.as_bytes()),
+                crate::library::storage::stream::base64(plain.as_bytes()),
                 coded,
                 "{plain}"
             );

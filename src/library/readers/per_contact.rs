@@ -22,15 +22,17 @@ use std::path::Path;
 
 use polars::prelude::*;
 
-use super::columns::col;
-use super::schema::{clips, contacts, frames, CLIPS_FILE, CONTACTS_FILE, FRAMES_FILE};
-use super::table::Table;
 use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
 use crate::force_model::per_contact::{
     foot_cop, heading_from_velocity, split, ContactSpan, SplitInput, SplitOptions,
 };
 use crate::force_model::GRAVITY;
+use crate::library::codec::columns::col;
+use crate::library::codec::schema::{
+    clips, contacts, frames, CLIPS_FILE, CONTACTS_FILE, FRAMES_FILE,
+};
+use crate::library::codec::table::Table;
 use crate::math::v3::V3;
 use crate::skeleton::units::NOMINAL_LEG_M;
 
@@ -84,7 +86,7 @@ fn xyz(t: &Table, names: [&str; 3]) -> Result<Vec<V3>> {
 }
 
 /// Reads `clip` from the library `lib` (frames, contacts, mass and leg length). The
-/// caller checks the library's layout first ([`super::provenance::check_layout`]; `forces`
+/// caller checks the library's layout first ([`crate::library::codec::provenance::check_layout`]; `forces`
 /// does so once for either of its paths).
 ///
 /// # Errors

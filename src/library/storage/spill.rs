@@ -24,9 +24,9 @@ use std::sync::Arc;
 
 use polars::prelude::*;
 
-use super::kinematics::Sample;
-use super::schema::kinematics as K;
 use crate::error::{Error, Result};
+use crate::library::codec::kinematics::Sample;
+use crate::library::codec::schema::kinematics as K;
 
 /// Bytes of one spilled sample: the frame and the three coordinates.
 pub const RECORD_BYTES: usize = 32;
@@ -84,12 +84,12 @@ impl SampleSpill {
     }
 
     /// Append the rows of a samples table sorted by
-    /// [`super::kinematics::SAMPLES_SORT_KEYS`] (rows with a null are skipped).
+    /// [`crate::library::codec::kinematics::SAMPLES_SORT_KEYS`] (rows with a null are skipped).
     ///
     /// # Errors
     /// A column is missing or of another type, or the write fails.
     pub fn add(&mut self, samples: &DataFrame) -> Result<()> {
-        let name = super::schema::KINEMATICS_SAMPLES_FILE;
+        let name = crate::library::codec::schema::KINEMATICS_SAMPLES_FILE;
         let bad = |e: PolarsError| Error::io(name, "samples of another schema", e);
         let str_col = |n: &str| -> Result<StringChunked> {
             Ok(samples.column(n).map_err(bad)?.str().map_err(bad)?.clone())
@@ -282,7 +282,7 @@ impl Drop for SampleSpill {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::library::kinematics::points_frame;
+    use crate::library::codec::kinematics::points_frame;
 
     fn sample(clip: &str, frame: i64, v: f64) -> Sample {
         Sample {

@@ -380,7 +380,7 @@ impl TableWriter {
         let path = dir.join(name);
         let tmp = dir.join(scratch_name(name, Scratch::Tmp));
         let schema = empty.schema().as_ref().clone();
-        let group_keys = super::schema::group_keys(name);
+        let group_keys = crate::library::codec::schema::group_keys(name);
         let (group_schema, mut columns) =
             group_schema(&schema).map_err(|e| io(&path, "cannot write parquet", e))?;
         if !group_keys.is_empty() {

@@ -1,5 +1,5 @@
-//! Issue 11 item 6: bounded work from small inputs (every documented limit refused before
-//! any work, exit 2, the field and the limit named, nothing written): query ranges, map
+//! Issue 11 item 6: bounded work from small inputs (every documented work cap refused before
+//! any work, exit 2, the field and the cap named, nothing written): query ranges, map
 //! grids, threads, twopac inputs, `synth`. Items 10–12 are in `safety_options`.
 //!
 //! Everything runs on the committed fixtures (`fixtures/bvh`, `fixtures/twopac`).
@@ -8,7 +8,7 @@ use crate::util::{fixture_clips, fixture_library, ok, refused, root, s};
 use std::path::Path;
 
 use polars::prelude::*;
-use stancelib::library::table::read_parquet;
+use stancelib::library::codec::table::read_parquet;
 
 // ---------------------------------------------------------------- item 6: query ranges
 

@@ -42,7 +42,7 @@ pub const MANIFEST_FILE: &str = "manifest.json";
 pub const MANIFEST_SCHEMA_PREFIX: &str = "stancelib.library/";
 
 /// Key of `manifest.json` naming the library's layout (`file` or `dataset`,
-/// [`super::layout::Layout`]); a manifest without it is a `file` library.
+/// [`crate::library::storage::layout::Layout`]); a manifest without it is a `file` library.
 pub const LAYOUT_MANIFEST_KEY: &str = "layout";
 /// The hive partition column of a `dataset` library's tables that have it.
 pub const PARTITION_COLUMN: &str = "character_id";

@@ -35,12 +35,12 @@ use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
 
-use super::schema::{
+use super::stream::TableWriter;
+use crate::error::{Error, Result};
+use crate::library::codec::schema::{
     sort_keys, CLIPS_FILE, DATASET_PART_FILE, HIVE_NULL_PARTITION, INPUTS_KEY, LAYOUT_MANIFEST_KEY,
     LIMITS_KEY, MANIFEST_FILE, PARTITIONED_FILES, PARTITION_COLUMN, STANCES_FILE, TABLE_FILES,
 };
-use super::stream::TableWriter;
-use crate::error::{Error, Result};
 
 /// How a library's tables are laid out on disk (module docs).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -134,7 +134,7 @@ pub fn check_output_outside(lib: &Path, out: &Path) -> Result<()> {
 /// The manifest names a layout this tool does not know (the key is named).
 pub fn layout_of(lib: &Path) -> Result<Layout> {
     let path = lib.join(MANIFEST_FILE);
-    let Ok(m) = super::manifest::read_manifest(lib) else {
+    let Ok(m) = crate::library::codec::manifest::read_manifest(lib) else {
         return Ok(Layout::File);
     };
     match m.get(LAYOUT_MANIFEST_KEY) {

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Result;
 
-use super::stances::PoolStance;
-pub use super::stances::{read_stance_timing, read_stances};
-use super::table::{opt_strings, Table};
+use crate::library::codec::stances::PoolStance;
+pub use crate::library::codec::stances::{read_stance_timing, read_stances};
+use crate::library::codec::table::{opt_strings, Table};
 
-use super::schema::{clips, CLIPS_FILE, STANCES_FILE};
+use crate::library::codec::schema::{clips, CLIPS_FILE, STANCES_FILE};
 
 /// Per-clip facts the queries need from `clips.parquet`.
 #[derive(Debug, Clone, PartialEq)]
@@ -94,10 +94,10 @@ pub fn read_clip_info(path: &Path) -> Result<BTreeMap<String, ClipInfo>> {
 /// Opens a library folder: its stances and clips.
 ///
 /// # Errors
-/// A library of another table layout ([`super::provenance::check_layout`]), a missing or
+/// A library of another table layout ([`crate::library::codec::provenance::check_layout`]), a missing or
 /// unreadable `stances.parquet` or `clips.parquet` (the error names it).
 pub fn open_library(dir: &Path) -> Result<StanceLibrary> {
-    super::provenance::check_layout(dir)?;
+    crate::library::codec::provenance::check_layout(dir)?;
     Ok(StanceLibrary {
         dir: dir.to_path_buf(),
         stances: read_stances(&dir.join(STANCES_FILE))?,

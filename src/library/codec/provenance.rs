@@ -27,7 +27,7 @@ use crate::skeleton::com::Sex;
 ///
 /// # Examples
 /// ```
-/// use stancelib::library::provenance::utc_rfc3339;
+/// use stancelib::library::codec::provenance::utc_rfc3339;
 /// assert_eq!(utc_rfc3339(0), "1970-01-01T00:00:00Z");
 /// assert_eq!(utc_rfc3339(951_782_400), "2000-02-29T00:00:00Z");
 /// ```

@@ -92,7 +92,7 @@ fn per_frame_tables_have_a_row_group_per_clip() {
         parts[3].clone(),
     ];
     let serial = serial_bytes(&groups, &[]);
-    let name = super::super::schema::FRAMES_FILE;
+    let name = crate::library::codec::schema::FRAMES_FILE;
     for cut in [usize::MAX, 7, 4000] {
         let d = tempfile::tempdir().unwrap();
         let mut w = TableWriter::create(d.path(), name, &all.clear()).unwrap();
@@ -146,7 +146,7 @@ fn a_long_clip_name_keeps_whole_statistics() {
         "frame" => [0i64, 1, 0],
     }
     .unwrap();
-    let name = super::super::schema::FRAMES_FILE;
+    let name = crate::library::codec::schema::FRAMES_FILE;
     let d = tempfile::tempdir().unwrap();
     let mut w = TableWriter::create(d.path(), name, &df.clear()).unwrap();
     w.push(&df).unwrap();
@@ -164,7 +164,7 @@ fn a_pushed_group_equals_its_rows() {
         "frame" => [0i64, 1, 0, 1, 2, 0],
     }
     .unwrap();
-    let name = super::super::schema::FRAMES_FILE;
+    let name = crate::library::codec::schema::FRAMES_FILE;
     let d = tempfile::tempdir().unwrap();
     let rows = d.path().join("rows");
     let groups = d.path().join("groups");

@@ -8,7 +8,7 @@
 //!
 //! # Examples
 //! ```
-//! use stancelib::library::manifest::read_manifest;
+//! use stancelib::library::codec::manifest::read_manifest;
 //! let d = tempfile::tempdir().unwrap();
 //! std::fs::write(d.path().join("manifest.json"), r#"{"schema_version": "4"}"#).unwrap();
 //! assert_eq!(read_manifest(d.path()).unwrap()["schema_version"], "4");
@@ -33,14 +33,14 @@ pub fn manifest_path(lib: &Path) -> PathBuf {
 ///
 /// # Errors
 /// The file cannot be opened or read (the OS reason in the chain), is not a regular
-/// file, or is larger than [`MAX_MANIFEST_BYTES`] (the error names the limit).
+/// file, or is larger than [`MAX_MANIFEST_BYTES`] (the error names the cap).
 pub fn read_manifest_bytes(lib: &Path) -> Result<Vec<u8>> {
     let path = manifest_path(lib);
     let what = "library manifest";
     let too_large = |bytes: u64| InputProblem::TooLarge {
         bytes,
         max: MAX_MANIFEST_BYTES,
-        limit: "MAX_MANIFEST_BYTES",
+        cap: "MAX_MANIFEST_BYTES",
     };
     // Inspected before it is opened: opening a FIFO would block.
     let meta = std::fs::metadata(&path).map_err(|e| Error::io(&path, "cannot read", e))?;

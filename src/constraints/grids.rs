@@ -1,4 +1,4 @@
-//! Sampled tables of one force model on its evaluation grid (spec stance-model §7.2).
+//! Sampled grids: one force model's functions on its evaluation grid (spec stance-model §7.2).
 //!
 //! # Model
 //!
@@ -35,8 +35,8 @@ use std::f64::consts::TAU;
 
 /// `f_a(τ_k)` and `S_a(τ_k)` of one stance on its grid; reusable across stances.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SampledTables {
-    /// `λ_act` of the exact friction check on these tables: the active set is
+pub struct SampledGrids {
+    /// `λ_act` of the exact friction check on these grids: the active set is
     /// `f_v ≥ λ_act · max f_v`; [`super::ACTIVE_FRACTION`] unless a query sets it.
     pub active_fraction: f64,
     /// The grid `τ_k = k/(N_s − 1)` (equal to `ForceModel::grid`), dimensionless.
@@ -53,9 +53,9 @@ pub struct SampledTables {
     unit_circle: Vec<(f64, f64)>,
 }
 
-impl Default for SampledTables {
+impl Default for SampledGrids {
     fn default() -> Self {
-        SampledTables {
+        SampledGrids {
             active_fraction: super::ACTIVE_FRACTION,
             tau: Vec::new(),
             f: Default::default(),
@@ -67,15 +67,15 @@ impl Default for SampledTables {
     }
 }
 
-impl SampledTables {
+impl SampledGrids {
     /// Tables of `model` on its own grid.
     pub fn new(model: &ForceModel) -> Self {
-        let mut tables = Self::default();
-        tables.rebuild(model);
-        tables
+        let mut grids = Self::default();
+        grids.rebuild(model);
+        grids
     }
 
-    /// Refills the tables for `model`, keeping the allocations (and the unit-circle table
+    /// Refills the grids for `model`, keeping the allocations (and the unit-circle table
     /// when the grid size is unchanged).
     pub fn rebuild(&mut self, model: &ForceModel) {
         let n = model.grid_len();

@@ -4,7 +4,7 @@
 //! # Model
 //! ```text
 //! point:    ʳc = R_eᵀ (c − p_e)        COM in the effector's contact frame (m)
-//!           ([`crate::kinematics::com_in_contact_frame`])
+//!           ([`crate::contacts::contact_runs::com_in_contact_frame`])
 //! outliers: per (character, effector): drop |ʳc − centroid| > P99.5 of those distances,
 //!           and |ʳc| > 1.3 · L_leg
 //! hull:     K_e ʳc ≤ k_e, unit outward rows, coplanar facets merged (≥ 4 non-coplanar points)

@@ -1,5 +1,5 @@
 use super::*;
-use crate::library::group_reader::GroupFileReader;
+use crate::library::storage::group_reader::GroupFileReader;
 use polars::prelude::*;
 
 /// A table of `n` rows: strings (dictionary pages), integers, floats, nulls, lists.

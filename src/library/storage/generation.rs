@@ -27,7 +27,7 @@
 //!
 //! # Examples
 //! ```
-//! use stancelib::library::generation::{generation, read_consistently};
+//! use stancelib::library::storage::generation::{generation, read_consistently};
 //! let d = tempfile::tempdir().unwrap();
 //! std::fs::write(d.path().join("manifest.json"), "{}").unwrap();
 //! let before = generation(d.path());
@@ -55,7 +55,7 @@ pub struct Generation(Option<[u8; 32]>);
 /// The generation of the library at `lib` now (module docs).
 pub fn generation(lib: &Path) -> Generation {
     Generation(
-        super::manifest::read_manifest_bytes(lib)
+        crate::library::codec::manifest::read_manifest_bytes(lib)
             .ok()
             .map(|b| Sha256::digest(&b).into()),
     )

@@ -5,11 +5,11 @@ use std::path::Path;
 
 use polars::prelude::*;
 
-use super::schema::{clips, flights, frames, CLIPS_FILE, FRAMES_FILE};
-use super::table::Table;
 /// The support effectors, in the order of the contact bars.
 pub use crate::contacts::EFFECTORS;
 use crate::error::{Error, Result};
+use crate::library::codec::schema::{clips, flights, frames, CLIPS_FILE, FRAMES_FILE};
+use crate::library::codec::table::Table;
 
 /// One flight of `clips.parquet` (`flights`), the fields the plot uses.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,7 +49,7 @@ pub struct ClipView {
 /// A missing or malformed table, or a clip the library does not hold (the error lists a
 /// few clip names it does hold).
 pub fn read_clip_view(lib: &Path, clip: &str) -> Result<ClipView> {
-    super::provenance::check_layout(lib)?;
+    crate::library::codec::provenance::check_layout(lib)?;
     let [vx_name, vy_name, _] = frames::COM_V;
     let mut names = vec![
         frames::CLIP,

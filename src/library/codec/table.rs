@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
 
-use super::layout::{locate_path, read_source};
 use crate::error::{Error, Result};
+use crate::library::storage::layout::{locate_path, read_source};
 
 /// Read a Parquet file into a DataFrame; a library table's `file`-layout path
 /// (`LIB/stances.parquet`) reads the table in the library's layout
-/// ([`super::layout::locate_path`]).
+/// ([`crate::library::storage::layout::locate_path`]).
 ///
 /// # Errors
 /// The file cannot be opened or is not valid Parquet.

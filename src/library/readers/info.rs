@@ -8,11 +8,13 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::provenance::manifest_sha256;
 use super::read::same_content;
-use super::schema::{clips, errors, stances as S, CLIPS_FILE, ERRORS_FILE, STANCES_FILE};
-use super::table::Table;
 use crate::error::{escape, Error, Result};
+use crate::library::codec::provenance::manifest_sha256;
+use crate::library::codec::schema::{
+    clips, errors, stances as S, CLIPS_FILE, ERRORS_FILE, STANCES_FILE,
+};
+use crate::library::codec::table::Table;
 
 /// Stances beyond a person's bounds listed by the text summary (`--json` lists all).
 pub const BEYOND_BOUNDS_SHOWN: usize = 10;
@@ -99,8 +101,8 @@ fn column_counts(t: &Table, name: &str) -> Result<Counts> {
 /// A missing or malformed `manifest.json`, `clips.parquet`, `stances.parquet` or
 /// `errors.parquet` (the error names the file and column).
 pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
-    super::provenance::check_layout(lib)?;
-    let m = super::manifest::read_manifest(lib)?;
+    crate::library::codec::provenance::check_layout(lib)?;
+    let m = crate::library::codec::manifest::read_manifest(lib)?;
     let s = |k: &str| m.get(k).and_then(|v| v.as_str()).map(str::to_string);
     let clips = Table::open_columns(
         &lib.join(CLIPS_FILE),
@@ -131,7 +133,7 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
         library: lib.to_path_buf(),
         manifest_sha256: manifest_sha256(lib)?,
         schema_version: s("schema_version"),
-        layout: super::layout::layout_of(lib)?.as_str(),
+        layout: crate::library::storage::layout::layout_of(lib)?.as_str(),
         tool_version: s("tool_version"),
         created_utc: s("created_utc"),
         command_line: m

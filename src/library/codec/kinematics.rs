@@ -1,8 +1,8 @@
 //! The kinematic tables (spec two-pac §3): `kinematics_samples.parquet` (a shard's
 //! samples), `kinematics.parquet` (the polytopes' facets) and `kinematics_points.parquet`
 //! (the points behind them), written and read back. While a library is written its
-//! samples wait in a scratch file ([`super::spill`]); the polytopes are built from them one
-//! (character, effector) at a time by [`crate::twopac::kinematic`].
+//! samples wait in a scratch file ([`crate::library::storage::spill`]); the polytopes are built from them one
+//! (character, effector) at a time by [`crate::twopac::limb_reach`].
 //!
 //! `kinematics.parquet`: one row per facet, `character_id`, `effector`, `nx`, `ny`, `nz`,
 //! `d_m` (`n·ʳc ≤ d`, unit outward `n`, metres, contact frame), sorted by (`character_id`,
@@ -19,8 +19,8 @@ use polars::prelude::*;
 use super::columns::col;
 use super::schema::{clips as C, contacts as CT, frames as F, kinematics as K, KINEMATICS_FILE};
 use super::table::Table;
+use crate::contacts::contact_runs::com_in_contact_frame;
 use crate::error::{Error, Result};
-use crate::kinematics::com_in_contact_frame;
 
 /// One kinematic sample: the COM in an effector's contact frame at one frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -309,7 +309,7 @@ pub fn points_frame(key: &(String, String), rows: &[Sample]) -> PolarsResult<Dat
 #[cfg(test)]
 mod schema_tests {
     use super::*;
-    use crate::library::schema::{KINEMATICS_COLUMNS, KINEMATICS_POINTS_COLUMNS};
+    use crate::library::codec::schema::{KINEMATICS_COLUMNS, KINEMATICS_POINTS_COLUMNS};
 
     #[test]
     fn the_kinematic_tables_have_the_schema_columns() {

@@ -186,7 +186,7 @@ pub const BALLISTIC_MIN_FRAMES: usize = 2;
 /// Largest distance of a flight's own free curvature `a_z` from −g, m/s², at which the
 /// stance beside it meets its edge position exactly ([`EdgeTargets::position_tolerance_m`]
 /// `None`; beyond it the position is a soft target of [`POSITION_TOLERANCE_M`]). The edge
-/// states come from a −g parabola ([`ballistic_fit`]); where the flight's COM itself curves
+/// states come from a −g parabola (`ballistic_fit`); where the flight's COM itself curves
 /// far from −g that parabola is not its path, and forcing the stance through it bends the
 /// stance's force: on `cmu_09_01_run_mb` the 102 ms flight curves at −5.6 m/s² (4.2 m/s²
 /// from −g; the clip's other flights −8.9 and −9.6) and, held exactly, the stances beside it
@@ -227,14 +227,13 @@ fn flight_ending_at(summary: &ClipSummary, last_frame: i64) -> Option<&Flight> {
 /// The curvature is −g even where the flight has its own free-curvature fit (a departure
 /// from spec com-from-bvh §7.7, which takes the free fit's state): a 0.1 s flight at
 /// 120 Hz leaves 8 interior frames, and their free curvature is as noisy as the COM
-/// estimate (−5.6, −8.9 and −9.6 m/s² on the three flights of `cmu_09_01_run_mb`). With
-/// −5.6 m/s² the liftoff and touchdown velocities that joined the 102 ms flight were
-/// 0.57 m/s apart instead of g·0.102 = 1.0 m/s, so the stances beside it put their apexes
-/// 44 ms apart and an edit at the recorded speed (ballistic flights) touched down 44 ms
-/// early: 4.5° joint-angle RMS against the source over the first cycle, 1.8° with −g
-/// (measured 2026-12-03). The free fit still gives the flight's `a_z`, the ballistic test
-/// and the clip's time scale `s_eff`; a clip whose flights say it is time-scaled is not
-/// eligible for queries (`stances::limits`), so −g is the physics of every stance used.
+/// estimate. A wrong curvature joins the liftoff and touchdown velocities of a flight of
+/// length `T` by other than `g·T`, which moves the apexes of the stances beside it and the
+/// touchdowns of an edit at the recorded speed (the measured case is in
+/// `docs/decisions.md`, "Measurements moved from module docs"). The free fit still gives
+/// the flight's `a_z`, the ballistic test and the clip's time scale `s_eff`; a clip whose
+/// flights say it is time-scaled is not eligible for queries (`stances::limits`), so −g
+/// is the physics of every stance used.
 fn ballistic_fit(fr: &ClipFrames, f: &Flight) -> Option<FlightFit> {
     if !f.ballistic {
         return None;
@@ -325,7 +324,7 @@ impl From<String> for StanceNote {
 /// A clip whose smoothing filter cannot be built (a frame time beyond
 /// `MAX_SAVGOL_WINDOW`) or that is shorter than the window gives no stances and one
 /// failed note (an `errors.parquet` row), never nothing silently.
-pub fn build_clip(
+pub fn assemble_clip(
     clip: &str,
     fr: &ClipFrames,
     summary: &ClipSummary,

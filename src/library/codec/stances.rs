@@ -679,7 +679,7 @@ pub fn errors_table(rows: &[ErrorRow]) -> PolarsResult<DataFrame> {
 #[cfg(test)]
 mod schema_tests {
     use super::*;
-    use crate::library::schema::{ERRORS_COLUMNS, STANCES_COLUMNS};
+    use crate::library::codec::schema::{ERRORS_COLUMNS, STANCES_COLUMNS};
 
     fn names(df: &DataFrame) -> Vec<String> {
         df.get_column_names()
