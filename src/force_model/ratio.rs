@@ -21,20 +21,11 @@
 //! min_{b ≥ 0} ‖B b − s_v‖²   s.t.   Σ_i b_i/(d+1) = I_v,   Σ_i b_i (d+1−i)/((d+1)(d+2)) = T_2
 //! ```
 //!
-//! **Edge position** (issue 39 item 2, 2026-12-08): the position was a soft row (1 mm
-//! tolerance) because held exactly it raised the plate run's vertical RMSE (0.12 → 0.17 BW,
-//! later 0.117 → 0.142 BW). That RMSE was scored on a clock on which the plates themselves do
-//! not join the flights: integrated from one flight's −g parabola across the stance to the
-//! next flight, the plate force of `hamner_s02_run_4ms` lands a median 20 mm below the next
-//! parabola with the plates shifted by the 2 ms that best match the kinematic force's shape,
-//! and 0.8 mm away shifted by 5 ms (the same with the OpenSim model's COM: 21 mm, 1.4 mm;
-//! the velocities join within 0.2 cm/s on either clock). The soft fit followed the SG
-//! acceleration, whose smear across the stance edges (a 7-frame window at 60 Hz) is cut at
-//! `t_TD`, `t_LO` and pushed back in by the impulse row, which moves the force's centroid
-//! about 4 ms late: the stance's liftoff then sat a median 13 mm below the flight after it
-//! (the "apex mismatch"). Held exactly, on the clock on which the plates join the flights,
-//! the vertical RMSE is lower than the soft fit's (ratio 0.127 → 0.117 BW, Fourier 0.129 →
-//! 0.121) and the apex mismatch 0.0 mm on every plate run (`docs/stance-model.md` §4.1, "Edge position").
+//! **Edge position** (issue 39 item 2): the vertical position is an exact row, like the
+//! impulse, where the flights beside the stance give trustworthy edge states; the soft fit
+//! it replaced followed the smoothed acceleration, whose smear across the stance edges put
+//! the liftoff a median 13 mm below the next flight (the measurements, and the plate clock
+//! they are scored on: `docs/decisions.md`, "Exact edge positions").
 //!
 //! The position is exact only where the edge states are trustworthy: beside a flight whose
 //! own free curvature `a_z` is more than 3 m/s² from −g it stays the soft row above with
@@ -46,14 +37,9 @@
 //!        w = r₀/σ,  σ = m · POSITION_TOLERANCE_M / Δt²   (N; r₀: RMS residual of the
 //!        impulse-only fit, N; m kg, Δt s)
 //! ```
-//! On `cmu_09_01_run_mb` (120 Hz) a 102 ms flight curves at −5.6 m/s² (its neighbours −8.9,
-//! −9.6): its −g parabola is not its path, and the stances beside it, held to it exactly,
-//! bent their force until the run edit planned a COM beyond the leg's reach (one frame did
-//! not converge, support foot 2.3–5.2 mm off; a 31.6° joint step against a 30° bound). Every
-//! flight of the plate runs is too short for a free fit (untested), so they keep the exact
-//! position and its 0.0 mm apex mismatch.
+//! (Why the fallback: `docs/decisions.md`, "Exact edge positions".)
 //!
-//! **Travel targets** (a departure, 2026-12-06): with edge targets the ratios `q_h`, `q_p`
+//! **Travel targets** (a departure): with edge targets the ratios `q_h`, `q_p`
 //! also get a soft row for the stance's travel along their axis, with tolerance
 //! [`TRAVEL_TOLERANCE_M`]:
 //! ```text
@@ -61,34 +47,9 @@
 //! ```
 //! (`r₀`: RMS of the impulse-constrained fit's load-weighted residual, √N, the unit of the
 //! weighted data rows; missing the target by `σ` costs `r₀²`, one sample's typical misfit;
-//! `∫₀¹∫₀ˢ f_v τ^k = M_k − M_{k+1}`, `M_k = ∫₀¹ τ^k f_v`.) The impulse alone left the
-//! model's travel free: beside a flight, the model distance `x_m` of the shared clips'
-//! stances was off their measured travel by median 0.82, p90 3.27, max 8.81 cm (bulk set
-//! 0.75 / 4.07 / 11.74), worst on stances longer than 0.6 s (median 2.55 cm), and
-//! ill-conditioned there: the identity edit of the 2.4 s liftoff `cmu_01_01:LR:1003`, whose
-//! COM is the recording's to 0.01 mm except ≤ 3.4 mm in its last 0.2 s, rebuilt its jump
-//! 2.2 cm long (6.8 cm when sampled half a frame later). With the rows: 0.51 / 1.64 /
-//! 2.06 cm (bulk 0.54 / 1.94 / 4.51), the heading force's RMS misfit 82.1 → 84.0 N (median).
-//! Since `σ ∝ 1/Δt²` (the weight grows as `Δt²`), a running stance's force data keep
-//! deciding its shape and a multi-second stance's travel is held (asked to move, the
-//! shared and bulk stances of 0.2–0.3 s move a median 3 % of the shift, those over 0.9 s
-//! 93 %). The fit falls back to the impulse alone, silently, where the weight is not
-//! finite and positive (a residual of 0) or the constrained solve fails. The tolerance, on
-//! the plate run (|μ_req − plate|) and the round trip of the real forward jumps (`edit
-//! jump` rebuilt, worst |model distance − asked| over cmu_13_32's four requests and
-//! cmu_01_01's four jumps):
-//!
-//! | travel tolerance | Δμ5 median | Δμ5 p90 | Δμ20 median | μ5 ≤ 0.7 (plates 93 %) | worst jump distance |
-//! |---|---|---|---|---|---|
-//! | none | 0.096 | 0.260 | 0.046 | 100 % | 2.96 cm |
-//! | 1 mm | 0.229 | 0.491 | 0.309 | 21 % | 0.50 cm |
-//! | 5 mm | 0.109 | 0.219 | 0.118 | 97 % | 0.53 cm |
-//! | 1 cm | 0.078 | 0.237 | 0.075 | 100 % | 0.58 cm |
-//! | **2 cm** | **0.093** | **0.251** | **0.048** | **100 %** | **1.05 cm** |
-//! | 3 cm | 0.094 | 0.255 | 0.051 | 100 % | 1.26 cm |
-//!
-//! 2 cm changes the plate-checked friction least (Δμ20 0.046 → 0.048, Δμ5 slightly better)
-//! and brings every rebuilt jump within the 2 cm the edit round trip asks.
+//! `∫₀¹∫₀ˢ f_v τ^k = M_k − M_{k+1}`, `M_k = ∫₀¹ τ^k f_v`.)
+//! The tolerance was chosen on the plate run's friction and the real forward jumps' round
+//! trip (`docs/decisions.md`, "Travel targets").
 //!
 //! Why: the paper's truncated periodic Fourier series rings at the stance edges, where
 //! `f_v` is small, so the friction ratio `|f_t|/f_v` (and with it `μ_req`, eq 7) was 3–4×
