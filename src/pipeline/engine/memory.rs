@@ -5,9 +5,8 @@
 //! summaries that grow between them, so a long build's RSS grew with the number of clips
 //! although its heap did not. `malloc_trim` returns the free pages of every arena
 //! (`madvise`, not only the top of the heap). Each trim costs the page faults of taking
-//! those pages back, so it runs every `TRIM_EVERY`-th call (measured on a 25× replica of
-//! the bulk CMU set, 2 threads: peak RSS 186 → 153 MiB when trimming after every batch,
-//! at +18 % wall time; the bulk set alone +11 %).
+//! those pages back, so it runs every `TRIM_EVERY`-th call (the measurement that set it:
+//! `docs/decisions.md`, "Memory trim").
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
