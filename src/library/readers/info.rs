@@ -67,6 +67,10 @@ pub struct LibraryInfo {
     /// Clips by where their body mass came from (`table`: `--masses`, `mass_kg`: given,
     /// `default`: 70 kg assumed); empty for a library written before `mass_source`.
     pub masses_by_source: Counts,
+    /// Per character, the smallest and largest reach of its clips, m (`clips.parquet`
+    /// `reach_m`: how far a jump may put the COM from the contact,
+    /// `query::limits::jump_limits`); empty for a library written before `reach_m`.
+    pub reach_by_character: BTreeMap<String, [f64; 2]>,
 }
 
 impl LibraryInfo {
@@ -151,7 +155,31 @@ pub fn library_info(lib: &Path) -> Result<LibraryInfo> {
         beyond_bounds: beyond_bounds(&clips, &stances)?,
         duplicates: duplicates(&clips)?,
         masses_by_source: masses_by_source(lib),
+        reach_by_character: reach_by_character(lib),
     })
+}
+
+/// Per character, the smallest and largest `reach_m` of its clips (m); empty when
+/// `clips.parquet` has no such column (written before it existed).
+fn reach_by_character(lib: &Path) -> BTreeMap<String, [f64; 2]> {
+    let mut out: BTreeMap<String, [f64; 2]> = BTreeMap::new();
+    let Ok(t) = Table::open_columns(&lib.join(CLIPS_FILE), &[clips::CHARACTER_ID, clips::REACH])
+    else {
+        return out;
+    };
+    let (Ok(ids), Ok(reach)) = (
+        crate::library::codec::table::opt_strings(&t, clips::CHARACTER_ID),
+        t.added_f64(clips::REACH),
+    ) else {
+        return out;
+    };
+    for (id, r) in ids.into_iter().zip(reach) {
+        if let (Some(id), Some(r)) = (id, r.filter(|r| r.is_finite())) {
+            let e = out.entry(id).or_insert([r, r]);
+            *e = [e[0].min(r), e[1].max(r)];
+        }
+    }
+    out
 }
 
 /// Clips by the kind of their `mass_source` (`table <file>:<line>` counts as `table`);
@@ -285,12 +313,19 @@ impl fmt::Display for LibraryInfo {
                     "size" => "the floor of a person's capacity (3.5 body weights)",
                     other => &escape(other),
                 };
+                let reach = match self.reach_by_character.get(id.as_str()) {
+                    Some([lo, hi]) if hi - lo < 5e-4 => {
+                        format!("; jumps: chi_max ≤ reach {lo:.3} m")
+                    }
+                    Some([lo, hi]) => format!("; jumps: chi_max ≤ reach {lo:.3}–{hi:.3} m by clip"),
+                    None => String::new(),
+                };
                 let id = escape(id);
                 let n = l.get("n_stances").and_then(|v| v.as_u64()).unwrap_or(0);
                 writeln!(
                     f,
                     "  {id}: mu {:.2}, F_max {:.0} N, chi_min {:.3} m, chi_max {:.3} m \
-                     ({n} stances; from {from})",
+                     ({n} stances; from {from}){reach}",
                     g("mu"),
                     g("f_max_n"),
                     g("chi_min_m"),
