@@ -250,23 +250,7 @@ pub fn fit_cosine_with(
 mod tests {
     use super::*;
     use crate::force_model::basis::simpson;
-
-    /// Samples of a bell `f_v = 2.5 m g sin²(πτ)` with the ratio `q_h = −0.4 + 0.9 τ` and
-    /// `q_p = 0.05`.
-    fn bell_samples(n: usize, mass: f64) -> [Vec<f64>; 3] {
-        let tau = sample_grid(n);
-        let fv: Vec<f64> = tau
-            .iter()
-            .map(|t| 2.5 * mass * 9.81 * (PI * t).sin().powi(2))
-            .collect();
-        let fh = fv
-            .iter()
-            .zip(&tau)
-            .map(|(f, t)| f * (-0.4 + 0.9 * t))
-            .collect();
-        let fp = fv.iter().map(|f| 0.05 * f).collect();
-        [fh, fp, fv]
-    }
+    use crate::force_model::ratio::bell_samples;
 
     #[test]
     fn series_identities_match_simpson() {

@@ -626,3 +626,21 @@ pub fn sample_grid(n: usize) -> Vec<f64> {
 
 #[cfg(test)]
 mod tests;
+
+/// Samples of a bell `f_v = 2.5 m g sin²(πτ)` on [`sample_grid`]`(n)` with a known ratio
+/// `q_h = −0.4 + 0.9 τ` and `q_p = 0.05`, as `[f_h, f_p, f_v]` (N); tests only.
+#[cfg(test)]
+pub(crate) fn bell_samples(n: usize, mass: f64) -> [Vec<f64>; 3] {
+    let tau = sample_grid(n);
+    let fv: Vec<f64> = tau
+        .iter()
+        .map(|t| 2.5 * mass * 9.81 * (std::f64::consts::PI * t).sin().powi(2))
+        .collect();
+    let fh = fv
+        .iter()
+        .zip(&tau)
+        .map(|(f, t)| f * (-0.4 + 0.9 * t))
+        .collect();
+    let fp = fv.iter().map(|f| 0.05 * f).collect();
+    [fh, fp, fv]
+}

@@ -13,22 +13,6 @@ fn bernstein_to_power_is_the_same_polynomial() {
     }
 }
 
-/// Samples of a bell `f_v = W sin²(πτ)·…` with a known ratio `q_h = −0.4 + 0.9 τ`.
-fn bell_samples(n: usize, mass: f64) -> [Vec<f64>; 3] {
-    let tau = sample_grid(n);
-    let fv: Vec<f64> = tau
-        .iter()
-        .map(|t| 2.5 * mass * 9.81 * (std::f64::consts::PI * t).sin().powi(2))
-        .collect();
-    let fh = fv
-        .iter()
-        .zip(&tau)
-        .map(|(f, t)| f * (-0.4 + 0.9 * t))
-        .collect();
-    let fp = fv.iter().map(|f| 0.05 * f).collect();
-    [fh, fp, fv]
-}
-
 #[test]
 fn travel_targets_bind_a_long_stance_more_than_a_short_one() {
     // A heading force with a ripple the linear ratio cannot follow (the misfit the
