@@ -40,7 +40,8 @@ use crate::math::v3::{cross, norm, sub, V3};
 use crate::skeleton::fk::FkWorkspace;
 
 use super::fidelity::gauge;
-use super::rotation::{axis_angle, conj, from_euler, is_tait_bryan, mul, rotate, to_euler, Quat};
+use super::pose::{local_quat, world_quats};
+use super::rotation::{axis_angle, conj, is_tait_bryan, mul, rotate, to_euler, Quat};
 
 /// Degrees of swing knee fold per unit of Froude speed `v/√(g L_leg)` (module docs).
 pub const SWING_FOLD_PER_FROUDE_DEG: f64 = 23.6;
@@ -165,6 +166,7 @@ pub fn fold_swing_knees(
         return (out, report);
     }
     let knees = gauge(body, motion);
+    let mut folder = KneeFolder::new(body);
     let dt = motion.frame_time_s;
     let first = body.leadin.min(n - 1);
     let frame = |t: f64| (t / dt).round();
@@ -190,70 +192,80 @@ pub fn fold_swing_knees(
         }
         for (f, d) in (a..=b).zip(add) {
             if d != 0.0 {
-                fold_knee(body, &mut out, f, s.side, d);
+                folder.fold(&mut out, f, s.side, d);
             }
         }
     }
     (out, report)
 }
 
-/// Adds `deg` of flexion to the knee of `side` in row `f` of `motion`: the knee's local
-/// rotation turned about the normal of the hip–knee–ankle plane (its parent's frame).
-fn fold_knee(body: &BodyModel, motion: &mut Motion, f: usize, side: usize, deg: f64) {
-    let sk = &body.skeleton;
-    let leg = [&body.landmarks.left, &body.landmarks.right][side];
-    let Some(parent) = sk.parents.get(leg.knee).copied().flatten() else {
-        return;
-    };
-    let ch = &sk.channels[leg.knee];
-    let axes: Vec<usize> = ch.rotations.iter().map(|&(a, _)| a).collect();
-    if !is_tait_bryan(&axes) {
-        return;
-    }
-    let row = motion.row(f).to_vec();
-    let mut ws = FkWorkspace::new(sk);
-    let (mut file, mut pts) = (vec![[0.0; 3]; sk.n_points()], vec![[0.0; 3]; sk.n_points()]);
-    body.points(&mut ws, &row, &mut file, &mut pts);
-    let (h, k, a): (V3, V3, V3) = (file[leg.hip], file[leg.knee], file[leg.ankle]);
-    let n_file = cross(sub(h, k), sub(a, k));
-    let len = norm(n_file);
-    if len.is_nan() || len <= 1e-9 {
-        return;
-    }
-    let n_world = n_file.map(|v| v / len);
-    let n_local = rotate(conj(world_rotation(sk, &row, parent)), n_world);
-    let deg_now: Vec<f64> = ch.rotations.iter().map(|&(_, i)| row[i]).collect();
-    let q = mul(
-        axis_angle(n_local, -deg.to_radians()),
-        from_euler(&axes, &deg_now),
-    );
-    let new = to_euler(
-        q,
-        [axes[0], axes[1], axes[2]],
-        [deg_now[0], deg_now[1], deg_now[2]],
-    );
-    let nc = motion.n_channels;
-    for (&(_, i), v) in ch.rotations.iter().zip(new) {
-        motion.values[f * nc + i] = v;
-    }
+/// What folding a knee needs of a skeleton: its rotation axes per joint and the FK
+/// buffers, made once per motion.
+struct KneeFolder<'a> {
+    body: &'a BodyModel,
+    axes: Vec<Vec<usize>>,
+    ws: FkWorkspace,
+    file: Vec<V3>,
+    pts: Vec<V3>,
 }
 
-/// World rotation (file axes) of joint `j` in `row`: its chain's local rotations composed
-/// from the root down.
-fn world_rotation(sk: &crate::skeleton::Skeleton, row: &[f64], j: usize) -> Quat {
-    let local = |j: usize| {
-        let ch = &sk.channels[j];
-        let axes: Vec<usize> = ch.rotations.iter().map(|&(a, _)| a).collect();
-        let deg: Vec<f64> = ch.rotations.iter().map(|&(_, i)| row[i]).collect();
-        from_euler(&axes, &deg)
-    };
-    let mut q = local(j);
-    let mut p = sk.parents[j];
-    while let Some(i) = p {
-        q = mul(local(i), q);
-        p = sk.parents[i];
+impl<'a> KneeFolder<'a> {
+    fn new(body: &'a BodyModel) -> Self {
+        let sk = &body.skeleton;
+        let axes = sk
+            .channels
+            .iter()
+            .map(|c| c.rotations.iter().map(|&(a, _)| a).collect())
+            .collect();
+        let np = sk.n_points();
+        KneeFolder {
+            body,
+            axes,
+            ws: FkWorkspace::new(sk),
+            file: vec![[0.0; 3]; np],
+            pts: vec![[0.0; 3]; np],
+        }
     }
-    q
+
+    /// Adds `deg` of flexion to the knee of `side` in row `f` of `motion`: the knee's
+    /// local rotation turned about the normal of the hip–knee–ankle plane (its parent's
+    /// frame).
+    fn fold(&mut self, motion: &mut Motion, f: usize, side: usize, deg: f64) {
+        let (body, sk) = (self.body, &self.body.skeleton);
+        let leg = [&body.landmarks.left, &body.landmarks.right][side];
+        let Some(parent) = sk.parents.get(leg.knee).copied().flatten() else {
+            return;
+        };
+        let axes = &self.axes[leg.knee];
+        if !is_tait_bryan(axes) {
+            return;
+        }
+        let row = motion.row(f).to_vec();
+        body.points(&mut self.ws, &row, &mut self.file, &mut self.pts);
+        let (h, k, a) = (
+            self.file[leg.hip],
+            self.file[leg.knee],
+            self.file[leg.ankle],
+        );
+        let n_file = cross(sub(h, k), sub(a, k));
+        let len = norm(n_file);
+        if len.is_nan() || len <= 1e-9 {
+            return;
+        }
+        let local: Vec<Quat> = (0..sk.n_joints())
+            .map(|j| local_quat(sk, &self.axes[j], j, &row))
+            .collect();
+        let parent_world = world_quats(sk, &local)[parent];
+        let n_local = rotate(conj(parent_world), n_file.map(|v| v / len));
+        let q = mul(axis_angle(n_local, -deg.to_radians()), local[leg.knee]);
+        let ch = &sk.channels[leg.knee];
+        let now: Vec<f64> = ch.rotations.iter().map(|&(_, i)| row[i]).collect();
+        let new = to_euler(q, [axes[0], axes[1], axes[2]], [now[0], now[1], now[2]]);
+        let nc = motion.n_channels;
+        for (&(_, i), v) in ch.rotations.iter().zip(new) {
+            motion.values[f * nc + i] = v;
+        }
+    }
 }
 
 #[cfg(test)]

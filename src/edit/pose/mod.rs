@@ -37,6 +37,7 @@ mod reference;
 
 pub use frame::{frame_count_f64, pose_frame, pose_motion};
 pub use joints::PoseWorkspace;
+pub(crate) use reference::{local_quat, world_quats};
 pub use reference::{Reference, StanceSource};
 
 use super::path::Phase;

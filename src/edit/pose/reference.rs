@@ -170,10 +170,7 @@ impl Reference {
         let (mut file, mut pts) = (vec![[0.0; 3]; np], vec![[0.0; 3]; np]);
         for f in 0..n {
             let row = motion.row(f);
-            for (j, ch) in sk.channels.iter().enumerate() {
-                let deg: Vec<f64> = ch.rotations.iter().map(|&(_, i)| row[i]).collect();
-                quats.push(rot::from_euler(&axes[j], &deg));
-            }
+            quats.extend((0..nj).map(|j| local_quat(sk, &axes[j], j, row)));
             body.points(&mut ws, row, &mut file, &mut pts);
             com.push(body.com(&pts));
             let wq = world_quats(sk, &quats[f * nj..(f + 1) * nj]);
@@ -332,8 +329,24 @@ fn trunk_joint(
     ok.then_some(j)
 }
 
+/// The local rotation of joint `j` in `row`: its rotation channels (axes `axes`) as
+/// Euler angles.
+pub(crate) fn local_quat(
+    sk: &crate::skeleton::Skeleton,
+    axes: &[usize],
+    j: usize,
+    row: &[f64],
+) -> Quat {
+    let deg: Vec<f64> = sk.channels[j]
+        .rotations
+        .iter()
+        .map(|&(_, i)| row[i])
+        .collect();
+    rot::from_euler(axes, &deg)
+}
+
 /// World rotations of one frame's local rotations (parents before children).
-fn world_quats(sk: &crate::skeleton::Skeleton, local: &[Quat]) -> Vec<Quat> {
+pub(crate) fn world_quats(sk: &crate::skeleton::Skeleton, local: &[Quat]) -> Vec<Quat> {
     let mut w: Vec<Quat> = Vec::with_capacity(local.len());
     for (j, q) in local.iter().enumerate() {
         let v = match sk.parents[j] {
