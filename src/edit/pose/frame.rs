@@ -5,8 +5,9 @@
 //! # Model
 //! ```text
 //! reference  stance k: t_src = td_k + (t − TD_k)·(lo_k − td_k)/(LO_k − TD_k)
-//!            flight after k:   t_A = lo_k + (t − LO_k)·e_k/E_k     (e, E: liftoff → apex,
-//!            flight before k': t_B = td_k' − (TD_k' − t)·a_k'/A_k'  a, A: apex → touchdown;
+//!            flight after k:   t_A = lo_k + (t − LO_k)·e_k⁺/E_k    (e, E: liftoff → apex,
+//!            flight before k': t_B = td_k' − (TD_k' − t)·a_k'⁺/A_k' a, A: apex → touchdown;
+//!            x⁺ = max(x, 0): a source apex inside its stance holds the edge pose;
 //!            lower case source, upper case plan)
 //!            q_j = slerp(q_j(t_A), q_j(t_B), w),  w = 3u² − 2u³,  u = (t − LO_k)/(TD_k' − LO_k)
 //! heading    q_root ← yaw(Δψ)·q_root,  Δψ = ψ_plan − ψ_source (in flight each edge's root
@@ -69,14 +70,26 @@ fn reference_pose(
         let (_, lo) = st[b].contact_window();
         let e_new = st[b].end() - lo;
         let s = src_of(b);
-        let rate = if e_new > 0.0 { s.after_s / e_new } else { 1.0 };
+        // A jog's apex can lie inside its stance (`after_s < 0`): its pose then holds the
+        // liftoff's instead of playing the stance backwards (the 2 m/s force-plate jog
+        // edited to 5 m/s bent its landing knee from 20° to 81° and back in three frames
+        // of flight, the root at 35 g).
+        let rate = if e_new > 0.0 {
+            s.after_s.max(0.0) / e_new
+        } else {
+            1.0
+        };
         (lo, s.lo_clip_s + (t - lo) * rate)
     });
     let side_b = after.map(|a| {
         let (td, _) = st[a].contact_window();
         let b_new = td - st[a].t0;
         let s = src_of(a);
-        let rate = if b_new > 0.0 { s.before_s / b_new } else { 1.0 };
+        let rate = if b_new > 0.0 {
+            s.before_s.max(0.0) / b_new
+        } else {
+            1.0
+        };
         (td, s.td_clip_s - (td - t) * rate)
     });
     match (side_a, side_b, before, after) {

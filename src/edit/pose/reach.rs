@@ -55,7 +55,12 @@ pub(super) fn place_feet(
             let d = sub(p, fp);
             let dv = dot(d, up);
             let pos = std::array::from_fn(|i| fp[i] + wh * (d[i] - dv * up[i]) + wv * dv * up[i]);
-            toe_pivot(r, ws, side, (pos, rot::slerp(fq, q, wv)), opts)
+            let (pos, q) = toe_pivot(r, ws, side, (pos, rot::slerp(fq, q, wv)), opts);
+            if planted[side] {
+                (pos, q)
+            } else {
+                (swing_reach(r, ws, side, pos, wv, opts), q)
+            }
         })
     });
     for (side, g) in goal.iter().enumerate() {
@@ -212,6 +217,60 @@ fn leg_reach(r: &Reference, ws: &PoseWorkspace, side: usize, opts: &EditOptions)
     )
 }
 
+/// A swinging (not planted) ankle goal `p` (file) brought within the extension the leg has
+/// at knee flexion `κ_b` of its hip, along the line to the hip (the foot rises and comes
+/// forward with the body instead of the knee straightening past the reference's):
+///
+/// ```text
+/// κ_ref = π − ∠(H − K, A − K)                   the reference leg's knee flexion (free pose)
+/// κ_b   = w κ_min + (1 − w) max(κ_min, κ_ref − s)   w: the foot's hold near its contact
+/// e(κ)  = √(l₁² + l₂² + 2 l₁ l₂ cos κ)           hip-to-ankle extension at flexion κ
+/// p ← H + (p − H) · e(κ_b) / |p − H|             when |p − H| > e(κ_b)
+/// ```
+/// (`κ_min = opts.min_knee_flexion_deg`, `s` = [`RUN_KNEE_SLACK_DEG`](crate::edit::RUN_KNEE_SLACK_DEG)).
+/// At the contact (`w = 1`) the bound is the stance's, so the goal is continuous through
+/// liftoff and touchdown; away from it the knee straightens at most `s` beyond the
+/// reference's. A run edited far above its recorded speed held the lifted foot near its
+/// contact while the body moved on faster than recorded, and the knee locked through the
+/// flight where the recording bends it to 51° (issue 37; `docs/edited-motion.md`).
+fn swing_reach(
+    r: &Reference,
+    ws: &PoseWorkspace,
+    side: usize,
+    p: V3,
+    w: f64,
+    opts: &EditOptions,
+) -> V3 {
+    let [hip, knee, ankle] = r.legs[side];
+    let (h, k, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
+    let (v1, v2) = (sub(h, k), sub(a, k));
+    let (l1, l2) = (norm(v1), norm(v2));
+    let d = norm(sub(p, h));
+    if l1 == 0.0 || l2 == 0.0 || d == 0.0 {
+        return p;
+    }
+    let kappa_ref = std::f64::consts::PI - (dot(v1, v2) / (l1 * l2)).clamp(-1.0, 1.0).acos();
+    let kappa_min = opts.min_knee_flexion_deg.to_radians();
+    let e = swing_extension([l1, l2], kappa_ref, kappa_min, w);
+    if d <= e {
+        return p;
+    }
+    std::array::from_fn(|i| h[i] + (p[i] - h[i]) * e / d)
+}
+
+/// `e(κ_b)` of [`swing_reach`]: the hip-to-ankle extension of a leg with thigh and shank
+/// `l` (any unit) at the bound flexion `κ_b = w κ_min + (1 − w) max(κ_min, κ_ref − s)`
+/// (rad; `w` clamped to `[0, 1]`).
+fn swing_extension(l: [f64; 2], kappa_ref: f64, kappa_min: f64, w: f64) -> f64 {
+    let free = kappa_min.max(kappa_ref - crate::edit::RUN_KNEE_SLACK_DEG.to_radians());
+    let w = w.clamp(0.0, 1.0);
+    let kappa = w * kappa_min + (1.0 - w) * free;
+    let [l1, l2] = l;
+    (l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * kappa.cos())
+        .max(0.0)
+        .sqrt()
+}
+
 /// The foot goal `(ankle, orientation)` (file frame) of leg `side`, turned about its
 /// toe tip (heel up, [`pivot_angle`]) when the ankle is beyond the leg's soft reach
 /// ([`leg_reach`]) from the hip; unchanged when it is within it or the leg has no toe
@@ -329,6 +388,42 @@ fn two_bone(r: &Reference, ws: &mut PoseWorkspace, side: usize, target: V3, max_
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Law of cosines, independently: the ankle of a hip at the origin, a thigh along −z
+    /// and a shank turned back by the flexion `k` (rad) in the x–z plane.
+    fn extension_at(l1: f64, l2: f64, k: f64) -> f64 {
+        let knee = [0.0, 0.0, -l1];
+        let ankle = add(knee, [-l2 * k.sin(), 0.0, -l2 * k.cos()]);
+        norm(ankle)
+    }
+
+    #[test]
+    fn a_held_swing_foot_has_the_stance_bound_and_a_free_one_the_reference_knee_less_the_slack() {
+        let (l1, l2) = (0.45, 0.42);
+        let (k_ref, k_min) = (60f64.to_radians(), 10f64.to_radians());
+        let slack = crate::edit::RUN_KNEE_SLACK_DEG.to_radians();
+        // At the contact: the stance's bound.
+        let held = swing_extension([l1, l2], k_ref, k_min, 1.0);
+        assert!((held - extension_at(l1, l2, k_min)).abs() < 1e-12);
+        // Away from it: the reference knee less the slack.
+        let free = swing_extension([l1, l2], k_ref, k_min, 0.0);
+        assert!((free - extension_at(l1, l2, k_ref - slack)).abs() < 1e-12);
+        // Between: continuous and shorter as the hold fades; weights outside [0, 1] clamp.
+        let mut last = held;
+        for i in 1..=10 {
+            let e = swing_extension([l1, l2], k_ref, k_min, 1.0 - f64::from(i) / 10.0);
+            assert!(
+                e < last && last - e <= 0.2 * (held - free),
+                "{i}: {e} after {last}"
+            );
+            last = e;
+        }
+        assert_eq!(swing_extension([l1, l2], k_ref, k_min, 2.0), held);
+        assert_eq!(swing_extension([l1, l2], k_ref, k_min, -1.0), free);
+        // A reference straighter than the stance bound plus the slack adds nothing.
+        let straight = swing_extension([l1, l2], k_min, k_min, 0.0);
+        assert!((straight - held).abs() < 1e-12);
+    }
 
     /// Ankle 8 cm above the floor, toe tip 19 cm ahead on it, Z up, pivot axis +y.
     const TOE: V3 = [0.19, 0.0, 0.0];
