@@ -11,6 +11,7 @@
 //! # References
 //! spec com-from-bvh §2–§8.
 
+use super::knee_branch;
 use super::points::{self, facing, first_non_finite, side_points, ClipPoints, ClipSource};
 use super::{ClipFrames, ClipSummary, IngestOptions};
 use crate::contacts::flight::clip_summary;
@@ -47,7 +48,8 @@ pub(super) fn run(
         .collect();
     let toe = points::toe_tips(lm, &body, &frames, &fwd, summary);
     body_warnings(skel, lm, &mut summary.warnings);
-    let com_pos = com_track(lm, &frames, &toe, opts.sex);
+    let knees = repaired_knees(lm, &frames, &toe, skip, &mut summary.warnings);
+    let com_pos = com_track(lm, &frames, &toe, &knees, opts.sex);
     check_handedness(summary, &frames, lm, &toe);
     if let Some(f) = first_non_finite(&com_pos) {
         // Name the fallback toe tip when it is the culprit (it scales with the leg length).
@@ -163,16 +165,54 @@ fn body_warnings(skel: &Skeleton, lm: &Landmarks, warnings: &mut Vec<String>) {
     }
 }
 
-/// The whole-body COM per frame (de Leva, spec com-from-bvh §5).
-fn com_track(lm: &Landmarks, frames: &[&[V3]], toe: &[Vec<V3>; 2], sex: Sex) -> Vec<V3> {
+/// Each leg's knee per frame with its two-bone branch jumps mirrored back
+/// ([`knee_branch::repair`]); a warning names the leg and how many frames moved.
+fn repaired_knees(
+    lm: &Landmarks,
+    frames: &[&[V3]],
+    toe: &[Vec<V3>; 2],
+    skip: usize,
+    warnings: &mut Vec<String>,
+) -> [Vec<V3>; 2] {
+    let limbs = [&lm.left, &lm.right];
+    std::array::from_fn(|k| {
+        let at = |j: usize| -> Vec<V3> { frames.iter().map(|fp| fp[j]).collect() };
+        let l = limbs[k];
+        let (knee, changed) = knee_branch::repair(&at(l.hip), &at(l.knee), &at(l.ankle), &toe[k]);
+        if let (Some(first), Some(last)) = (changed.first(), changed.last()) {
+            warnings.push(format!(
+                "{} knee: {} frame(s) in frames {}-{} mirrored back across the hip-ankle line \
+                 for the COM (two-bone IK branch jumps)",
+                ["left", "right"][k],
+                changed.len(),
+                skip + first,
+                skip + last
+            ));
+        }
+        knee
+    })
+}
+
+/// The whole-body COM per frame (de Leva, spec com-from-bvh §5), with the knees given
+/// (the file's, or [`repaired_knees`]).
+fn com_track(
+    lm: &Landmarks,
+    frames: &[&[V3]],
+    toe: &[Vec<V3>; 2],
+    knees: &[Vec<V3>; 2],
+    sex: Sex,
+) -> Vec<V3> {
     (0..frames.len())
         .map(|f| {
             let fp = frames[f];
+            let mut left = side_points(&lm.left, fp, toe[0][f]);
+            let mut right = side_points(&lm.right, fp, toe[1][f]);
+            (left.kjc, right.kjc) = (knees[0][f], knees[1][f]);
             let b = BodyPoints {
                 vert: lm.vert.at(fp),
                 cerv: fp[lm.cerv],
-                left: side_points(&lm.left, fp, toe[0][f]),
-                right: side_points(&lm.right, fp, toe[1][f]),
+                left,
+                right,
             };
             com(&b, sex)
         })

@@ -17,6 +17,7 @@
 
 pub mod body;
 mod clip;
+pub mod knee_branch;
 pub mod masses;
 pub mod plates;
 mod points;
