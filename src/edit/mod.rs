@@ -59,13 +59,17 @@
 //!   the leg's shortfall by finite differences of FK, foot IK and COM), and the solved
 //!   changes are ramped in and out over [`DEFAULT_POSTURE_RAMP_S`]. Without it the left
 //!   push-off ended 2.0 frames early and 10 frames were reported; with it 0.91 frames and
-//!   none.
+//!   none. A run's pelvis turns too where a support knee would straighten more than
+//!   `pose::reach::POSTURE_KNEE_SLACK_DEG` beyond the toe pivot's bound (below).
 //! - The edit keeps its source's posture (issue 37 item 5, [`fidelity`]): a run's knee
 //!   straightens no further than the source's least flexion less [`RUN_KNEE_SLACK_DEG`]
 //!   (the heel rises instead), a jump's knee shares the end of its push with the heel
-//!   ([`DEFAULT_SOFT_REACH`]), and swinging feet rise with a body that flies higher than
-//!   recorded ([`DEFAULT_SWING_HOLD_S`]). Every written motion is checked against its
-//!   source: trunk lean, knee flexion, knees locked through a flight, root spikes.
+//!   ([`DEFAULT_SOFT_REACH`]), swinging feet rise with a body that flies higher than
+//!   recorded ([`DEFAULT_SWING_HOLD_S`]), and a swinging ankle stays within the reference
+//!   knee's flexion less [`RUN_KNEE_SLACK_DEG`] of its hip (`pose::reach::swing_reach`: a
+//!   run faster than recorded lifts the foot with the body instead of locking the knee).
+//!   Every written motion is checked against its source: trunk lean, knee flexion, knees
+//!   locked through a flight, root spikes.
 //! - A run's swing knee folds with speed ([`swing`], a departure from the paper's replayed
 //!   swing): `k (Fr_target − Fr_source)` degrees more at each swing's peak, `Fr = v/√(g L)`,
 //!   `k` measured on five runners of the shared data (leaving one out: 22–27°).

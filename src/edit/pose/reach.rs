@@ -15,7 +15,8 @@
 //! knee       rotate the shank about n = (H − K) × (A − K) to |A − H| = |ankle* − H|
 //! hip        the smallest rotation taking A − H onto ankle* − H
 //! posture    s_k = |G_k − H_k − (c_plan − c)| − R_k: support leg k's shortfall after the
-//!            coming root shift (G_k: its goal after the pivot, R_k = max_reach·(l₁ + l₂));
+//!            coming root shift (G_k: its goal after the pivot, R_k: the knee's reach R at
+//!            κ_min − POSTURE_KNEE_SLACK_DEG, at least 0);
 //!            where one is positive, the damped least-squares step of edit::posture
 //!            brings it to −tol (J_kd = ∂s_k/∂x_d by finite differences, once per frame)
 //! ```
@@ -121,7 +122,9 @@ pub(super) fn reach_update(
         let goal = at.goals[k].filter(|_| g.planted[k])?;
         let [hip, knee, ankle] = r.legs[k];
         let (h, kn, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
-        let reach = opts.max_reach * (norm(sub(h, kn)) + norm(sub(a, kn))) * body.unit_m;
+        let kappa = (opts.min_knee_flexion_deg - POSTURE_KNEE_SLACK_DEG).max(0.0);
+        let reach = knee_reach([norm(sub(h, kn)), norm(sub(a, kn))], opts.max_reach, kappa);
+        let reach = reach * body.unit_m;
         let hip_m = ws.pts[hip];
         let v = sub(sub(body.to_internal(goal), hip_m), shift);
         let d = norm(v);
@@ -205,17 +208,37 @@ fn leg_reach(r: &Reference, ws: &PoseWorkspace, side: usize, opts: &EditOptions)
     let [hip, knee, ankle] = r.legs[side];
     let (h, k, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
     let (l1, l2) = (norm(sub(h, k)), norm(sub(a, k)));
-    let full = l1 + l2;
-    let bent = (l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * opts.min_knee_flexion_deg.to_radians().cos())
-        .max(0.0)
-        .sqrt();
-    let hard = (opts.max_reach * full).min(bent);
+    let hard = knee_reach([l1, l2], opts.max_reach, opts.min_knee_flexion_deg);
     (
         h,
-        (opts.soft_reach * full).max(norm(sub(a, h))).min(hard),
+        (opts.soft_reach * (l1 + l2)).max(norm(sub(a, h))).min(hard),
         hard,
     )
 }
+
+/// The knee's reach of a leg with thigh and shank `l` (any unit) at flexion `kappa_deg`:
+/// `R = min(max_reach·(l₁ + l₂), √(l₁² + l₂² + 2 l₁ l₂ cos κ))`, the hip-to-ankle distance
+/// at which the knee is as straight as it may be.
+fn knee_reach(l: [f64; 2], max_reach: f64, kappa_deg: f64) -> f64 {
+    let [l1, l2] = l;
+    let bent = (l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * kappa_deg.to_radians().cos())
+        .max(0.0)
+        .sqrt();
+    (max_reach * (l1 + l2)).min(bent)
+}
+
+/// How much straighter than the toe pivot's bound (`opts.min_knee_flexion_deg`) a support
+/// knee may go before the pelvis turns to keep it ([`reach_update`]), degrees: with the
+/// posture check's 10° tolerance below the source's least flexion, the toe pivot keeps the
+/// first 5° ([`RUN_KNEE_SLACK_DEG`](crate::edit::RUN_KNEE_SLACK_DEG)), the pelvis the next
+/// 2.5° and the last 2.5° are left to frames out of reach even so. (A jump's bound is 0°:
+/// its pelvis turns only for a leg that does not reach straight.) Measured on runs edited
+/// to 5 m/s (issue 37): with the pelvis turning only for a leg out of reach straight, the
+/// fixture landed and two runners pushed off up to 15° straighter than recorded (exit 1);
+/// turning at the pivot's own bound (0° here) kept every knee in range but the turns'
+/// ramps moved the root up to 8.7 g (3 → 5 m/s) and 12.5 g (fixture); at 2.5°, 6.2 and
+/// 11.1 g.
+pub const POSTURE_KNEE_SLACK_DEG: f64 = 2.5;
 
 /// A swinging (not planted) ankle goal `p` (file) brought within the extension the leg has
 /// at knee flexion `κ_b` of its hip, along the line to the hip (the foot rises and comes
