@@ -648,17 +648,7 @@ fn issue37_item5_edit_run_posture_stays_within_the_recorded_range() {
         let lib = library(&sub, std::slice::from_ref(src));
         for &(v, allowed) in speeds {
             let out = sub.join(format!("run_{v}.bvh"));
-            let (code, said) = edit_with_output(&[
-                "edit",
-                "run",
-                "--lib",
-                &s(&lib),
-                "--speed",
-                &v.to_string(),
-                "--allow-infeasible",
-                "--out",
-                &s(&out),
-            ]);
+            let (code, said) = edit_run_at(&lib, v, &out);
             // The swing knee may fold beyond the recording by the speed law it names.
             let fold = swing_law_deg(&said);
             let (outside, lean_e, knee_e, lean_r, knee_r) =
@@ -727,17 +717,7 @@ fn issue37_item5_edit_run_faster_keeps_the_lifted_knee_bent_and_no_root_spike() 
         let sub = dir.path().join(format!("c{n}"));
         let lib = library(&sub, std::slice::from_ref(&src));
         let out = sub.join(format!("run_{v}.bvh"));
-        let (code, said) = edit_with_output(&[
-            "edit",
-            "run",
-            "--lib",
-            &s(&lib),
-            "--speed",
-            &v.to_string(),
-            "--allow-infeasible",
-            "--out",
-            &s(&out),
-        ]);
+        let (code, said) = edit_run_at(&lib, v, &out);
         let (flights, locked, spikes, max_e, max_r) = jump_flight_and_spikes(&out, &src, &sub);
         eprintln!(
             "{clip} → {v} m/s (exit {code}): {} flights, {locked} knee(s) locked, spike frames \
@@ -748,17 +728,36 @@ fn issue37_item5_edit_run_faster_keeps_the_lifted_knee_bent_and_no_root_spike() 
         );
         assert!(!flights.is_empty(), "{clip} → {v}: no flight in {said}");
         assert_eq!(locked, 0, "{clip} → {v} m/s: {said}");
-        if allowed > 0 {
-            eprintln!(
-                "KNOWN MISS: {} spike frame(s) (ceiling {allowed})",
-                spikes.len()
-            );
-        }
-        assert!(
-            spikes.len() <= allowed,
-            "{clip} → {v} m/s: spikes {spikes:?}"
+        assert_spikes_within(&spikes, allowed, &format!("{clip} → {v} m/s"));
+    }
+}
+
+/// `edit run --speed v --allow-infeasible` of `lib` into `out`: the exit code and stderr
+/// ([`edit_with_output`]).
+fn edit_run_at(lib: &Path, v: f64, out: &Path) -> (i32, String) {
+    edit_with_output(&[
+        "edit",
+        "run",
+        "--lib",
+        &s(lib),
+        "--speed",
+        &v.to_string(),
+        "--allow-infeasible",
+        "--out",
+        &s(out),
+    ])
+}
+
+/// At most `allowed` root spike frames in `spikes` (a known miss, printed, when `allowed`
+/// is above 0); `what` names the edit.
+fn assert_spikes_within(spikes: &[usize], allowed: usize, what: &str) {
+    if allowed > 0 {
+        eprintln!(
+            "KNOWN MISS: {what}: {} spike frame(s) (ceiling {allowed})",
+            spikes.len()
         );
     }
+    assert!(spikes.len() <= allowed, "{what}: root spikes at {spikes:?}");
 }
 
 /// The swing fold of the speed law an edit run printed ("speed law +4.2°"), degrees.
@@ -947,17 +946,7 @@ fn issue37_item5_edit_jump_higher_keeps_bent_knees_in_flight_and_no_root_spike()
                 "{}: a knee locked through the flight",
                 src.display()
             );
-            if allowed > 0 {
-                eprintln!(
-                    "KNOWN MISS: {} spike frame(s) × {scale} (ceiling {allowed})",
-                    spikes.len()
-                );
-            }
-            assert!(
-                spikes.len() <= allowed,
-                "{}: root spikes at {spikes:?}",
-                src.display()
-            );
+            assert_spikes_within(&spikes, allowed, &format!("{} × {scale}", src.display()));
         }
     }
 }
