@@ -190,12 +190,8 @@ pub fn trunk_lean_deg(hl: V3, hr: V3, cerv: V3, up: V3) -> f64 {
     f.atan2(dot(trunk, up)).to_degrees()
 }
 
-/// Knee flexion κ = 180° − ∠(hip, knee, ankle), deg.
-pub fn knee_flexion_deg(hip: V3, knee: V3, ankle: V3) -> f64 {
-    let (u, v) = (sub(hip, knee), sub(ankle, knee));
-    let c = dot(u, v) / (norm(u) * norm(v));
-    180.0 - c.clamp(-1.0, 1.0).acos().to_degrees()
-}
+/// Knee flexion κ = 180° − ∠(hip, knee, ankle), deg ([`flexion_deg`]).
+pub use crate::math::v3::flexion_deg as knee_flexion_deg;
 
 /// Every frame of `motion` measured with `body` (rows in `body`'s channel layout).
 pub fn gauge(body: &BodyModel, motion: &Motion) -> Vec<Gauge> {

@@ -25,7 +25,7 @@
 //! # Units
 //! Metres, internal Z-up frame.
 
-use crate::math::v3::{add, dot, norm, scale, sub, V3};
+use crate::math::v3::{add, dot, flexion_deg, norm, scale, sub, V3};
 
 /// Least knee offset from the hip–ankle line on both frames of a jump, m: below it the
 /// two branches are within a few millimetres and a swap moves no mass worth repairing.
@@ -52,16 +52,6 @@ fn offset(hip: V3, knee: V3, ankle: V3) -> (V3, V3) {
     };
     let kh = sub(knee, hip);
     (sub(kh, scale(dot(kh, u), u)), u)
-}
-
-/// Knee flexion of a leg, degrees: 180° less the angle at the knee.
-fn flexion_deg(hip: V3, knee: V3, ankle: V3) -> f64 {
-    let (a, b) = (sub(hip, knee), sub(ankle, knee));
-    let n = norm(a) * norm(b);
-    if n == 0.0 {
-        return 0.0;
-    }
-    180.0 - (dot(a, b) / n).clamp(-1.0, 1.0).acos().to_degrees()
 }
 
 /// Is the step from offset `a` to offset `b`, flexions `fa` and `fb` (deg), a branch jump

@@ -49,3 +49,14 @@ pub fn norm(a: [f64; 3]) -> f64 {
 pub fn unit(a: [f64; 3]) -> [f64; 3] {
     scale(1.0 / norm(a), a)
 }
+
+/// Flexion at a joint, degrees: `180° − ∠(proximal, joint, distal)` (0 for a straight
+/// limb, and for a degenerate one with a zero-length segment). The knee's: hip, knee, ankle.
+pub fn flexion_deg(proximal: [f64; 3], joint: [f64; 3], distal: [f64; 3]) -> f64 {
+    let (u, v) = (sub(proximal, joint), sub(distal, joint));
+    let n = norm(u) * norm(v);
+    if n == 0.0 {
+        return 0.0;
+    }
+    180.0 - (dot(u, v) / n).clamp(-1.0, 1.0).acos().to_degrees()
+}

@@ -30,7 +30,7 @@ use super::reference::Reference;
 use crate::edit::posture::{self, Posture, PostureFrame, Row, N_DOF, POSTURE_ZERO};
 use crate::edit::rotation::{self as rot, Quat};
 use crate::edit::EditOptions;
-use crate::math::v3::{add, cross, dot, norm, sub, V3};
+use crate::math::v3::{add, cross, dot, flexion_deg, norm, sub, V3};
 
 /// One IK pass of the feet (step 2 of [`pose_frame`](super::frame::pose_frame)): each
 /// pulled ankle goes part way ([`Pull`]) from where FK puts it towards its goal, by
@@ -266,13 +266,12 @@ fn swing_reach(
 ) -> V3 {
     let [hip, knee, ankle] = r.legs[side];
     let (h, k, a) = (ws.file[hip], ws.file[knee], ws.file[ankle]);
-    let (v1, v2) = (sub(h, k), sub(a, k));
-    let (l1, l2) = (norm(v1), norm(v2));
+    let (l1, l2) = (norm(sub(h, k)), norm(sub(a, k)));
     let d = norm(sub(p, h));
     if l1 == 0.0 || l2 == 0.0 || d == 0.0 {
         return p;
     }
-    let kappa_ref = std::f64::consts::PI - (dot(v1, v2) / (l1 * l2)).clamp(-1.0, 1.0).acos();
+    let kappa_ref = flexion_deg(h, k, a).to_radians();
     let kappa_min = opts.min_knee_flexion_deg.to_radians();
     let e = swing_extension([l1, l2], kappa_ref, kappa_min, w);
     if d <= e {
