@@ -190,7 +190,7 @@ pub fn trunk_lean_deg(hl: V3, hr: V3, cerv: V3, up: V3) -> f64 {
     f.atan2(dot(trunk, up)).to_degrees()
 }
 
-/// Knee flexion κ = 180° − ∠(hip, knee, ankle), deg ([`flexion_deg`]).
+/// Knee flexion κ = 180° − ∠(hip, knee, ankle), deg ([`crate::math::v3::flexion_deg`]).
 pub use crate::math::v3::flexion_deg as knee_flexion_deg;
 
 /// Every frame of `motion` measured with `body` (rows in `body`'s channel layout).
