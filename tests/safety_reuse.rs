@@ -191,6 +191,39 @@ fn incremental_rebuilds_a_library_without_content_hashes() {
     );
 }
 
+/// The library's manifest with its `source_digest` set to `digest` (removed if `None`).
+fn set_source_digest(lib: &Path, digest: Option<&str>) {
+    let p = lib.join("manifest.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+    let o = m.as_object_mut().unwrap();
+    assert!(
+        o["source_digest"].as_str().is_some_and(|d| d.len() == 64),
+        "a build records its 64-hex source digest: {:?}",
+        o.get("source_digest")
+    );
+    match digest {
+        Some(d) => o.insert("source_digest".into(), d.into()),
+        None => o.remove("source_digest"),
+    };
+    std::fs::write(&p, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+}
+
+// A library written by other code (its rows computed by another COM, say) is not this
+// build's: before the source digest, its rows were reused because the options and the
+// clips' bytes were the same.
+#[test]
+fn incremental_rebuilds_a_library_written_by_another_build() {
+    rebuilt_after(
+        |lib| set_source_digest(lib, Some(&"0".repeat(64))),
+        "written by another build of stancelib (source digest 000000000000",
+    );
+    rebuilt_after(
+        |lib| set_source_digest(lib, None),
+        "written by another build of stancelib (source digest none",
+    );
+}
+
 // A clip whose rows are not as many as the manifest records is rebuilt on its own, the
 // other clips reused.
 #[test]

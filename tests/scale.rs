@@ -466,6 +466,17 @@ fn merge_refuses_shards_built_with_other_options_naming_the_shard() {
     let (code, err) = merge_cli(&[&a, &b], &out);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("tool_version"), "{err}");
+    // Another source at the same version: shards computed by different code.
+    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("\"source_digest\": \"", "\"source_digest\": \"f00d"),
+    )
+    .unwrap();
+    let (code, err) = merge_cli(&[&a, &b], &out);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("source_digest"), "{err}");
     // Shards of different input lists never merge either.
     build_cli(&inputs[1..], &b, &["--shard", "2/2"]);
     let (code, err) = merge_cli(&[&a, &b], &out);

@@ -132,6 +132,12 @@ pub const SCHEMA_VERSION_KEY: &str = "stancelib.schema_version";
 pub const TOOL_VERSION_KEY: &str = "stancelib.tool_version";
 /// The tool version recorded everywhere (`CARGO_PKG_VERSION`).
 pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// SHA-256 (hex) of the source this build was compiled from (`src/`, `Cargo.toml`,
+/// `Cargo.lock`; computed by `src/build.rs`). A library's manifest records it as
+/// `source_digest`; `build --incremental` reuses rows only from a library of the same
+/// source, because a change of the code changes rows that the options and the clip's
+/// bytes do not name.
+pub const SOURCE_DIGEST: &str = env!("STANCELIB_SOURCE_DIGEST");
 /// Key-value metadata key of a library table: the fingerprint of the build options.
 pub const OPTIONS_KEY: &str = "stancelib.options";
 /// Key-value metadata key of a library table: the inputs' content hashes (JSON).

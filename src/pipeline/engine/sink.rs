@@ -39,8 +39,8 @@ use crate::library::codec::schema::{
     SCHEMA_VERSION, STANCES_FILE,
 };
 use crate::library::codec::schema::{
-    INPUTS_KEY, LAYOUT_MANIFEST_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, TOOL_VERSION,
-    TOOL_VERSION_KEY,
+    INPUTS_KEY, LAYOUT_MANIFEST_KEY, LIMITS_KEY, OPTIONS_KEY, SCHEMA_VERSION_KEY, SOURCE_DIGEST,
+    TOOL_VERSION, TOOL_VERSION_KEY,
 };
 use crate::library::codec::write::write_atomic;
 use crate::library::storage::group_reader::GroupFileReader;
@@ -353,6 +353,7 @@ impl LibrarySink {
             "schema": format!("{MANIFEST_SCHEMA_PREFIX}{SCHEMA_VERSION}"),
             "schema_version": SCHEMA_VERSION,
             "tool_version": TOOL_VERSION,
+            "source_digest": SOURCE_DIGEST,
             // Not in the Parquet metadata: these change from run to run (the tables do not).
             "created_utc": crate::library::codec::provenance::now_utc(),
             "command_line": crate::library::codec::provenance::command_line(),

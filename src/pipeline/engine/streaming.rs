@@ -46,7 +46,9 @@ use super::tables::{combine, strings, BuildReport, Tables};
 use crate::error::{Error, Result};
 use crate::ingest::IngestOptions;
 use crate::library::codec::provenance::library_layout;
-use crate::library::codec::schema::{clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION};
+use crate::library::codec::schema::{
+    clips, CLIPS_FILE, ERRORS_FILE, SCHEMA_VERSION, SOURCE_DIGEST,
+};
 use crate::library::codec::stances::{first_non_finite, ErrorRow};
 use crate::library::codec::table::read_parquet;
 use crate::library::storage::integrity::{
@@ -263,8 +265,13 @@ struct Reuse {
 /// Most clips a refusal names one by one (the rest are counted).
 const REFUSED_CLIPS_NAMED: usize = 10;
 
+/// The first 12 hex digits of a digest (enough to tell two builds apart in a message).
+fn short_digest(d: &str) -> String {
+    d.chars().take(12).collect()
+}
+
 /// Clips of the previous library at `out` that can be reused for `named`: the library's
-/// options and layout are this build's, every table it gives rows from has the content
+/// options, layout and source digest are this build's, every table it gives rows from has the content
 /// hash its manifest recorded ([`crate::library::storage::integrity`]), and per clip the input's
 /// path and content are unchanged and its rows in every table are as many as recorded.
 /// Anything else is rebuilt, with a line in `refused` saying why.
@@ -279,6 +286,16 @@ fn reusable(out: &Path, named: &[(PathBuf, String)], fingerprint: &str, joints: 
     let current: Option<serde_json::Value> = serde_json::from_str(fingerprint).ok();
     if current.is_none() || manifest.get("options") != current.as_ref() {
         return all("the library was built with other options".into());
+    }
+    // Rows computed by other code are not this build's rows.
+    let digest = manifest.get("source_digest").and_then(|d| d.as_str());
+    if digest != Some(SOURCE_DIGEST) {
+        return all(format!(
+            "the library was written by another build of stancelib (source digest {}, this \
+             build {})",
+            digest.map_or("none".to_string(), short_digest),
+            short_digest(SOURCE_DIGEST)
+        ));
     }
     // Rows of another table layout cannot be copied into this one.
     if library_layout(out).as_deref() != Some(SCHEMA_VERSION) {
