@@ -384,8 +384,14 @@ pub fn fixture_library() -> &'static Path {
 }
 
 /// Manifest keys (at any depth) that change from one build to the next: build date,
-/// command line, wall time.
-pub const MANIFEST_VOLATILE_KEYS: [&str; 3] = ["created_utc", "command_line", "wall_time_s"];
+/// command line, wall time, and the digest of the source the tool was compiled from (it
+/// changes with every commit, the rows only with the ones that change them).
+pub const MANIFEST_VOLATILE_KEYS: [&str; 4] = [
+    "created_utc",
+    "command_line",
+    "wall_time_s",
+    "source_digest",
+];
 
 /// `v` without [`MANIFEST_VOLATILE_KEYS`], at every depth.
 pub fn without_volatile(v: serde_json::Value) -> serde_json::Value {
