@@ -621,7 +621,7 @@ fn issue37_item5_edit_run_posture_stays_within_the_recorded_range() {
     let mut cases: Vec<(PathBuf, Vec<(f64, usize)>)> = vec![(
         fixture("run_120hz_m_yup"),
         // (speed, frames allowed outside): 0 at 2–4 m/s; the 5 m/s known miss as measured.
-        vec![(2.0, 0), (3.0, 0), (4.0, 0), (5.0, 0)],
+        vec![(2.0, 0), (3.0, 0), (4.0, 0), (5.0, 0), (6.0, 0)],
     )];
     if let Some(data) =
         shared_or_skip("issue37_item5_edit_run_posture_stays_within_the_recorded_range")
@@ -640,7 +640,7 @@ fn issue37_item5_edit_run_posture_stays_within_the_recorded_range() {
         ));
         cases.push((
             data.join("bvh/run/cmu_09_01_run_mb.bvh"),
-            vec![(3.0, 0), (4.0, 0)],
+            vec![(3.0, 0), (4.0, 0), (4.5, 0), (5.0, 0)],
         ));
     }
     for (n, (src, speeds)) in cases.iter().enumerate() {
@@ -730,6 +730,110 @@ fn issue37_item5_edit_run_faster_keeps_the_lifted_knee_bent_and_no_root_spike() 
         assert_eq!(locked, 0, "{clip} → {v} m/s: {said}");
         assert_spikes_within(&spikes, allowed, &format!("{clip} → {v} m/s"));
     }
+}
+
+// See: issue 37 item 5 — an edited run's support foot meets the plan. The paper's contact
+// point keeps the recording's split of the contact ahead of and behind the body, and CMU
+// `09_01` (3.6 m/s) asked for 4.5 or 5 m/s pushed off farther behind than its legs reach:
+// its last push-off frames 5.6 / 15.5 mm off the floor point with the knee straight, the
+// heel up 50° and the pelvis turned 10° (exit 1). The fixture at 6 m/s landed with its
+// knee straighter than its range (exit 1). The contact now moves, only where the legs do
+// not reach, by the least whole centimetre that lets them (`edit::footing`). Measured from
+// the written plan: every frame converges, the moved contact is forward at a push-off,
+// back at a landing, and the share of the contact ahead of the COM moves the way the
+// plate runner's does from 2 to 3 m/s (0.39 → 0.46); runs that reach keep the paper's
+// contact.
+#[test]
+fn issue37_item5_edit_run_moves_a_contact_only_where_the_legs_do_not_reach() {
+    let dir = tempfile::tempdir().unwrap();
+    let fixture_lib = library(&dir.path().join("fx"), &[fixture("run_120hz_m_yup")]);
+    let out = dir.path().join("fx_6.bvh");
+    let (code, said) = edit_run_at(&fixture_lib, 6.0, &out);
+    eprintln!("fixture → 6 m/s (exit {code}): {said}");
+    assert_eq!(code, 0, "{said}");
+    assert!(
+        said.contains("contact moved") && said.contains(" back ("),
+        "{said}"
+    );
+    let Some(data) =
+        shared_or_skip("issue37_item5_edit_run_moves_a_contact_only_where_the_legs_do_not_reach")
+    else {
+        return;
+    };
+    let src = data.join("bvh/run/cmu_09_01_run_mb.bvh");
+    let lib = library(&dir.path().join("c09"), std::slice::from_ref(&src));
+    let own = dir.path().join("c09_own.bvh");
+    let (code, said) = edit_run_at(&lib, 3.6, &own);
+    assert_eq!(code, 0, "{said}");
+    assert!(!said.contains("contact moved"), "{said}");
+    let split_own = share_ahead(&own);
+    for v in [4.5, 5.0] {
+        let out = dir.path().join(format!("c09_{v}.bvh"));
+        let (code, said) = edit_run_at(&lib, v, &out);
+        let split = share_ahead(&out);
+        eprintln!(
+            "cmu_09_01 → {v} m/s (exit {code}): share of the contact ahead of the COM \
+             {split:.3} (at its own speed {split_own:.3}); {said}"
+        );
+        assert_eq!(code, 0, "{said}");
+        assert!(
+            said.contains("contact moved") && said.contains(" forward ("),
+            "{said}"
+        );
+        let plan = read_parquet(&out.with_extension("plan.parquet")).unwrap();
+        let converged = plan.column("converged").unwrap().bool().unwrap().clone();
+        assert!(
+            converged.iter().all(|c| c == Some(true)),
+            "{v} m/s: a frame off the plan"
+        );
+        assert!(split > split_own, "{v} m/s: {split} ≤ {split_own}");
+    }
+    // A run that reaches keeps the paper's contact.
+    let h3 = library(
+        &dir.path().join("h3"),
+        &[data.join("forceplate/hamner_multi_run_3ms/clip.bvh")],
+    );
+    let (code, said) = edit_run_at(&h3, 4.0, &dir.path().join("h3_4.bvh"));
+    assert_eq!(code, 0, "{said}");
+    assert!(!said.contains("contact moved"), "{said}");
+}
+
+/// The median share of a stance's contact length that lies ahead of the COM at touchdown,
+/// from an edit's plan table: `x_TD / (x_TD + x_LO)` along each stance's travel, `x_TD`
+/// the contact's distance ahead of the COM at its first stance frame and `x_LO` the COM's
+/// beyond the contact at its last.
+fn share_ahead(out: &Path) -> f64 {
+    let phase = plan_str(out, "phase");
+    let td = plan_f64(out, "stance_td_clip_s");
+    let col = |n: &str| plan_f64(out, n);
+    let (cx, cy, px, py) = (
+        col("com_x_m"),
+        col("com_y_m"),
+        col("contact_x_m"),
+        col("contact_y_m"),
+    );
+    let mut shares = Vec::new();
+    let mut i = 0;
+    while i < phase.len() {
+        if phase[i].as_deref() != Some("stance") {
+            i += 1;
+            continue;
+        }
+        let mut j = i;
+        while j + 1 < phase.len() && phase[j + 1].as_deref() == Some("stance") && td[j + 1] == td[i]
+        {
+            j += 1;
+        }
+        let h = [cx[j] - cx[i], cy[j] - cy[i]];
+        let n = h[0].hypot(h[1]);
+        let ahead = ((px[i] - cx[i]) * h[0] + (py[i] - cy[i]) * h[1]) / n;
+        let behind = ((cx[j] - px[i]) * h[0] + (cy[j] - py[i]) * h[1]) / n;
+        shares.push(ahead / (ahead + behind));
+        i = j + 1;
+    }
+    assert!(!shares.is_empty(), "no stance in {}", out.display());
+    shares.sort_by(f64::total_cmp);
+    shares[shares.len() / 2]
 }
 
 /// `edit run --speed v --allow-infeasible` of `lib` into `out`: the exit code and stderr
@@ -1007,9 +1111,11 @@ fn issue38_item1_edits_print_their_verdict_and_exit_by_it() {
         err.contains("infeasible, written anyway") && err.contains("(by "),
         "{err}"
     );
-    // 1: feasible, but its posture leaves the recorded range (6 m/s, 1.7 × the recorded
-    // speed: the landing leg straightens beyond the source's least flexion less 10°).
-    let (code, _, err) = edit_run("6", &[], "r6.bvh");
+    // 1: feasible, but its posture leaves the recorded range (7 m/s, 2 × the recorded
+    // speed: with its contacts moved back a tenth of a leg, the most `edit::footing`
+    // moves them, the landing leg still straightens beyond the source's least flexion
+    // less 10°).
+    let (code, _, err) = edit_run("7", &[], "r7.bvh");
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("knee flexion") && err.contains("outside"),

@@ -24,8 +24,8 @@ use crate::force_model::GRAVITY;
 use crate::stances::segment::Boundary;
 
 use super::feasibility::{
-    approx, contact_point_with, exact_at_contact_point, exact_feasible, Limits, QueryContext,
-    Verdict,
+    approx, contact_point_with, exact, exact_at_contact_point, exact_feasible, Limits,
+    QueryContext, Verdict,
 };
 use super::gait::{GaitLaw, LawSource};
 use super::pool::{PoolStance, Prepared};
@@ -340,6 +340,27 @@ pub fn check_solution(p: &Prepared, req: &Request, sol: &Solution, lim: &Limits)
         feasible_approx,
         verdict,
         cp: u.unwrap_or(s.cp),
+    }
+}
+
+/// The checks of a solved stance with its contact at `cp` (m, stance axes `(h, p)`) instead
+/// of the re-solved `u*`: an edit that moved its contact for the legs to reach
+/// (`edit::footing`) is judged where its foot is.
+pub fn check_at_contact(
+    p: &Prepared,
+    req: &Request,
+    sol: &Solution,
+    lim: &Limits,
+    cp: [f64; 2],
+) -> ScaledStance {
+    let ctx = QueryContext {
+        cp,
+        ..query_context(p, req, sol)
+    };
+    ScaledStance {
+        verdict: exact(&p.grids, &p.stance.model, &ctx, sol.beta, lim),
+        cp,
+        ..check_solution(p, req, sol, lim)
     }
 }
 

@@ -11,6 +11,7 @@ use super::edit_outputs::{plan_table, plot_of, sidecars, EditOutputs};
 use super::queries::{load_pool, query_kv, write_table, LimitOptions};
 use crate::bvh::{parse_file, write_file, Bvh};
 use crate::edit::fidelity::{check, recorded_knee_range, FidelityOptions};
+use crate::edit::footing::{fit_run_contacts, impulse_change, Footing};
 use crate::edit::plan::{place, EditStance, PlanKind, StanceTiming};
 use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
@@ -164,7 +165,10 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
     let order: Vec<usize> = (0..e.cycles).flat_map(|_| [0, 1]).collect();
     let stances = chosen.stances.clone();
     let edit = compute(t, e.run.length_scale, stances, order, PlanKind::Run, &fold)?;
-    let achieved = format!("{achieved}; {}", swing_text(&edit.swing));
+    let mut achieved = format!("{achieved}; {}", swing_text(&edit.swing));
+    if let Some(moved) = footing_text(&edit) {
+        achieved = format!("{achieved}; {moved}");
+    }
     let tm = &chosen.timing;
     let kv = query_kv(
         &t.lib,
@@ -175,7 +179,7 @@ pub fn edit_run(e: &RunEdit) -> anyhow::Result<EditReport> {
             "active_set": limits.active, "gait_law": tm.law.source.name(),
             "sigma_contact": tm.sigma_c, "sigma_step": tm.sigma_t, "kappa": tm.kappa,
             "speed_achieved_mps": chosen.speed_mps, "keep_left_out": e.run.keep_left_out,
-            "swing_fold_deg": edit.swing.asked_deg,
+            "swing_fold_deg": edit.swing.asked_deg, "contact_shift_m": edit.footing.shift_m,
         }),
     )?;
     let title = format!(
@@ -224,6 +228,38 @@ fn swing_text(r: &FoldReport) -> String {
         "swing knee {:+.1}° at its fold (speed law {:+.1}°, {} of {} swings)",
         r.applied_deg, r.asked_deg, r.folded, r.swings
     )
+}
+
+/// The contacts a run moved for its legs to reach, in one phrase (`None`: none moved):
+/// per moved stance the shift, the support frames off the plan before and after, and the
+/// change of its angular impulse ([`crate::edit::footing`]).
+fn footing_text(e: &EditOutputs) -> Option<String> {
+    let f = &e.footing;
+    let each: Vec<String> = e
+        .stances
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| f.shift_m[i] != 0.0)
+        .map(|(i, s)| {
+            let d = f.shift_m[i];
+            format!(
+                "{} {:.0} cm {} (off the plan for {:.0} → {:.0} ms of the stance, angular \
+                 impulse {:+.1} N·m·s)",
+                s.source.stance_id,
+                d.abs() * 100.0,
+                if d > 0.0 { "forward" } else { "back" },
+                f.before[i].total() as f64 * f.miss_s[i] * 1e3,
+                f.after[i].total() as f64 * f.miss_s[i] * 1e3,
+                impulse_change(s, d)
+            )
+        })
+        .collect();
+    (!each.is_empty()).then(|| {
+        format!(
+            "contact moved where the legs do not reach the plan's: {}",
+            each.join(", ")
+        )
+    })
 }
 
 /// A run's plan in one phrase: its mean speed, the gait law and each stance's contact time
@@ -431,6 +467,28 @@ fn compute(
     if kind != PlanKind::Run {
         opts.swing_hold_s = DEFAULT_JUMP_SWING_HOLD_S;
     }
+    let fidelity_opts = match kind {
+        PlanKind::Run => FidelityOptions::run(),
+        PlanKind::Jump | PlanKind::PairedJump => FidelityOptions::jump(),
+    };
+    let mut stances = stances;
+    let footing = if kind == PlanKind::Run {
+        fit_run_contacts(
+            &mut stances,
+            &order,
+            &reference,
+            &opts,
+            fidelity_opts,
+            frame_time_s,
+        )
+    } else {
+        Footing::none(stances.len())
+    };
+    let (path, sources) = if footing.moved() {
+        place(&stances, &order, &reference, kind)
+    } else {
+        (path, sources)
+    };
     let edited = pose_motion(&reference, &path, &sources, &opts, frame_time_s);
     let footprints = path.stances.iter().map(|s| s.contact_point()).collect();
     let violated = stances
@@ -442,10 +500,7 @@ fn compute(
         &reference.motion,
         &edited.motion,
         &edited.frames,
-        match kind {
-            PlanKind::Run => FidelityOptions::run(),
-            PlanKind::Jump | PlanKind::PairedJump => FidelityOptions::jump(),
-        },
+        fidelity_opts,
     );
     fidelity.swing_folded = swing.folded > 0;
     Ok(EditOutputs {
@@ -458,6 +513,7 @@ fn compute(
         violated,
         fidelity,
         swing,
+        footing,
     })
 }
 

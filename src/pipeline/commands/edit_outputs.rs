@@ -42,6 +42,9 @@ pub struct EditOutputs {
     pub fidelity: Fidelity,
     /// The swing knee fold of a run ([`crate::edit::swing`]; nothing for a jump).
     pub swing: crate::edit::swing::FoldReport,
+    /// The contacts a run moved for its legs to reach ([`crate::edit::footing`]; none for
+    /// a jump).
+    pub footing: crate::edit::footing::Footing,
 }
 
 /// The sidecar paths of `FILE.bvh`: `FILE.plan.parquet`, `FILE.png`.

@@ -1,0 +1,327 @@
+//! Where a run's foot goes when the plan's contact point is beyond the body's reach: the
+//! least shift of a stance's contact point along its heading that lets its support leg
+//! follow the plan within the recorded posture (issue 37 item 5; a departure from the
+//! paper).
+//!
+//! # Model
+//! The paper places each contact at `u*`, where the scaled stance keeps its recorded
+//! angular impulse about the COM (stance-model §8.3). A run edited far faster than recorded
+//! keeps the recorded split of its longer contact between the front and the back of the
+//! body, and its push-off can end farther behind the body than the legs reach (CMU `09_01`,
+//! 3.6 m/s, asked for 5 m/s: the support ankle 15.5 mm off the floor point with the knee
+//! straight, the heel up 50° and the pelvis turned 10°), or its landing farther ahead than
+//! the recorded knee allows. People do move the foot: the plate runner recorded at 2 and
+//! 3 m/s puts its foot 0.13 m farther ahead of the COM at touchdown and 0.055 m farther
+//! behind it at liftoff. A law for that split could not be chosen by leaving runners out
+//! (`docs/edited-motion.md`), so the contact moves only where the legs cannot follow the
+//! plan, and by the least step that lets them:
+//! ```text
+//! support frame of source stance i, stance fraction u = (t − t_TD) / (t_LO − t_TD):
+//!   miss   the foot off its goal (not converged), or the support knee straighter than
+//!          the recorded range less the posture check's tolerance
+//!   late   misses with u ≥ ½ (the push-off: the contact must move forward, δ_i > 0)
+//!   early  misses with u < ½ (the landing: backward, δ_i < 0)
+//! search   δ_i ← δ_i ± CONTACT_SHIFT_STEP_M while stance i misses on one side only,
+//!          |δ_i| ≤ MAX_CONTACT_SHIFT_LEGS · L_leg; per stance the trial with the fewest
+//!          misses is kept (the smaller |δ_i| on a tie)
+//! u_h,i ← u*_h,i + δ_i        the angular impulse changes by ΔH = δ_i · I_v   (N·m·s)
+//! ```
+//! The COM path, the forces and the times stay the plan's; the force checks are repeated
+//! at the moved contact. A stance that misses on both sides keeps `u*` and its frames are
+//! reported as before.
+//!
+//! # Frames and units
+//! Metres along the stance's heading; `I_v` the stance's vertical impulse (N·s).
+
+use super::fidelity::{check, FidelityOptions, Gauge};
+use super::path::{ComPath, Phase};
+use super::plan::{feet_of, place, EditStance, PlanKind};
+use super::pose::{pose_motion, FramePose, Reference};
+use super::EditOptions;
+use crate::query::run::check_at_contact;
+
+/// Step of the contact-shift search, m.
+pub const CONTACT_SHIFT_STEP_M: f64 = 0.01;
+/// Largest contact shift, in leg lengths: a tenth of a leg (8.6 cm for CMU subject 09) is
+/// about the spread of one runner's touchdown distance between its strides at one speed
+/// (± 10 % of a 0.3–0.5 m distance ahead of the COM, `docs/edited-motion.md`).
+pub const MAX_CONTACT_SHIFT_LEGS: f64 = 0.1;
+
+/// The support frames of one source stance that miss the plan, by side of mid-stance.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Misses {
+    /// Before mid-stance (landing).
+    pub early: usize,
+    /// From mid-stance on (push-off).
+    pub late: usize,
+}
+
+impl Misses {
+    /// Both sides.
+    pub fn total(self) -> usize {
+        self.early + self.late
+    }
+
+    /// The direction the contact should move: +1 (forward) when only the push-off misses,
+    /// −1 when only the landing does, 0 otherwise.
+    pub fn direction(self) -> f64 {
+        match (self.early, self.late) {
+            (0, l) if l > 0 => 1.0,
+            (e, 0) if e > 0 => -1.0,
+            _ => 0.0,
+        }
+    }
+}
+
+/// The misses of every source stance (`n` of them) in a posed plan: `frames` and `gauges`
+/// (the written frames' knees) of `path`, `feet[i]` the legs of source stance `i` in
+/// contact (left, right), `knee_floor_deg` the least knee flexion the posture check accepts
+/// (`-∞`: none).
+pub fn misses(
+    frames: &[FramePose],
+    gauges: &[Gauge],
+    path: &ComPath,
+    feet: &[[bool; 2]],
+    knee_floor_deg: f64,
+) -> Vec<Misses> {
+    let mut out = vec![Misses::default(); feet.len()];
+    for (f, g) in frames.iter().zip(gauges) {
+        let (Phase::Stance(k), Some((td, lo))) = (f.phase, f.window) else {
+            continue;
+        };
+        let Some(i) = path.stances.get(k).map(|s| s.source) else {
+            continue;
+        };
+        let Some(legs) = feet.get(i) else {
+            continue;
+        };
+        let straight = (0..2).any(|s| legs[s] && g.knee_deg[s] < knee_floor_deg);
+        if f.converged && !straight {
+            continue;
+        }
+        let u = if lo > td {
+            (f.time_s - td) / (lo - td)
+        } else {
+            0.5
+        };
+        if u < 0.5 {
+            out[i].early += 1;
+        } else {
+            out[i].late += 1;
+        }
+    }
+    out
+}
+
+/// The outcome of the search.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Footing {
+    /// Contact shift of every source stance along its heading, m (forward +).
+    pub shift_m: Vec<f64>,
+    /// Misses with the plan's contacts.
+    pub before: Vec<Misses>,
+    /// Misses with the shifted contacts (in the trial that chose each stance's shift).
+    pub after: Vec<Misses>,
+    /// Time one miss of each stance stands for, s: the trial's frame time over the times
+    /// the stance plays in a trial (so `misses × miss_s` is the time of one stance off the
+    /// plan).
+    pub miss_s: Vec<f64>,
+}
+
+impl Footing {
+    /// No shift (the plan's contacts), for `n` source stances.
+    pub fn none(n: usize) -> Footing {
+        Footing {
+            shift_m: vec![0.0; n],
+            before: vec![Misses::default(); n],
+            after: vec![Misses::default(); n],
+            miss_s: vec![0.0; n],
+        }
+    }
+
+    /// Whether any contact moved.
+    pub fn moved(&self) -> bool {
+        self.shift_m.iter().any(|&d| d != 0.0)
+    }
+}
+
+/// The least contact shifts (module docs) of `n` source stances, each at most `cap_m`:
+/// `trial(shifts)` poses the plan with the contacts moved by `shifts` and returns its
+/// [`misses`]. Calls `trial` at most `1 + ⌊cap_m / CONTACT_SHIFT_STEP_M⌋` times.
+pub fn fit_shifts(n: usize, cap_m: f64, mut trial: impl FnMut(&[f64]) -> Vec<Misses>) -> Footing {
+    let mut shift = vec![0.0; n];
+    let before = trial(&shift);
+    let dir: Vec<f64> = before.iter().map(|m| m.direction()).collect();
+    let mut best: Vec<(f64, Misses)> = before.iter().map(|&m| (0.0, m)).collect();
+    let mut active: Vec<bool> = dir.iter().map(|&d| d != 0.0).collect();
+    let steps = (cap_m.max(0.0) / CONTACT_SHIFT_STEP_M).floor() as usize;
+    for step in 1..=steps {
+        if !active.iter().any(|&a| a) {
+            break;
+        }
+        for i in 0..n {
+            if active[i] {
+                shift[i] = dir[i] * step as f64 * CONTACT_SHIFT_STEP_M;
+            }
+        }
+        let got = trial(&shift);
+        for i in 0..n {
+            if !active[i] {
+                continue;
+            }
+            let m = got.get(i).copied().unwrap_or_default();
+            if m.total() < best[i].1.total() {
+                best[i] = (shift[i], m);
+            }
+            // Done when it reaches, or when the other side starts to miss.
+            if m.total() == 0 || m.direction() != dir[i] {
+                active[i] = false;
+            }
+        }
+    }
+    Footing {
+        shift_m: best.iter().map(|b| b.0).collect(),
+        before,
+        after: best.iter().map(|b| b.1).collect(),
+        miss_s: vec![0.0; n],
+    }
+}
+
+/// Stances a trial poses: the first two cycles of a run are enough to see every
+/// stance after a flight on each side (a cycle repeats).
+pub const TRIAL_STANCES: usize = 4;
+/// How many times the output rate a trial poses at: a later cycle's frames fall at other
+/// times of a stance than the first two cycles' (the fixture run at 7 m/s kept its knee in
+/// range in cycles 1–2 and straightened 0.6° beyond it one frame after a touchdown of
+/// cycle 3), so each trial sees the stances at the times any cycle's frames may fall.
+pub const TRIAL_OVERSAMPLING: f64 = 4.0;
+
+/// Moves the contacts of a run's solved `stances` (played in `order`) where its legs do not
+/// reach the plan ([`fit_shifts`], each shift at most [`MAX_CONTACT_SHIFT_LEGS`] leg
+/// lengths), and checks the moved stances' forces there ([`check_at_contact`]). Each trial
+/// poses the first [`TRIAL_STANCES`] of `order` as the edit would (`opts`,
+/// `frame_time_s`) and judges its knees as the posture check `fidelity` does.
+pub fn fit_run_contacts(
+    stances: &mut [EditStance],
+    order: &[usize],
+    reference: &Reference,
+    opts: &EditOptions,
+    fidelity: FidelityOptions,
+    frame_time_s: f64,
+) -> Footing {
+    let trial_order = &order[..order.len().min(TRIAL_STANCES)];
+    let feet: Vec<[bool; 2]> = stances.iter().map(|e| feet_of(&e.source.label)).collect();
+    let moved = |shift: &[f64]| -> Vec<EditStance> {
+        stances
+            .iter()
+            .zip(shift)
+            .map(|(e, &d)| {
+                let mut e = e.clone();
+                e.scaled.cp[0] += d;
+                e
+            })
+            .collect()
+    };
+    let trial = |shift: &[f64]| {
+        let (path, sources) = place(&moved(shift), trial_order, reference, PlanKind::Run);
+        let posed = pose_motion(
+            reference,
+            &path,
+            &sources,
+            opts,
+            frame_time_s / TRIAL_OVERSAMPLING,
+        );
+        let fid = check(
+            &reference.body,
+            &reference.motion,
+            &posed.motion,
+            &posed.frames,
+            fidelity,
+        );
+        let floor = if fidelity.knee_extension {
+            fid.knee_recorded_deg[0] - fidelity.knee_tol_deg
+        } else {
+            f64::NEG_INFINITY
+        };
+        misses(&posed.frames, &fid.frames, &path, &feet, floor)
+    };
+    let cap = MAX_CONTACT_SHIFT_LEGS * reference.body.leg_m;
+    let mut footing = fit_shifts(stances.len(), cap, trial);
+    let dt = frame_time_s / TRIAL_OVERSAMPLING;
+    footing.miss_s = (0..stances.len())
+        .map(|i| dt / trial_order.iter().filter(|&&k| k == i).count().max(1) as f64)
+        .collect();
+    for (e, &d) in stances.iter_mut().zip(&footing.shift_m) {
+        if d != 0.0 {
+            let cp = [e.scaled.cp[0] + d, e.scaled.cp[1]];
+            e.scaled = check_at_contact(&e.prepared, &e.request, &e.scaled.solution, &e.limits, cp);
+        }
+    }
+    footing
+}
+
+/// The change of a stance's angular impulse about the COM (pitch, N·m·s) when its contact
+/// moves `d` metres along its heading: `ΔH = d · I_v`, `I_v = β_v Δt F1_v(1)` its vertical
+/// impulse.
+pub fn impulse_change(e: &EditStance, d: f64) -> f64 {
+    let m = &e.prepared.stance.model;
+    d * e.scaled.solution.beta[2] * m.dt_s * m.axes[2].f1(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A toy leg: stance `i` misses `late` frames while its push-off is `need_i` metres
+    /// short, one frame per centimetre, and `early` frames once shifted past `room_i`.
+    fn toy(need: Vec<f64>, room: Vec<f64>) -> impl FnMut(&[f64]) -> Vec<Misses> {
+        move |s: &[f64]| {
+            s.iter()
+                .enumerate()
+                .map(|(i, &d)| Misses {
+                    late: ((need[i] - d) / 0.01).ceil().max(0.0) as usize,
+                    early: ((d - room[i]) / 0.01).ceil().max(0.0) as usize,
+                })
+                .collect()
+        }
+    }
+
+    #[test]
+    fn the_least_step_that_reaches_is_kept_and_a_reaching_stance_stays() {
+        let f = fit_shifts(2, 0.1, toy(vec![0.025, 0.0], vec![1.0, 1.0]));
+        assert!((f.shift_m[0] - 0.03).abs() < 1e-12, "{:?}", f.shift_m);
+        assert_eq!(f.shift_m[1], 0.0);
+        assert_eq!(f.before[0].late, 3);
+        assert_eq!(f.after[0], Misses::default());
+        assert!(f.moved());
+    }
+
+    #[test]
+    fn the_shift_stops_at_the_cap_and_where_the_landing_starts_to_miss() {
+        // Short by 20.5 cm, capped at 5 cm: the fewest misses within the cap.
+        let f = fit_shifts(1, 0.05, toy(vec![0.205], vec![1.0]));
+        assert!((f.shift_m[0] - 0.05).abs() < 1e-12);
+        assert_eq!(f.after[0].late, 16);
+        // Short by 4 cm with 2 cm of room at the landing: 2 cm, no further.
+        let f = fit_shifts(1, 0.1, toy(vec![0.04], vec![0.02]));
+        assert!((f.shift_m[0] - 0.02).abs() < 1e-12, "{:?}", f.shift_m);
+        assert_eq!(f.after[0], Misses { early: 0, late: 2 });
+    }
+
+    #[test]
+    fn a_landing_miss_moves_the_contact_back_and_both_sides_keep_it() {
+        // Misses at the landing only while the contact is more than 1.5 cm ahead.
+        let landing = |s: &[f64]| {
+            vec![Misses {
+                early: ((0.015 + s[0]) / 0.01).ceil().max(0.0) as usize,
+                late: 0,
+            }]
+        };
+        let f = fit_shifts(1, 0.1, landing);
+        assert!((f.shift_m[0] + 0.02).abs() < 1e-12, "{:?}", f.shift_m);
+        let both = |_: &[f64]| vec![Misses { early: 2, late: 3 }];
+        let f = fit_shifts(1, 0.1, both);
+        assert!(!f.moved());
+        assert_eq!(f.after, f.before);
+    }
+}
