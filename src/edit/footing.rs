@@ -23,7 +23,8 @@
 //!   early  misses with u < ½ (the landing: backward, δ_i < 0)
 //! search   δ_i ← δ_i ± CONTACT_SHIFT_STEP_M while stance i misses on one side only,
 //!          |δ_i| ≤ MAX_CONTACT_SHIFT_LEGS · L_leg; per stance the trial with the fewest
-//!          misses is kept (the smaller |δ_i| on a tie)
+//!          misses is kept (on a tie, the one whose feet come nearest their goals, then the
+//!          smaller |δ_i|)
 //! u_h,i ← u*_h,i + δ_i        the angular impulse changes by ΔH = δ_i · I_v   (N·m·s)
 //! ```
 //! The COM path, the forces and the times stay the plan's; the force checks are repeated
@@ -48,18 +49,26 @@ pub const CONTACT_SHIFT_STEP_M: f64 = 0.01;
 pub const MAX_CONTACT_SHIFT_LEGS: f64 = 0.1;
 
 /// The support frames of one source stance that miss the plan, by side of mid-stance.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Misses {
     /// Before mid-stance (landing).
     pub early: usize,
     /// From mid-stance on (push-off).
     pub late: usize,
+    /// Largest distance of a missing frame's support foot from its goal, m.
+    pub off_m: f64,
 }
 
 impl Misses {
     /// Both sides.
     pub fn total(self) -> usize {
         self.early + self.late
+    }
+
+    /// Whether `self` misses less than `other`: fewer frames, or as many with the foot
+    /// nearer its goal.
+    pub fn better_than(self, other: Misses) -> bool {
+        (self.total(), self.off_m) < (other.total(), other.off_m)
     }
 
     /// The direction the contact should move: +1 (forward) when only the push-off misses,
@@ -104,6 +113,9 @@ pub fn misses(
         } else {
             0.5
         };
+        if !f.converged {
+            out[i].off_m = out[i].off_m.max(f.foot_error_m);
+        }
         if u < 0.5 {
             out[i].early += 1;
         } else {
@@ -170,7 +182,7 @@ pub fn fit_shifts(n: usize, cap_m: f64, mut trial: impl FnMut(&[f64]) -> Vec<Mis
                 continue;
             }
             let m = got.get(i).copied().unwrap_or_default();
-            if m.total() < best[i].1.total() {
+            if m.better_than(best[i].1) {
                 best[i] = (shift[i], m);
             }
             // Done when it reaches, or when the other side starts to miss.
@@ -281,6 +293,7 @@ mod tests {
                 .map(|(i, &d)| Misses {
                     late: ((need[i] - d) / 0.01).ceil().max(0.0) as usize,
                     early: ((d - room[i]) / 0.01).ceil().max(0.0) as usize,
+                    ..Misses::default()
                 })
                 .collect()
         }
@@ -305,7 +318,21 @@ mod tests {
         // Short by 4 cm with 2 cm of room at the landing: 2 cm, no further.
         let f = fit_shifts(1, 0.1, toy(vec![0.04], vec![0.02]));
         assert!((f.shift_m[0] - 0.02).abs() < 1e-12, "{:?}", f.shift_m);
-        assert_eq!(f.after[0], Misses { early: 0, late: 2 });
+        assert_eq!((f.after[0].early, f.after[0].late), (0, 2));
+    }
+
+    #[test]
+    fn as_many_misses_nearer_the_goal_is_better() {
+        // One frame misses from 7 cm on, its foot 6 mm nearer its goal per centimetre: the
+        // nearest within the cap (8 cm), not the first with one miss.
+        let f = fit_shifts(1, 0.085, |s: &[f64]| {
+            vec![Misses {
+                early: 0,
+                late: if s[0] < 0.065 { 3 } else { 1 },
+                off_m: (0.05 - 0.6 * s[0]).max(0.001),
+            }]
+        });
+        assert!((f.shift_m[0] - 0.08).abs() < 1e-12, "{:?}", f.shift_m);
     }
 
     #[test]
@@ -314,12 +341,18 @@ mod tests {
         let landing = |s: &[f64]| {
             vec![Misses {
                 early: ((0.015 + s[0]) / 0.01).ceil().max(0.0) as usize,
-                late: 0,
+                ..Misses::default()
             }]
         };
         let f = fit_shifts(1, 0.1, landing);
         assert!((f.shift_m[0] + 0.02).abs() < 1e-12, "{:?}", f.shift_m);
-        let both = |_: &[f64]| vec![Misses { early: 2, late: 3 }];
+        let both = |_: &[f64]| {
+            vec![Misses {
+                early: 2,
+                late: 3,
+                off_m: 0.01,
+            }]
+        };
         let f = fit_shifts(1, 0.1, both);
         assert!(!f.moved());
         assert_eq!(f.after, f.before);
