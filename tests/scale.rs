@@ -454,29 +454,18 @@ fn merge_refuses_shards_built_with_other_options_naming_the_shard() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("options") && err.contains(&s(&b)), "{err}");
     assert!(!out.exists());
-    // Another tool version: the manifest says so (edited here to stand for an old build).
-    build_cli(&inputs, &b, &["--shard", "2/2"]);
+    // Another tool version, or another source at the same version (shards computed by
+    // different code): the manifest says so (edited here to stand for an old build).
     let path = b.join("manifest.json");
-    let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::write(
-        &path,
-        text.replace("\"tool_version\": \"", "\"tool_version\": \"0.0.0-"),
-    )
-    .unwrap();
-    let (code, err) = merge_cli(&[&a, &b], &out);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("tool_version"), "{err}");
-    // Another source at the same version: shards computed by different code.
-    build_cli(&inputs, &b, &["--shard", "2/2"]);
-    let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::write(
-        &path,
-        text.replace("\"source_digest\": \"", "\"source_digest\": \"f00d"),
-    )
-    .unwrap();
-    let (code, err) = merge_cli(&[&a, &b], &out);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("source_digest"), "{err}");
+    for (key, mark) in [("tool_version", "0.0.0-"), ("source_digest", "f00d")] {
+        build_cli(&inputs, &b, &["--shard", "2/2"]);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let from = format!("\"{key}\": \"");
+        std::fs::write(&path, text.replace(&from, &format!("{from}{mark}"))).unwrap();
+        let (code, err) = merge_cli(&[&a, &b], &out);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(key), "{err}");
+    }
     // Shards of different input lists never merge either.
     build_cli(&inputs[1..], &b, &["--shard", "2/2"]);
     let (code, err) = merge_cli(&[&a, &b], &out);
