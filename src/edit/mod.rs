@@ -53,8 +53,8 @@
 //! - A support foot still beyond reach on its upright toe (a CMU run at 1.1 × its speed
 //!   plans the COM 1.127 m from the contact at liftoff, 3 % beyond the recorded 1.094 m) is
 //!   reached by posture, not by the leg alone ([`posture`]): the pelvis (pitch, roll, yaw,
-//!   at most [`DEFAULT_MAX_PELVIS_TURN_DEG`]) turns under a trunk that keeps its recorded
-//!   orientation, by the smallest damped least-squares change that brings the stance hip
+//!   at most [`DEFAULT_MAX_PELVIS_TURN_DEG`]) turns under a trunk (and swinging legs, by
+//!   how little their feet are held) that keeps its recorded orientation, by the smallest damped least-squares change that brings the stance hip
 //!   within reach of the foot once the root has put the COM back on the plan (Jacobian of
 //!   the leg's shortfall by finite differences of FK, foot IK and COM), and the solved
 //!   changes are ramped in and out over [`DEFAULT_POSTURE_RAMP_S`]. Without it the left

@@ -9,6 +9,12 @@
 //! degrees of freedom x ∈ [−1, 1]³ (scaled by the bound b):
 //!   pelvis (root) pitch, roll, yaw    θ_d = x_d · b    about the root:  R_p = R_up(θ₂) R_fwd(θ₁) R_lat(θ₀)
 //!   the trunk (first joint above the root) turned back by R_p⁻¹: its world orientation is kept
+//!   so is the hip of a swinging leg, by weight w = 1 − h (h: how strongly the foot is held
+//!   on its planted path, 1 at its contacts): q_hip = slerp(q_hip, (R_p W_parent)⁻¹ W_hip, w),
+//!   so a swinging leg translates with the pelvis instead of swinging out with its turn (a
+//!   10° roll threw the first swing of CMU `09_01` at 5 m/s 12 cm sideways; now under 2 cm
+//!   beyond the recording's lateral range), and a leg leaving or meeting the floor turns with
+//!   the pelvis as its planted IK does (a full turn back at liftoff snapped the leg: 14 g)
 //!   axes: lateral l = horizontal unit of (H_L − H_R), up z, forward l × z (free pose)
 //! shortfall of support leg k after the root correction (COM on the plan):
 //!   s_k(x) = |G_k − H_k(x) − (c_plan − c(x))| − R_k
@@ -52,6 +58,19 @@ pub const DAMPING_M: f64 = 1e-3;
 /// a degree, far inside the linear range of FK).
 pub const FD_STEP: f64 = 1e-3;
 
+/// A joint that keeps its world rotation (by `weight`) when the pelvis turns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Kept {
+    /// The joint.
+    pub joint: usize,
+    /// Its parent's world rotation in the free pose.
+    pub parent_world: Quat,
+    /// Its own world rotation in the free pose.
+    pub world: Quat,
+    /// 1: kept; 0: turned with the pelvis; between, slerped.
+    pub weight: f64,
+}
+
 /// The joints, axes and free-pose world rotations one frame's posture changes act on.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PostureFrame {
@@ -59,21 +78,23 @@ pub struct PostureFrame {
     axes: [V3; 3],
     /// Root joint.
     root: usize,
-    /// Trunk joint, its parent's and its own world rotation in the free pose.
-    trunk: Option<(usize, Quat, Quat)>,
+    /// Joints that keep their world rotation when the pelvis turns: the trunk, and the hips
+    /// of swinging legs ([`Kept`]).
+    kept: [Option<Kept>; 3],
     /// Bound of each pelvis turn (rad).
     bound: f64,
 }
 
 impl PostureFrame {
     /// The frame of a free pose: hips `hips` (left, right; file), up axis `up` (file, unit),
-    /// the root, the trunk joint with its parent's and its own world rotation, and the
-    /// bound of the pelvis turns (rad).
+    /// the root, the joints that keep their world rotation (the trunk; the hip of each leg
+    /// not planted) with their parent's and their own world rotation, and the bound of the
+    /// pelvis turns (rad).
     pub fn new(
         hips: [V3; 2],
         up: V3,
         root: usize,
-        trunk: Option<(usize, Quat, Quat)>,
+        kept: [Option<Kept>; 3],
         bound: f64,
     ) -> PostureFrame {
         let d: V3 = std::array::from_fn(|i| hips[0][i] - hips[1][i]);
@@ -97,14 +118,15 @@ impl PostureFrame {
         PostureFrame {
             axes: [lat, fwd, up],
             root,
-            trunk,
+            kept,
             bound,
         }
     }
 
     /// Applies posture `x` to the free pose's local rotations `q` (in place): the root
-    /// turned by `R_p = R_up(θ₂) R_fwd(θ₁) R_lat(θ₀)` about its own position, the trunk joint
-    /// keeping its world rotation (`q_t = (R_p W_parent)⁻¹ W_t`).
+    /// turned by `R_p = R_up(θ₂) R_fwd(θ₁) R_lat(θ₀)` about its own position, the kept joints
+    /// (trunk, hips of legs not planted) keeping their world rotation
+    /// (`q_t = (R_p W_parent)⁻¹ W_t`).
     pub fn apply(&self, x: &Posture, q: &mut [Quat]) {
         if x.iter().all(|&v| v == 0.0) {
             return;
@@ -119,9 +141,14 @@ impl PostureFrame {
             ),
         );
         q[self.root] = rot::normalize(rot::mul(rp, q[self.root]));
-        if let Some((j, w_parent, w_own)) = self.trunk {
-            let parent = rot::mul(rp, w_parent);
-            q[j] = rot::normalize(rot::mul(rot::conj(parent), w_own));
+        for k in self.kept.iter().flatten() {
+            let parent = rot::mul(rp, k.parent_world);
+            let back = rot::normalize(rot::mul(rot::conj(parent), k.world));
+            q[k.joint] = if k.weight >= 1.0 {
+                back
+            } else {
+                rot::slerp(q[k.joint], back, k.weight.max(0.0))
+            };
         }
     }
 }
@@ -285,22 +312,43 @@ mod tests {
     }
 
     #[test]
-    fn pelvis_turns_under_a_trunk_that_keeps_its_world_orientation() {
-        // Root 0, trunk 1 (child of the root), Z up, hips along ±y: lateral +y.
+    fn pelvis_turns_under_a_trunk_and_a_free_leg_that_keep_their_world_orientation() {
+        // Root 0, trunk 1 and a swinging hip 3 (through a hip link 2) below the root, a
+        // planted hip 4; Z up, hips along ±y: lateral +y.
         let up = [0.0, 0.0, 1.0];
         let q_root = rot::axis_angle([0.0, 0.0, 1.0], 0.3);
         let q_trunk = rot::axis_angle([0.0, 1.0, 0.0], 0.2);
+        let q_link = rot::axis_angle([1.0, 0.0, 0.0], 0.1);
+        let q_hip = rot::axis_angle([0.0, 1.0, 0.0], -0.6);
+        let q_planted = rot::axis_angle([0.0, 1.0, 0.0], 0.4);
         let w_trunk = rot::mul(q_root, q_trunk);
+        let w_link = rot::mul(q_root, q_link);
+        let w_hip = rot::mul(w_link, q_hip);
         let fr = PostureFrame::new(
             [[0.0, 0.1, 0.0], [0.0, -0.1, 0.0]],
             up,
             0,
-            Some((1, q_root, w_trunk)),
+            [
+                Some(Kept {
+                    joint: 1,
+                    parent_world: q_root,
+                    world: w_trunk,
+                    weight: 1.0,
+                }),
+                Some(Kept {
+                    joint: 3,
+                    parent_world: w_link,
+                    world: w_hip,
+                    weight: 1.0,
+                }),
+                None,
+            ],
             10f64.to_radians(),
         );
-        let mut q = vec![q_root, q_trunk];
+        let mut q = vec![q_root, q_trunk, q_link, q_hip, q_planted];
         fr.apply(&[0.7, -0.4, 1.0], &mut q);
-        // The root turned; the trunk's world rotation is the free pose's.
+        // The root turned; the trunk's and the free hip's world rotations are the free
+        // pose's, while the planted leg turns with the pelvis (its IK places it after).
         assert!(rot::angle_deg(q[0], q_root) > 5.0);
         let w = rot::mul(q[0], q[1]);
         assert!(
@@ -308,5 +356,26 @@ mod tests {
             "{}",
             rot::angle_deg(w, w_trunk)
         );
+        let w = rot::mul(rot::mul(q[0], q[2]), q[3]);
+        // acos near 1: a few 1e-6° of round-off.
+        assert!(
+            rot::angle_deg(w, w_hip) < 1e-5,
+            "{}",
+            rot::angle_deg(w, w_hip)
+        );
+        // Half kept: halfway between turned with the pelvis and kept.
+        let mut half = fr;
+        half.kept[1] = half.kept[1].map(|k| Kept { weight: 0.5, ..k });
+        let mut q = vec![q_root, q_trunk, q_link, q_hip, q_planted];
+        half.apply(&[0.7, -0.4, 1.0], &mut q);
+        let w = rot::mul(rot::mul(q[0], q[2]), q[3]);
+        let turned = rot::mul(rot::mul(q[0], q_link), q_hip);
+        let (to_kept, to_turned) = (rot::angle_deg(w, w_hip), rot::angle_deg(w, turned));
+        assert!(
+            to_kept > 1.0 && (to_kept - to_turned).abs() < 1e-6,
+            "{to_kept} {to_turned}"
+        );
+        let w = rot::mul(q[0], q[4]);
+        assert!(rot::angle_deg(w, rot::mul(q_root, q_planted)) > 5.0);
     }
 }

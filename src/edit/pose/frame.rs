@@ -33,7 +33,7 @@ use super::reference::{yaw_of, Reference, StanceSource};
 use super::{EditedMotion, FramePose};
 use crate::bvh::Motion;
 use crate::edit::path::{ComPath, Phase};
-use crate::edit::posture::{self, Posture, PostureFrame, POSTURE_ZERO};
+use crate::edit::posture::{self, Kept, Posture, PostureFrame, POSTURE_ZERO};
 use crate::edit::rotation as rot;
 use crate::edit::EditOptions;
 use crate::math::v3::{add, norm, sub, V3};
@@ -263,7 +263,7 @@ fn solve_frame(
     let solve = fixed.is_none();
     let base = fixed.copied().unwrap_or(POSTURE_ZERO);
     let frame = ((solve && g.planted.iter().any(|&p| p)) || base != POSTURE_ZERO)
-        .then(|| posture_frame(r, ws, opts));
+        .then(|| posture_frame(r, ws, opts, &g.pulls));
     let mut reach = ReachState {
         y: POSTURE_ZERO,
         jac: None,
@@ -325,20 +325,36 @@ fn solve_frame(
     }
 }
 
-/// The free pose's posture frame ([`PostureFrame`]): its hips, the trunk joint's world
-/// rotations and the bound of `opts` (`ws` is left with FK of the free pose).
-fn posture_frame(r: &Reference, ws: &mut PoseWorkspace, opts: &EditOptions) -> PostureFrame {
+/// The free pose's posture frame ([`PostureFrame`]): its hips, the world rotations of the
+/// joints that keep them (the trunk; the hip of each leg by how little its foot is held,
+/// `1 − pull`, from `pulls`) and the bound of `opts` (`ws` is left with FK of the free pose).
+fn posture_frame(
+    r: &Reference,
+    ws: &mut PoseWorkspace,
+    opts: &EditOptions,
+    pulls: &[Option<(V3, rot::Quat, [f64; 2])>; 2],
+) -> PostureFrame {
     ws.pose.q.copy_from_slice(&ws.free_q);
     forward(r, &ws.pose, &mut ws.world_q, &mut ws.file, &mut ws.pts);
-    let trunk = r.trunk.map(|j| {
-        let parent = r.body.skeleton.parents[j].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
-        (j, parent, ws.world_q[j])
-    });
+    let kept = |joint: usize, weight: f64| {
+        let parent = r.body.skeleton.parents[joint].map_or(rot::QUAT_IDENTITY, |p| ws.world_q[p]);
+        Kept {
+            joint,
+            parent_world: parent,
+            world: ws.world_q[joint],
+            weight,
+        }
+    };
+    let free_hip = |side: usize| {
+        let held = pulls[side].map_or(0.0, |(_, _, pull)| pull[1].clamp(0.0, 1.0));
+        (held < 1.0).then(|| kept(r.legs[side][0], 1.0 - held))
+    };
+    let kept = [r.trunk.map(|j| kept(j, 1.0)), free_hip(0), free_hip(1)];
     PostureFrame::new(
         [ws.file[r.legs[0][0]], ws.file[r.legs[1][0]]],
         up_file(&r.body),
         r.root,
-        trunk,
+        kept,
         opts.max_pelvis_turn_deg.to_radians(),
     )
 }
