@@ -466,6 +466,31 @@ fn merge_refuses_shards_built_with_other_options_naming_the_shard() {
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(key), "{err}");
     }
+    // Shards that agree with each other but were written by other code (both digests
+    // edited alike, or both missing as in a library written before the digest): the merged
+    // manifest would record this build's digest on their rows, so they are refused too.
+    for foreign in [Some("0".repeat(64)), None] {
+        for shard in [(&a, "1/2"), (&b, "2/2")] {
+            build_cli(&inputs, shard.0, &["--shard", shard.1]);
+            let p = shard.0.join("manifest.json");
+            let mut m: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+            let o = m.as_object_mut().unwrap();
+            match &foreign {
+                Some(d) => o.insert("source_digest".into(), d.clone().into()),
+                None => o.remove("source_digest"),
+            };
+            std::fs::write(&p, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+        }
+        let (code, err) = merge_cli(&[&a, &b], &out);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("written by another build of stancelib"),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+    build_cli(&inputs, &a, &["--shard", "1/2"]);
     // Shards of different input lists never merge either.
     build_cli(&inputs[1..], &b, &["--shard", "2/2"]);
     let (code, err) = merge_cli(&[&a, &b], &out);

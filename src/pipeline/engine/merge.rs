@@ -35,7 +35,7 @@ use crate::error::{Error, Result};
 use crate::library::codec::schema::sort_keys;
 use crate::library::codec::schema::{
     group_column, CLIPS_FILE, CONTACTS_FILE, ERRORS_FILE, FRAMES_FILE, JOINTS_FILE,
-    KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, STANCES_FILE,
+    KINEMATICS_SAMPLES_FILE, MANIFEST_FILE, SOURCE_DIGEST, STANCES_FILE,
 };
 use crate::library::codec::table::read_parquet;
 use crate::library::storage::group_reader::GroupFileReader;
@@ -214,6 +214,22 @@ fn check_shards(mut libs: Vec<ShardLib>) -> Result<Vec<ShardLib>> {
     let Some(first) = libs.first() else {
         return Err(Error::config(None, None, "merge: no shard libraries given"));
     };
+    // The merged manifest records this build's source: rows of other code are not its rows
+    // (a later `build --incremental` would reuse them).
+    for lib in &libs {
+        let digest = lib.manifest.get("source_digest").and_then(|d| d.as_str());
+        if digest != Some(SOURCE_DIGEST) {
+            return Err(bad(
+                &lib.dir,
+                format!(
+                    "source_digest is {} here but this stancelib is {SOURCE_DIGEST}: a shard \
+                     written by another build of stancelib is never merged (build it again \
+                     with this one)",
+                    digest.unwrap_or("none")
+                ),
+            ));
+        }
+    }
     for lib in &libs[1..] {
         for field in SHARED_FIELDS {
             let (a, b) = (first.manifest.pointer(field), lib.manifest.pointer(field));
