@@ -61,11 +61,12 @@
 //!   push-off ended 2.0 frames early and 10 frames were reported; with it 0.91 frames and
 //!   none. A run's pelvis turns too where a support knee would straighten more than
 //!   `pose::reach::POSTURE_KNEE_SLACK_DEG` beyond the toe pivot's bound (below).
-//! - Where a run's support leg cannot follow the plan (a push-off farther behind the body
-//!   than the leg reaches, a landing straighter than the recorded knee), its contact point
-//!   moves along the heading by the least whole centimetre that lets it, at most a tenth of
-//!   a leg ([`footing`], a departure from the paper's angular-impulse contact point: the
-//!   edit prints the shift and the change of the stance's angular impulse).
+//! - Where a written run's support leg does not follow the plan (a push-off farther behind
+//!   the body than the leg reaches, a landing straighter than the recorded knee), its
+//!   contact point moves along the heading by the least step (an eighth of its bound) that
+//!   lets it, at most a tenth of a leg ([`footing`], a departure from the paper's
+//!   angular-impulse contact point: the edit prints the shift and the change of the
+//!   stance's angular impulse).
 //! - The edit keeps its source's posture (issue 37 item 5, [`fidelity`]): a run's knee
 //!   straightens no further than the source's least flexion less [`RUN_KNEE_SLACK_DEG`]
 //!   (the heel rises instead), a jump's knee shares the end of its push with the heel

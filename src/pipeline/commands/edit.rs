@@ -11,7 +11,7 @@ use super::edit_outputs::{plan_table, plot_of, sidecars, EditOutputs};
 use super::queries::{load_pool, query_kv, write_table, LimitOptions};
 use crate::bvh::{parse_file, write_file, Bvh};
 use crate::edit::fidelity::{check, recorded_knee_range, FidelityOptions};
-use crate::edit::footing::{fit_run_contacts, impulse_change, Footing};
+use crate::edit::footing::{impulse_change, pose_reaching, Footing};
 use crate::edit::plan::{place, EditStance, PlanKind, StanceTiming};
 use crate::edit::pose::{pose_motion, Reference};
 use crate::edit::select::{
@@ -243,7 +243,7 @@ fn footing_text(e: &EditOutputs) -> Option<String> {
         .map(|(i, s)| {
             let d = f.shift_m[i];
             format!(
-                "{} {:.0} cm {} (off the plan for {:.0} → {:.0} ms of the stance, angular \
+                "{} {:.1} cm {} (off the plan for {:.0} → {:.0} ms of the stance, pitch angular \
                  impulse {:+.1} N·m·s)",
                 s.source.stance_id,
                 d.abs() * 100.0,
@@ -472,24 +472,20 @@ fn compute(
         PlanKind::Jump | PlanKind::PairedJump => FidelityOptions::jump(),
     };
     let mut stances = stances;
-    let footing = if kind == PlanKind::Run {
-        fit_run_contacts(
+    let (path, edited, footing) = if kind == PlanKind::Run {
+        let (path, _, edited, footing) = pose_reaching(
             &mut stances,
             &order,
             &reference,
             &opts,
             fidelity_opts,
             frame_time_s,
-        )
+        );
+        (path, edited, footing)
     } else {
-        Footing::none(stances.len())
+        let edited = pose_motion(&reference, &path, &sources, &opts, frame_time_s);
+        (path, edited, Footing::none(stances.len()))
     };
-    let (path, sources) = if footing.moved() {
-        place(&stances, &order, &reference, kind)
-    } else {
-        (path, sources)
-    };
-    let edited = pose_motion(&reference, &path, &sources, &opts, frame_time_s);
     let footprints = path.stances.iter().map(|s| s.contact_point()).collect();
     let violated = stances
         .iter()
