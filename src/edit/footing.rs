@@ -27,9 +27,12 @@
 //!          misses on one side only, |δ_i| ≤ b = MAX_CONTACT_SHIFT_LEGS · L_leg; per stance
 //!          the trial with the fewest misses is kept (on a tie, the one whose feet come
 //!          nearest their goals, then the smaller |δ_i|)
-//! check    a stance the move makes infeasible (feasible at u*) keeps u*
-//! confirm  the edit posed again with u_h,i ← u*_h,i + δ_i is kept if its frames miss
-//!          less than at u*; the pitch angular impulse changes by ΔH_p = −δ_i · I_v
+//! check    no search when a stance is infeasible at u*; a stance the move makes
+//!          infeasible keeps u* (its search ends there)
+//! confirm  the edit posed again with u_h,i ← u*_h,i + δ_i is kept if no moved stance
+//!          misses more than at u* and all together miss less (a stance that misses more
+//!          goes back to u* and the rest are posed again); the pitch angular impulse
+//!          changes by ΔH_p = −δ_i · I_v
 //! ```
 //! The COM path, the forces and the times stay the plan's; the force checks are repeated
 //! at the moved contact. A stance that misses on both sides keeps `u*` and its frames are
@@ -134,10 +137,11 @@ pub struct Footing {
     pub shift_m: Vec<f64>,
     /// Misses with the plan's contacts.
     pub before: Vec<Misses>,
-    /// Misses with the shifted contacts (in the trial that chose each stance's shift).
+    /// Misses with the shifted contacts ([`fit_shifts`]: in the trial that chose each
+    /// stance's shift; [`pose_reaching`]: in the edit written).
     pub after: Vec<Misses>,
-    /// Time one miss of each stance stands for, s: the trial's frame time over the times
-    /// the stance plays in a trial (so `misses × miss_s` is the time of one stance off the
+    /// Time one miss of each stance stands for, s: the frame time over the times the
+    /// stance plays (so `misses × miss_s` is the time of one play of the stance off the
     /// plan).
     pub miss_s: Vec<f64>,
 }
@@ -269,7 +273,10 @@ pub fn pose_reaching(
         .collect();
     footing.before.clone_from(&before);
     footing.after.clone_from(&before);
-    if before.iter().all(|m| m.total() == 0) {
+    // Nothing to move where the frames follow the plan; nor where a stance is infeasible
+    // at the paper's contact (the request is refused, or written as infeasible, as it is).
+    let infeasible = stances.iter().any(|e| e.scaled.verdict.violated.is_some());
+    if infeasible || before.iter().all(|m| m.total() == 0) {
         return (path, sources, edited, footing);
     }
     let trial_order = &order[..order.len().min(TRIAL_STANCES)];
@@ -280,20 +287,46 @@ pub fn pose_reaching(
     let dt = frame_time_s / room.clamp(1.0, TRIAL_OVERSAMPLING);
     let cap = MAX_CONTACT_SHIFT_LEGS * reference.body.leg_m;
     let searched = fit_shifts(n, cap, cap / CONTACT_SHIFT_STEPS as f64, |shift| {
-        pose(&moved(stances, shift).0, trial_order, dt).3
+        let (st, kept) = moved(stances, shift);
+        let mut m = pose(&st, trial_order, dt).3;
+        // A shift the forces do not allow ends that stance's search (it misses both ways).
+        for (i, m) in m.iter_mut().enumerate() {
+            if shift[i] != 0.0 && kept[i] == 0.0 {
+                *m = Misses {
+                    early: usize::MAX / 4,
+                    late: usize::MAX / 4,
+                    off_m: f64::INFINITY,
+                };
+            }
+        }
+        m
     });
-    let (moved_stances, shift) = moved(stances, &searched.shift_m);
-    if shift.iter().all(|&d| d == 0.0) {
-        return (path, sources, edited, footing);
+    let mut shift = searched.shift_m;
+    // Confirmed on the edit itself: every moved stance misses no more than at the paper's
+    // contact, and all of them together less; a stance that misses more goes back.
+    for _ in 0..n {
+        let (moved_stances, kept) = moved(stances, &shift);
+        if kept.iter().all(|&d| d == 0.0) {
+            break;
+        }
+        let (p1, s1, e1, after) = pose(&moved_stances, order, frame_time_s);
+        let worse: Vec<usize> = (0..n)
+            .filter(|&i| kept[i] != 0.0 && before[i].better_than(after[i]))
+            .collect();
+        if worse.is_empty() {
+            if !total(&after).better_than(total(&before)) {
+                break;
+            }
+            *stances = moved_stances;
+            footing.shift_m = kept;
+            footing.after = after;
+            return (p1, s1, e1, footing);
+        }
+        for i in worse {
+            shift[i] = 0.0;
+        }
     }
-    let (p1, s1, e1, after) = pose(&moved_stances, order, frame_time_s);
-    if !total(&after).better_than(total(&before)) {
-        return (path, sources, edited, footing);
-    }
-    *stances = moved_stances;
-    footing.shift_m = shift;
-    footing.after = after;
-    (p1, s1, e1, footing)
+    (path, sources, edited, footing)
 }
 
 /// `stances` with each contact moved `shift[i]` along its heading and its forces checked

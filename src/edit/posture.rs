@@ -87,9 +87,8 @@ pub struct PostureFrame {
 
 impl PostureFrame {
     /// The frame of a free pose: hips `hips` (left, right; file), up axis `up` (file, unit),
-    /// the root, the joints that keep their world rotation (the trunk; the hip of each leg
-    /// not planted) with their parent's and their own world rotation, and the bound of the
-    /// pelvis turns (rad).
+    /// the root, the joints that keep their world rotation ([`Kept`]: the trunk, and the hip
+    /// of each leg by how little its foot is held), and the bound of the pelvis turns (rad).
     pub fn new(
         hips: [V3; 2],
         up: V3,
@@ -125,8 +124,8 @@ impl PostureFrame {
 
     /// Applies posture `x` to the free pose's local rotations `q` (in place): the root
     /// turned by `R_p = R_up(θ₂) R_fwd(θ₁) R_lat(θ₀)` about its own position, the kept joints
-    /// (trunk, hips of legs not planted) keeping their world rotation
-    /// (`q_t = (R_p W_parent)⁻¹ W_t`).
+    /// keeping their world rotation by their weight `w`
+    /// (`q_t = slerp(q_t, (R_p W_parent)⁻¹ W_t, w)`).
     pub fn apply(&self, x: &Posture, q: &mut [Quat]) {
         if x.iter().all(|&v| v == 0.0) {
             return;

@@ -153,11 +153,10 @@ fn verify_shards(libs: &[ShardLib]) -> Result<()> {
 }
 
 /// The manifest fields all shards of one build share.
-const SHARED_FIELDS: [&str; 7] = [
+const SHARED_FIELDS: [&str; 6] = [
     "/schema",
     "/schema_version",
     "/tool_version",
-    "/source_digest",
     "/options",
     "/shard/count",
     "/shard/inputs_sha256",
