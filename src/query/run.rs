@@ -358,9 +358,10 @@ pub fn check_at_contact(
         ..query_context(p, req, sol)
     };
     ScaledStance {
+        solution: *sol,
+        feasible_approx: approx_ok(p, sol.beta, lim),
         verdict: exact(&p.grids, &p.stance.model, &ctx, sol.beta, lim),
         cp,
-        ..check_solution(p, req, sol, lim)
     }
 }
 
